@@ -1,0 +1,60 @@
+"""sweepik: every inverse-kinematics solution of 6-DOF serial arms, by a one-joint sweep.
+
+Public API: robots (``load_robot``, ``Robot``, ``Joint``), pose helpers and error metrics, and the solvers
+``solve`` and ``solve_many``. See the README and docs/conventions.md for units and conventions.
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
+from .errors import (
+    InvalidPoseError,
+    NonFiniteError,
+    RobotDefinitionError,
+    RobotFileError,
+    ShapeError,
+    SweepikError,
+    UnknownOptionError,
+    UnknownRobotError,
+)
+from .pose import (
+    matrix_from_zyz,
+    pose_error_geodesic,
+    pose_error_paper,
+    pose_from_xyz_zyz,
+    rotation_angle,
+    wrap_angle,
+    xyz_zyz_from_pose,
+    zyz_from_matrix,
+)
+from .robot import Joint, Robot
+from .robot_file import bundled_robots, load_robot, robot_from_dict
+
+try:
+    __version__ = version("sweepik")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
+    __version__ = "0.0.0"
+
+__all__ = [
+    "__version__",
+    "Joint",
+    "Robot",
+    "load_robot",
+    "bundled_robots",
+    "robot_from_dict",
+    "zyz_from_matrix",
+    "matrix_from_zyz",
+    "pose_from_xyz_zyz",
+    "xyz_zyz_from_pose",
+    "wrap_angle",
+    "rotation_angle",
+    "pose_error_paper",
+    "pose_error_geodesic",
+    "SweepikError",
+    "RobotDefinitionError",
+    "RobotFileError",
+    "UnknownRobotError",
+    "ShapeError",
+    "NonFiniteError",
+    "InvalidPoseError",
+    "UnknownOptionError",
+]

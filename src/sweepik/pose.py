@@ -1,0 +1,156 @@
+"""Pose helpers: Z-Y-Z Euler angles (Craig's convention), pose construction and pose error metrics.
+
+Conventions
+-----------
+* A pose is a homogeneous transform ``(..., 4, 4)``; rotations are ``(..., 3, 3)``.
+* ``R = Rz(alpha) @ Ry(beta) @ Rz(gamma)`` (Craig 2005, Z-Y-Z Euler angles), radians,
+  ``beta`` in [0, pi], ``alpha`` and ``gamma`` in (-pi, pi].
+* At the gimbal cases ``beta = 0`` (only ``alpha + gamma`` is defined) and ``beta = pi`` (only
+  ``alpha - gamma``), Craig's choice ``alpha = 0`` is made.
+* Errors are in the robot's length unit; the orientation part is weighted by a length (default
+  100 mm, the paper's choice) that turns radians into that unit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = [
+    "GIMBAL_TOL",
+    "zyz_from_matrix",
+    "matrix_from_zyz",
+    "pose_from_xyz_zyz",
+    "xyz_zyz_from_pose",
+    "wrap_angle",
+    "rotation_angle",
+    "pose_error_paper",
+    "pose_error_geodesic",
+]
+
+#: Below this beta (or pi - beta), in radians, alpha and gamma of a Z-Y-Z decomposition are only
+#: defined through their sum (difference). alpha is computed from matrix entries of size sin(beta), so its
+#: rounding error is about 2e-16 / sin(beta): at 1e-4 rad that is 2e-12 rad, i.e. 2e-10 mm of J at the
+#: paper's 100 mm weight. Inside the band the gimbal form is used (see ``pose_error_paper``).
+GIMBAL_TOL = 1e-4
+
+Array = NDArray[np.float64]
+
+#: sin(beta) at or below which a rotation is treated as exactly gimbal-locked by ``zyz_from_matrix``
+#: (alpha from entries this small would be pure rounding noise).
+_EXACT_GIMBAL = 1e-12
+
+
+def wrap_angle(x: ArrayLike) -> Array:
+    """Wrap angles (radians) into (-pi, pi]."""
+    x = np.asarray(x, dtype=np.float64)
+    return np.pi - np.mod(np.pi - x, 2.0 * np.pi)
+
+
+def zyz_from_matrix(R: ArrayLike) -> Array:
+    """Z-Y-Z Euler angles ``(..., 3)`` = (alpha, beta, gamma) in radians of rotations ``(..., 3, 3)``.
+
+    Also accepts poses ``(..., 4, 4)`` (the rotation block is used).
+
+    >>> import numpy as np
+    >>> np.round(zyz_from_matrix(matrix_from_zyz([0.1, 0.2, 0.3])), 12).tolist()
+    [0.1, 0.2, 0.3]
+    """
+    R = np.asarray(R, dtype=np.float64)[..., :3, :3]
+    r13, r23, r33 = R[..., 0, 2], R[..., 1, 2], R[..., 2, 2]
+    r31, r32 = R[..., 2, 0], R[..., 2, 1]
+    sb = np.hypot(r31, r32)
+    beta = np.arctan2(sb, r33)
+    alpha = np.arctan2(r23, r13)
+    gamma = np.arctan2(r32, -r31)
+    # Gimbal cases (exactly degenerate up to rounding): Craig's choice alpha = 0.
+    zero = sb <= _EXACT_GIMBAL
+    up = zero & (r33 > 0)
+    down = zero & (r33 <= 0)
+    alpha = np.where(zero, 0.0, alpha)
+    beta = np.where(up, 0.0, np.where(down, np.pi, beta))
+    gamma = np.where(up, np.arctan2(-R[..., 0, 1], R[..., 0, 0]), gamma)
+    gamma = np.where(down, np.arctan2(R[..., 0, 1], -R[..., 0, 0]), gamma)
+    return np.stack([alpha, beta, gamma], axis=-1)
+
+
+def _rot_z(a: Array) -> Array:
+    c, s = np.cos(a), np.sin(a)
+    z, o = np.zeros_like(a), np.ones_like(a)
+    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
+
+
+def _rot_y(a: Array) -> Array:
+    c, s = np.cos(a), np.sin(a)
+    z, o = np.zeros_like(a), np.ones_like(a)
+    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
+
+
+def matrix_from_zyz(angles: ArrayLike) -> Array:
+    """Rotation matrices ``(..., 3, 3)`` from Z-Y-Z Euler angles ``(..., 3)`` in radians."""
+    a = np.asarray(angles, dtype=np.float64)
+    return _rot_z(a[..., 0]) @ _rot_y(a[..., 1]) @ _rot_z(a[..., 2])
+
+
+def pose_from_xyz_zyz(xyz: ArrayLike, zyz: ArrayLike) -> Array:
+    """Pose ``(..., 4, 4)`` from a position ``(..., 3)`` (length unit) and Z-Y-Z angles ``(..., 3)`` (radians)."""
+    xyz = np.asarray(xyz, dtype=np.float64)
+    R = matrix_from_zyz(zyz)
+    shape = np.broadcast_shapes(xyz.shape[:-1], R.shape[:-2])
+    T = np.zeros((*shape, 4, 4))
+    T[..., :3, :3] = R
+    T[..., :3, 3] = xyz
+    T[..., 3, 3] = 1.0
+    return T
+
+
+def xyz_zyz_from_pose(T: ArrayLike) -> tuple[Array, Array]:
+    """Split poses ``(..., 4, 4)`` into positions ``(..., 3)`` and Z-Y-Z angles ``(..., 3)`` (radians)."""
+    T = np.asarray(T, dtype=np.float64)
+    return T[..., :3, 3].copy(), zyz_from_matrix(T)
+
+
+def rotation_angle(R: ArrayLike) -> Array:
+    """Angle (radians, in [0, pi]) of rotations ``(..., 3, 3)``; accurate near 0 (atan2 form, not arccos)."""
+    R = np.asarray(R, dtype=np.float64)
+    v = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1)
+    s = 0.5 * np.linalg.norm(v, axis=-1)
+    c = 0.5 * (R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2] - 1.0)
+    return np.arctan2(s, c)
+
+
+def pose_error_paper(T: ArrayLike, T_desired: ArrayLike, weight: float = 100.0) -> Array:
+    """The paper's error J (eq. 6) between poses ``(..., 4, 4)``, in the poses' length unit.
+
+    ``J = sqrt(Jp**2 + (weight * Jo)**2)`` with ``Jp`` the position distance and ``Jo`` the norm of the
+    Z-Y-Z angle differences, each difference wrapped into (-pi, pi]. ``weight`` is a length (the paper:
+    100 mm). Where either pose is within ``GIMBAL_TOL`` of a gimbal case, alpha and gamma are not separately
+    defined: there the decomposition of ``T`` nearest ``T_desired`` is used, i.e. the alpha difference is
+    zero and the gamma difference is the wrapped difference of ``alpha + gamma`` (``alpha - gamma`` at
+    beta = pi).
+    """
+    T = np.asarray(T, dtype=np.float64)
+    Td = np.asarray(T_desired, dtype=np.float64)
+    jp = np.linalg.norm(T[..., :3, 3] - Td[..., :3, 3], axis=-1)
+    e = zyz_from_matrix(T)
+    ed = zyz_from_matrix(Td)
+    da = wrap_angle(e[..., 0] - ed[..., 0])
+    db = e[..., 1] - ed[..., 1]
+    dg = wrap_angle(e[..., 2] - ed[..., 2])
+    near0 = (e[..., 1] < GIMBAL_TOL) | (ed[..., 1] < GIMBAL_TOL)
+    nearpi = (np.pi - e[..., 1] < GIMBAL_TOL) | (np.pi - ed[..., 1] < GIMBAL_TOL)
+    dsum = wrap_angle((e[..., 0] + e[..., 2]) - (ed[..., 0] + ed[..., 2]))
+    ddiff = wrap_angle((e[..., 0] - e[..., 2]) - (ed[..., 0] - ed[..., 2]))
+    dg = np.where(near0, dsum, np.where(nearpi, ddiff, dg))
+    da = np.where(near0 | nearpi, 0.0, da)
+    jo = np.sqrt(da**2 + db**2 + dg**2)
+    return np.asarray(np.sqrt(jp**2 + (weight * jo) ** 2))
+
+
+def pose_error_geodesic(T: ArrayLike, T_desired: ArrayLike, weight: float = 100.0) -> Array:
+    """Position distance plus ``weight`` times the rotation angle of ``R_desired^T R`` (length unit)."""
+    T = np.asarray(T, dtype=np.float64)
+    Td = np.asarray(T_desired, dtype=np.float64)
+    jp = np.linalg.norm(T[..., :3, 3] - Td[..., :3, 3], axis=-1)
+    dR = np.swapaxes(Td[..., :3, :3], -1, -2) @ T[..., :3, :3]
+    return np.asarray(jp + weight * rotation_angle(dR))

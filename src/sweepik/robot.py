@@ -1,0 +1,219 @@
+"""The robot model: joints from a Denavit-Hartenberg table, limits, base and tool transforms.
+
+Conventions
+-----------
+* ``dh_convention="modified"`` (Craig 2005): row i holds ``a_{i-1}, alpha_{i-1}, d_i, theta_i`` and the link
+  transform is ``RotX(alpha_{i-1}) TransX(a_{i-1}) RotZ(theta_i) TransZ(d_i)``; joint i moves frame i.
+* ``dh_convention="standard"``: row i holds ``a_i, alpha_i, d_i, theta_i`` and the link transform is
+  ``RotZ(theta_i) TransZ(d_i) TransX(a_i) RotX(alpha_i)``.
+* A revolute joint's value q_i (radians) is added to the row's constant ``theta`` (its offset); a prismatic
+  joint's value (length unit) is added to the row's constant ``d``.
+* ``fk(q) = T_world_base @ T_0_1(q_1) @ ... @ T_{n-1}_n(q_n) @ T_flange_tool``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import kinematics
+from ._validate import check_configuration, check_poses
+from .errors import RobotDefinitionError
+
+__all__ = ["Joint", "Robot", "JointType", "DHConvention"]
+
+JointType = Literal["revolute", "prismatic"]
+DHConvention = Literal["modified", "standard"]
+Array = NDArray[np.float64]
+
+#: Joint values this far outside a limit (radians or length unit) still count as inside: IK results at a
+#: limit carry rounding errors of ~1e-12, far below any mechanical meaning.
+LIMIT_TOL = 1e-9
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One joint: its type, its DH row (constants; the joint value adds to ``theta`` or ``d``) and limits.
+
+    Angles in radians, lengths in the robot's length unit.
+    """
+
+    type: JointType
+    a: float = 0.0
+    alpha: float = 0.0
+    d: float = 0.0
+    theta: float = 0.0
+    lower: float = -np.pi
+    upper: float = np.pi
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        label = self.name or "joint"
+        if self.type not in ("revolute", "prismatic"):
+            raise RobotDefinitionError(f"{label}: type must be 'revolute' or 'prismatic', got {self.type!r}")
+        for f in ("a", "alpha", "d", "theta", "lower", "upper"):
+            v = getattr(self, f)
+            if not isinstance(v, int | float) or not np.isfinite(v):
+                raise RobotDefinitionError(f"{label}: {f} must be a finite number, got {v!r}")
+            object.__setattr__(self, f, float(v))
+        if self.lower > self.upper:
+            raise RobotDefinitionError(
+                f"{label}: lower limit {self.lower:g} is above upper limit {self.upper:g}"
+            )
+
+    @property
+    def is_revolute(self) -> bool:
+        return self.type == "revolute"
+
+    @property
+    def offset(self) -> float:
+        """Constant added to the joint value: ``theta`` for a revolute joint, ``d`` for a prismatic one."""
+        return self.theta if self.is_revolute else self.d
+
+
+def _frozen(T: ArrayLike | None, what: str) -> Array:
+    arr = np.eye(4) if T is None else check_poses(T, what).copy()
+    if arr.shape != (4, 4):
+        raise RobotDefinitionError(f"{what} must be a single 4x4 transform, got shape {arr.shape}")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Robot:
+    """An immutable serial robot. See the module docstring for conventions.
+
+    >>> r = Robot("slider", (Joint("prismatic", lower=0, upper=1), Joint("revolute", a=0.5)))
+    >>> r.fk([0.2, 0.0])[:3, 3].tolist()
+    [0.5, 0.0, 0.2]
+    """
+
+    name: str
+    joints: tuple[Joint, ...]
+    dh_convention: DHConvention = "modified"
+    T_world_base: Array = field(default_factory=lambda: np.eye(4))
+    T_flange_tool: Array = field(default_factory=lambda: np.eye(4))
+    length_unit: str = "mm"
+    default_reduction: str | None = None
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if self.dh_convention not in ("modified", "standard"):
+            raise RobotDefinitionError(
+                f"{self.name}: dh_convention must be 'modified' or 'standard', got {self.dh_convention!r}"
+            )
+        joints = tuple(self.joints)
+        if not joints or not all(isinstance(j, Joint) for j in joints):
+            raise RobotDefinitionError(f"{self.name}: joints must be a non-empty sequence of Joint")
+        object.__setattr__(self, "joints", joints)
+        object.__setattr__(self, "T_world_base", _frozen(self.T_world_base, f"{self.name}: base transform"))
+        object.__setattr__(self, "T_flange_tool", _frozen(self.T_flange_tool, f"{self.name}: tool transform"))
+        for attr, values in (
+            ("dh_a", [j.a for j in joints]),
+            ("dh_alpha", [j.alpha for j in joints]),
+            ("dh_d", [j.d for j in joints]),
+            ("dh_theta", [j.theta for j in joints]),
+            ("lower", [j.lower for j in joints]),
+            ("upper", [j.upper for j in joints]),
+        ):
+            arr = np.array(values, dtype=np.float64)
+            arr.setflags(write=False)
+            object.__setattr__(self, attr, arr)
+        rev = np.array([j.is_revolute for j in joints])
+        rev.setflags(write=False)
+        object.__setattr__(self, "is_revolute", rev)
+
+    # Populated in __post_init__ (declared for type checkers).
+    dh_a: Array = field(init=False, repr=False)
+    dh_alpha: Array = field(init=False, repr=False)
+    dh_d: Array = field(init=False, repr=False)
+    dh_theta: Array = field(init=False, repr=False)
+    lower: Array = field(init=False, repr=False)
+    upper: Array = field(init=False, repr=False)
+    is_revolute: NDArray[np.bool_] = field(init=False, repr=False)
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.joints)
+
+    @property
+    def joint_names(self) -> list[str]:
+        return [j.name or f"q{i + 1}" for i, j in enumerate(self.joints)]
+
+    @property
+    def limits(self) -> Array:
+        """Joint limits ``(n, 2)``: radians for revolute joints, length unit for prismatic ones."""
+        return np.stack([self.lower, self.upper], axis=-1)
+
+    @property
+    def length_scale(self) -> float:
+        """A characteristic length of the arm (sum of |a|, |d| and prismatic ranges), for relative tolerances."""
+        span = np.where(self.is_revolute, 0.0, self.upper - self.lower)
+        return float(np.sum(np.abs(self.dh_a)) + np.sum(np.abs(self.dh_d)) + np.sum(np.minimum(span, 1e12)))
+
+    def fk(self, q: ArrayLike) -> Array:
+        """Tool pose ``(..., 4, 4)`` for joint values ``q (..., n)``.
+
+        >>> from sweepik import load_robot
+        >>> load_robot("carm").fk([500, 0, 0, 0, 0, 0])[:3, 3].round(6).tolist()
+        [402.0, -350.0, 500.0]
+        """
+        qa = check_configuration(q, self.n_joints)
+        frames = kinematics.chain_frames(self, qa)
+        return frames[..., -1, :, :] @ self.T_flange_tool
+
+    def frames(self, q: ArrayLike) -> Array:
+        """World poses ``(..., n + 2, 4, 4)``: base, link frames 1..n, then the tool (for drawing the arm)."""
+        qa = check_configuration(q, self.n_joints)
+        frames = kinematics.chain_frames(self, qa)
+        tool = frames[..., -1:, :, :] @ self.T_flange_tool
+        return np.concatenate([frames, tool], axis=-3)
+
+    def jacobian(self, q: ArrayLike) -> Array:
+        """Geometric Jacobian ``(..., 6, n)`` in world coordinates at the tool point.
+
+        Rows 0-2 map joint rates to the tool origin's linear velocity, rows 3-5 to the angular velocity.
+        """
+        qa = check_configuration(q, self.n_joints)
+        return kinematics.geometric_jacobian(self, qa)
+
+    def wrap(self, q: ArrayLike) -> Array:
+        """Revolute joint values shifted by multiples of 2 pi into their limits where possible.
+
+        Each revolute value is first wrapped into (-pi, pi], then moved by +-2 pi if that brings it inside
+        the limits. Prismatic values are unchanged.
+        """
+        qa = np.array(q, dtype=np.float64)
+        w = np.pi - np.mod(np.pi - qa, 2.0 * np.pi)
+        for shift in (2.0 * np.pi, -2.0 * np.pi):
+            cand = w + shift
+            better = (w < self.lower - LIMIT_TOL) | (w > self.upper + LIMIT_TOL)
+            ok = (cand >= self.lower - LIMIT_TOL) & (cand <= self.upper + LIMIT_TOL)
+            w = np.where(better & ok, cand, w)
+        return np.where(self.is_revolute, w, qa)
+
+    def within_limits(self, q: ArrayLike) -> NDArray[np.bool_]:
+        """``(...)`` bool: all joint values inside their limits (revolute ones after ``wrap``), with ``LIMIT_TOL``."""
+        w = self.wrap(q)
+        return np.all((w >= self.lower - LIMIT_TOL) & (w <= self.upper + LIMIT_TOL), axis=-1)
+
+    def dh_table(self) -> list[dict[str, float | str]]:
+        """The DH table as rows of plain values (angles in degrees), for display."""
+        rows: list[dict[str, float | str]] = []
+        for name, j in zip(self.joint_names, self.joints, strict=True):
+            rows.append(
+                {
+                    "joint": name,
+                    "type": j.type,
+                    "a": j.a,
+                    "alpha_deg": float(np.degrees(j.alpha)),
+                    "d": j.d,
+                    "theta_deg": float(np.degrees(j.theta)),
+                    "lower": float(np.degrees(j.lower)) if j.is_revolute else j.lower,
+                    "upper": float(np.degrees(j.upper)) if j.is_revolute else j.upper,
+                }
+            )
+        return rows
