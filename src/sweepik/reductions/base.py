@@ -1,0 +1,91 @@
+"""The Reduction protocol: "given the value of one joint theta*, solve the other joints in closed form".
+
+A reduction turns the 6-D IK problem into a 1-D search over theta*. The sweep engine samples theta*, asks the
+reduction for the other joints (every closed-form branch) and, if the reduction offers one, for a signed
+residual whose zeros are exactly the IK solutions.
+
+Poses handed to a reduction are chain poses ``(N, 4, 4)``: the flange in the base frame of the DH chain,
+i.e. ``inv(T_world_base) @ T_world_tool @ inv(T_flange_tool)``. The engine does that conversion.
+
+Writing your own reduction: subclass :class:`Reduction`, set ``free_joint`` and ``n_branches``, implement
+``solve_rest`` (and, for speed and for double roots, ``residual``); pass an instance to ``sweepik.solve``::
+
+    class MyReduction(Reduction):
+        name = "my-arm-q1"
+        def __init__(self, robot):
+            super().__init__(robot, free_joint=0, n_branches=4)
+        def solve_rest(self, poses, theta, branch=None):
+            ...  # (N, M, 4, n) configurations, NaN where a branch does not exist
+
+See docs/reductions.md for a complete example.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..robot import Robot
+
+Array = NDArray[np.float64]
+IntArray = NDArray[np.intp]
+
+
+class Reduction(ABC):
+    """Base class of reductions. Shapes: ``poses (N, 4, 4)``, ``theta (N, M)`` in theta*'s unit.
+
+    Attributes:
+        robot: the robot this reduction solves.
+        free_joint: index of theta* in the configuration vector.
+        n_branches: number B of closed-form branches for a given theta*.
+        name: registry name (e.g. ``"carm-d1"``).
+    """
+
+    name: str = "custom"
+    #: Known blind spots, for the docs and ``sweepik solve --reduction`` help.
+    blind_spots: str = ""
+
+    def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:
+        self.robot = robot
+        self.free_joint = int(free_joint)
+        self.n_branches = int(n_branches)
+
+    @property
+    def periodic(self) -> bool:
+        """True when theta* is a revolute joint (the sweep wraps around the circle)."""
+        return bool(self.robot.is_revolute[self.free_joint])
+
+    @abstractmethod
+    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        """Full configurations for each theta*: ``(N, M, B, n)``, or ``(N, M, n)`` when ``branch`` is given.
+
+        ``branch`` (int array broadcastable to ``theta``) selects one branch per sample. Entries of branches
+        that do not exist at that theta* are NaN.
+        """
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
+        """Signed residual ``(N, M, B)`` (``(N, M)`` with ``branch``), continuous in theta* on each branch,
+        zero exactly at IK solutions, NaN where the branch does not exist. ``None``: not provided, the
+        engine then works on the pose error (local minima only).
+        """
+        return None
+
+    def sample_hints(self, poses: Array) -> Array | None:
+        """Extra theta* samples ``(N, K)`` (NaN-padded): branch-domain edges, branch swaps, places where the
+        residual bends sharply. Roots next to a domain edge are only bracketed if the edge is a sample.
+        """
+        return None
+
+    def special_solutions(self, poses: Array) -> Array | None:
+        """Candidate configurations ``(N, K, n)`` (NaN-padded) at theta* values where the reduction itself
+        degenerates (its blind spots). The engine certifies them by forward kinematics like any other.
+        """
+        return None
+
+    def search_range(self, poses: Array) -> Array | None:
+        """``(N, 2)`` theta* interval that holds every solution, for a prismatic theta* searched without
+        joint limits (``limits=False``). ``None``: the joint limits are used.
+        """
+        return None

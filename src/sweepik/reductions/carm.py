@@ -1,0 +1,271 @@
+"""Closed-form reductions of the C-Arm (paper Table 1): theta* = d1 (the paper's choice) and theta* = theta2.
+
+Geometry used by both (derivation in docs/carm.md). With the chain pose ``R_D, P = (Px, Py, Pz)``:
+
+* Entry {2,4} of eq. (4): ``-S2 Px + C2 (Pz - d1) = 0`` ties theta2 to d1.
+* The wrist point in frame 2 is ``(u, 0, -Py)`` with ``u = C2 Px + S2 (Pz - d1)``; it must equal
+  ``(S3 L1 + C34 L2, 0, C3 L1 - S34 L2)`` (eq. 1c): a planar two-link problem, two elbow branches
+  ``eps = +-1`` while ``|L1 - L2| <= rho = sqrt(u^2 + Py^2) <= L1 + L2``. Its circle-line form gives
+  ``(C34, S34) = (k (u, Py) + eps s (-Py, u)) / rho^2`` with ``k = (rho^2 + L2^2 - L1^2) / (2 L2)``,
+  ``s = sqrt(rho^2 - k^2)``, and ``L1 (S3, C3) = (u - L2 C34, L2 S34 - Py)``.
+* The wrist: ``N = R_04^T R_D`` must be ``RotY(theta5) RotZ(theta6)``, which holds iff ``N[1, 2] = 0``
+  (joint 5's axis, y of frame 4, perpendicular to the desired tool z axis). That entry,
+  ``C34 (C2 zx + S2 zz) + S34 zy``, is the signed residual: algebraic (no trigonometric calls),
+  dimensionless, continuous across the elbow domain edges. Then ``theta5 = atan2(N02, N22)``,
+  ``theta6 = atan2(N10, N11)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import RobotDefinitionError
+from ..robot import Robot
+from .base import Array, IntArray, Reduction
+
+#: Relative tolerance on the structure check of a robot against the C-Arm's DH table.
+_STRUCT_TOL = 1e-9
+#: rho^2 - k^2 down to -DISC_TOL * (L1 + L2)^2 counts as 0: the elbow domain edges are sampled exactly
+#: (sample hints) and must not turn into NaN by rounding.
+DISC_TOL = 1e-12
+#: Number of extra samples placed across the narrow window |Pz - d1| ~ |Px| where theta2 swings by pi.
+_SWING_SAMPLES = 16
+
+
+def carm_lengths(robot: Robot) -> tuple[float, float]:
+    """(L1, L2) of a robot with the C-Arm's structure; RobotDefinitionError if it has another structure."""
+    j = robot.joints
+    types = [x.type for x in j]
+    alpha = np.degrees(robot.dh_alpha)
+    ok = (
+        robot.dh_convention == "modified"
+        and types == ["prismatic"] + ["revolute"] * 5
+        and np.allclose(alpha, [0, 90, -90, 0, -90, 90], atol=_STRUCT_TOL)
+        and np.allclose(robot.dh_a[[0, 1, 2, 4, 5]], 0.0, atol=_STRUCT_TOL)
+        and np.allclose(robot.dh_d[:4], 0.0, atol=_STRUCT_TOL)
+        and abs(robot.dh_d[5]) <= _STRUCT_TOL
+        and np.allclose(robot.dh_theta, [0, 0, -np.pi / 2, 0, 0, 0], atol=_STRUCT_TOL)
+    )
+    if not ok:
+        raise RobotDefinitionError(
+            f"robot {robot.name!r} does not have the C-Arm's DH structure (paper Table 1); "
+            "the carm-d1/carm-theta2 reductions do not apply"
+        )
+    return float(robot.dh_a[3]), float(robot.dh_d[4])
+
+
+class _CArmBase(Reduction):
+    def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:
+        super().__init__(robot, free_joint, n_branches)
+        self.L1, self.L2 = carm_lengths(robot)
+
+    # --- shared closed form ----------------------------------------------------------------------
+    def _elbow(self, u: Array, Py: Array, eps: Array) -> tuple[Array, Array]:
+        """(C34, S34) of the planar two-link problem; NaN outside its domain."""
+        L1, L2 = self.L1, self.L2
+        rho2 = u * u + Py * Py
+        k = (rho2 + L2 * L2 - L1 * L1) / (2.0 * L2)
+        disc = rho2 - k * k
+        disc = np.where(disc >= -DISC_TOL * (L1 + L2) ** 2, np.maximum(disc, 0.0), np.nan)
+        s = eps * np.sqrt(disc)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            c34 = (k * u - s * Py) / rho2
+            s34 = (k * Py + s * u) / rho2
+        return c34, s34
+
+    @staticmethod
+    def _residual(c2: Array, s2: Array, c34: Array, s34: Array, z: Array) -> Array:
+        return c34 * (c2 * z[0] + s2 * z[2]) + s34 * z[1]
+
+    def _configuration(
+        self, d1: Array, c2: Array, s2: Array, u: Array, Py: Array, c34: Array, s34: Array, R: Array
+    ) -> Array:
+        """Full configurations ``(..., 6)`` from the position part; R: ``(3, 3, ...)`` rows/cols leading."""
+        L2 = self.L2
+        th2 = np.arctan2(s2, c2)
+        th3 = np.arctan2(u - L2 * c34, L2 * s34 - Py)
+        th4 = np.arctan2(s34, c34) - th3
+        th4 = np.pi - np.mod(np.pi - th4, 2.0 * np.pi)
+        # V = R_B2^T R_D (rows), N = R_24^T V
+        V0 = c2 * R[0] + s2 * R[2]
+        V1 = -s2 * R[0] + c2 * R[2]
+        V2 = -R[1]
+        N0 = s34 * V0 + c34 * V2
+        N1 = c34 * V0 - s34 * V2
+        th5 = np.arctan2(N0[2], V1[2])
+        th6 = np.arctan2(N1[0], N1[1])
+        return np.stack([d1, th2, th3, th4, th5, th6], axis=-1)
+
+
+def _unpack(poses: Array, extra_dims: int) -> tuple[Array, Array, Array, Array, Array]:
+    """Px, Py, Pz, z axis (3, N, 1...) and R (3, 3, N, 1...) broadcastable against (N, M[, B])."""
+    shape = (poses.shape[0],) + (1,) * extra_dims
+    P = poses[:, :3, 3]
+    Px, Py, Pz = (P[:, i].reshape(shape) for i in range(3))
+    R = np.moveaxis(poses[:, :3, :3], 0, -1).reshape(3, 3, *shape)
+    z = R[:, 2]
+    return Px, Py, Pz, z, R
+
+
+class CArmD1(_CArmBase):
+    """theta* = d1 (paper section 4). Four branches: b = 0..3 with sigma = +1 for b < 2 (theta2 of eq. 5b),
+    -1 otherwise (eq. 5a), and elbow eps = +1 for even b.
+
+    Blind spot: where the wrist point lies on joint 2's axis (Px = 0 and d1 = Pz) theta2 is not fixed by the
+    position; ``special_solutions`` solves that slice from the orientation.
+    """
+
+    name = "carm-d1"
+    blind_spots = "d1 = Pz with Px = 0 (wrist on joint 2's axis): solved separately as a special slice"
+
+    def __init__(self, robot: Robot) -> None:
+        super().__init__(robot, free_joint=0, n_branches=4)
+
+    def _signs(self, ndim: int, branch: IntArray | None) -> tuple[Array, Array]:
+        if branch is None:
+            b = np.arange(4).reshape((1,) * ndim + (4,))
+        else:
+            b = np.asarray(branch)
+        sigma = np.where(b < 2, 1.0, -1.0)
+        eps = np.where(b % 2 == 0, 1.0, -1.0)
+        return sigma, eps
+
+    def _position(self, poses: Array, theta: Array, branch: IntArray | None):  # type: ignore[no-untyped-def]
+        extra = 2 if branch is None else 1
+        Px, Py, Pz, z, R = _unpack(poses, extra)
+        sigma, eps = self._signs(theta.ndim, branch)
+        d1 = theta[..., None] if branch is None else theta
+        t = Pz - d1
+        r = np.hypot(Px, t)
+        safe = r > 0
+        rr = np.where(safe, r, 1.0)
+        c2 = np.where(safe, sigma * Px / rr, sigma)
+        s2 = np.where(safe, sigma * t / rr, 0.0)
+        u = sigma * r
+        c34, s34 = self._elbow(u, Py, eps)
+        return d1, c2, s2, u, Py, c34, s34, z, R
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        _, c2, s2, _, _, c34, s34, z, _ = self._position(poses, theta, branch)
+        return self._residual(c2, s2, c34, s34, z)
+
+    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        d1, c2, s2, u, Py, c34, s34, _, R = self._position(poses, theta, branch)
+        d1 = np.broadcast_to(d1, c34.shape)
+        return self._configuration(d1, c2, s2, u, Py, c34, s34, R)
+
+    def sample_hints(self, poses: Array) -> Array:
+        L1, L2 = self.L1, self.L2
+        Px, Py, Pz = poses[:, 0, 3], poses[:, 1, 3], poses[:, 2, 3]
+        q2 = Px * Px + Py * Py
+        with np.errstate(invalid="ignore"):
+            t_out = np.sqrt((L1 + L2) ** 2 - q2)  # NaN where no d1 reaches the wrist
+            t_in = np.sqrt((L1 - L2) ** 2 - q2)
+        # theta2 swings by pi across |t| ~ |Px| around d1 = Pz: sample that window densely in angle.
+        phi = np.linspace(-np.pi / 2, np.pi / 2, _SWING_SAMPLES + 2)[1:-1]
+        swing = Pz[:, None] - np.abs(Px)[:, None] * np.tan(phi)[None, :]
+        cols = [Pz - t_out, Pz + t_out, Pz - t_in, Pz + t_in, Pz]
+        return np.concatenate([np.stack(cols, axis=-1), swing], axis=-1)
+
+    def search_range(self, poses: Array) -> Array:
+        L = self.L1 + self.L2
+        Pz = poses[:, 2, 3]
+        return np.stack([Pz - L, Pz + L], axis=-1)
+
+    def special_solutions(self, poses: Array) -> Array:
+        """Wrist on joint 2's axis (Px = 0, d1 = Pz): u = 0, theta34 from the elbow, theta2 from the
+        orientation (``A cos theta2 + B sin theta2 = c``). 4 candidates per pose (NaN where none)."""
+        Px, Py, Pz, z, R = _unpack(poses, 0)
+        sel = np.abs(Px) <= 1e-9 * (self.L1 + self.L2)
+        out = []
+        for eps in (1.0, -1.0):
+            c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))
+            # c34 (c2 zx + s2 zz) + s34 zy = 0  ->  c2 zx + s2 zz = rhs
+            A, B = c34 * z[0], c34 * z[2]
+            rhs = -s34 * z[1]
+            amp = np.hypot(A, B)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                base = np.arctan2(B, A)
+                delta = np.arccos(rhs / amp)
+            for sgn in (1.0, -1.0):
+                th2 = base + sgn * delta
+                c2, s2 = np.cos(th2), np.sin(th2)
+                q = self._configuration(Pz, c2, s2, np.zeros_like(Py), Py, c34, s34, R)
+                out.append(np.where(sel[..., None], q, np.nan))
+        return np.stack(out, axis=1)
+
+
+class CArmTheta2(_CArmBase):
+    """theta* = theta2 (revolute, periodic). Two branches (elbow eps = +1 for b = 0).
+
+    Given theta2, entry {2,4} fixes ``d1 = Pz - Px tan(theta2)``. Blind spot: cos(theta2) = 0, where d1
+    drops out of that equation (possible only when Px = 0); ``special_solutions`` solves the slices
+    theta2 = +-90 deg in closed form (theta34 from the orientation, then d1 from the two-link circle).
+    Self-motion families (theta2 = +-90 deg with theta5 = 0) lie entirely in that slice: use carm-d1 there.
+    """
+
+    name = "carm-theta2"
+    blind_spots = "cos(theta2) = 0 (d1 drops out): solved separately as a special slice; families need carm-d1"
+
+    def __init__(self, robot: Robot) -> None:
+        super().__init__(robot, free_joint=1, n_branches=2)
+
+    def _position(self, poses: Array, theta: Array, branch: IntArray | None):  # type: ignore[no-untyped-def]
+        extra = 2 if branch is None else 1
+        Px, Py, Pz, z, R = _unpack(poses, extra)
+        th = theta[..., None] if branch is None else theta
+        b = np.arange(2).reshape((1,) * theta.ndim + (2,)) if branch is None else np.asarray(branch)
+        eps = np.where(b == 0, 1.0, -1.0)
+        c2, s2 = np.cos(th), np.sin(th)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = Px / c2
+            d1 = Pz - s2 * u
+        u = np.where(np.abs(c2) > 1e-300, u, np.nan)
+        c34, s34 = self._elbow(u, Py, eps)
+        return d1, c2, s2, u, Py, c34, s34, z, R
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        _, c2, s2, _, _, c34, s34, z, _ = self._position(poses, theta, branch)
+        return self._residual(c2, s2, c34, s34, z)
+
+    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        d1, c2, s2, u, Py, c34, s34, _, R = self._position(poses, theta, branch)
+        shape = c34.shape
+        return self._configuration(
+            np.broadcast_to(d1, shape), np.broadcast_to(c2, shape), np.broadcast_to(s2, shape), u, Py, c34, s34, R
+        )
+
+    def sample_hints(self, poses: Array) -> Array:
+        L1, L2 = self.L1, self.L2
+        Px, Py = poses[:, 0, 3], poses[:, 1, 3]
+        cols = [np.full_like(Px, np.pi / 2), np.full_like(Px, -np.pi / 2)]
+        for bound in ((L1 + L2) ** 2, (L1 - L2) ** 2):
+            with np.errstate(invalid="ignore", divide="ignore"):
+                umax = np.sqrt(bound - Py * Py)  # |u| = |Px / cos theta2| at the domain edge
+                c = np.abs(Px) / umax
+                a = np.where(c <= 1.0, np.arccos(np.minimum(c, 1.0)), np.nan)
+            cols += [a, -a, np.pi - a, a - np.pi]
+        return np.stack(cols, axis=-1)
+
+    def special_solutions(self, poses: Array) -> Array:
+        """theta2 = +-90 deg (requires Px = 0): theta34 from N[1,2] = 0, u from the two-link circle."""
+        Px, Py, Pz, z, R = _unpack(poses, 0)
+        L1, L2 = self.L1, self.L2
+        sel = np.abs(Px) <= 1e-9 * (L1 + L2)
+        out = []
+        for s2v in (1.0, -1.0):
+            c2 = np.zeros_like(Px)
+            s2 = np.full_like(Px, s2v)
+            nrm = np.hypot(z[1], z[2])
+            for sg in (1.0, -1.0):
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    c34 = sg * z[1] / nrm
+                    s34 = -sg * s2v * z[2] / nrm
+                    root = np.sqrt(L1 * L1 - (L2 * s34 - Py) ** 2)
+                for sr in (1.0, -1.0):
+                    u = L2 * c34 + sr * root
+                    d1 = Pz - u / s2v
+                    q = self._configuration(d1, c2, s2, u, Py, c34, s34, R)
+                    out.append(np.where(sel[..., None], q, np.nan))
+        return np.stack(out, axis=1)

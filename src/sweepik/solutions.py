@@ -1,0 +1,123 @@
+"""Result types: ``Solutions`` (all IK solutions of one pose) and ``Family`` (a self-motion continuum)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._validate import check_configuration
+from .errors import SweepikError
+
+if TYPE_CHECKING:
+    from .reductions.base import Reduction
+    from .robot import Robot
+
+Array = NDArray[np.float64]
+
+#: Tolerance when asking a family for a member just outside its interval (relative to the interval length).
+_FAMILY_EDGE_TOL = 1e-9
+
+
+def joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
+    """Per-joint absolute differences ``(..., n)``: revolute ones wrapped modulo 2 pi (radians)."""
+    d = np.asarray(q, dtype=np.float64) - np.asarray(q_ref, dtype=np.float64)
+    wrapped = np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi))
+    return np.where(robot.is_revolute, wrapped, np.abs(d))
+
+
+@dataclass(frozen=True, eq=False)
+class Family:
+    """A continuum of solutions (self-motion): every theta* in ``interval`` gives a solution.
+
+    Attributes:
+        free_joint: index of the joint that parametrises the family (theta* of the reduction).
+        interval: ``(lo, hi)`` in that joint's unit (radians or length unit), inside the joint limits
+            when the solve applied limits.
+    """
+
+    free_joint: int
+    interval: tuple[float, float]
+    reduction: Reduction = field(repr=False)
+    chain_pose: Array = field(repr=False)
+    branch: int = 0
+
+    def at(self, theta: ArrayLike) -> Array:
+        """Member configuration(s) ``(n,)`` (or ``(..., n)``) at theta* value(s) inside ``interval``."""
+        th = np.asarray(theta, dtype=np.float64)
+        lo, hi = self.interval
+        tol = _FAMILY_EDGE_TOL * max(hi - lo, 1.0)
+        if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
+            raise SweepikError(f"theta* = {th.tolist()} is outside the family's interval [{lo:.12g}, {hi:.12g}]")
+        flat = np.clip(th.reshape(1, -1), lo, hi)
+        q = self.reduction.solve_rest(self.chain_pose[None], flat, np.full(flat.shape, self.branch))
+        q = self.reduction.robot.wrap(q[0])
+        return q.reshape(*th.shape, -1)
+
+    def sample(self, count: int = 50) -> Array:
+        """``(count, n)`` member configurations evenly spaced over the interval."""
+        return self.at(np.linspace(self.interval[0], self.interval[1], count))
+
+
+@dataclass(frozen=True, eq=False)
+class Solutions:
+    """Every IK solution of one pose.
+
+    Attributes:
+        q: ``(k, n)`` configurations (radians / length unit), revolute values wrapped into their limits.
+        error: ``(k,)`` the paper's error J (eq. 6) in the robot's length unit.
+        error_geodesic: ``(k,)`` position error + weight x rotation angle (length unit).
+        within_limits: ``(k,)`` bool; all True when solved with ``limits=True``.
+        families: self-motion continua (empty for almost every pose).
+        reason: why there is no solution, when ``q`` and ``families`` are empty; else ``None``.
+        pose: the target ``(4, 4)``.
+    """
+
+    q: Array
+    error: Array
+    error_geodesic: Array
+    within_limits: NDArray[np.bool_]
+    families: tuple[Family, ...]
+    reason: str | None
+    pose: Array
+    robot: Robot = field(repr=False)
+
+    def __len__(self) -> int:
+        return int(self.q.shape[0])
+
+    def __iter__(self) -> Iterator[Array]:
+        return iter(self.q)
+
+    def __getitem__(self, i: int) -> Array:
+        return self.q[i]
+
+    def __bool__(self) -> bool:
+        return len(self) > 0 or bool(self.families)
+
+    def distances(self, q_ref: ArrayLike) -> Array:
+        """``(k,)`` Euclidean joint-space distance to ``q_ref`` (angles modulo 2 pi, mixed units)."""
+        ref = check_configuration(q_ref, self.robot.n_joints, "q_ref")
+        return np.asarray(np.linalg.norm(joint_distance(self.robot, self.q, ref), axis=-1))
+
+    def nearest(self, q_ref: ArrayLike) -> Array:
+        """The solution ``(n,)`` closest to ``q_ref`` (angles modulo 2 pi). Family members count too: the
+        nearest member is searched along each family. Raises SweepikError when there is no solution."""
+        ref = check_configuration(q_ref, self.robot.n_joints, "q_ref")
+        best: Array | None = None
+        best_d = np.inf
+        if len(self):
+            d = self.distances(ref)
+            i = int(np.argmin(d))
+            best, best_d = self.q[i], float(d[i])
+        for fam in self.families:
+            members = fam.sample(401)
+            d = np.linalg.norm(joint_distance(self.robot, members, ref), axis=-1)
+            i = int(np.argmin(d))
+            if d[i] < best_d:
+                best, best_d = members[i], float(d[i])
+        if best is None:
+            raise SweepikError(f"no solution to choose from ({self.reason})")
+        return best.copy()

@@ -1,0 +1,259 @@
+"""``solve`` and ``solve_many``: all IK solutions of poses, certified by forward kinematics.
+
+Pipeline (see DESIGN.md): chain poses -> strategy (precise sweep or the paper's) -> candidate
+configurations -> FK check against the target -> joint limits -> duplicates removed -> ``Solutions``.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import kinematics
+from ._validate import check_poses
+from .errors import ShapeError, UnknownOptionError
+from .paper_sweep import paper_candidates
+from .pose import pose_error_geodesic, pose_error_paper
+from .reductions import Reduction, get_reduction
+from .robot import Robot
+from .solutions import Family, Solutions
+from .sweep import N_SAMPLES, FamilySpan, find_candidates
+from .units import mm_per_unit, orientation_weight
+
+__all__ = ["solve", "solve_many", "STRATEGIES"]
+
+Array = NDArray[np.float64]
+Strategy = Literal["precise", "paper"]
+STRATEGIES = ("precise", "paper")
+
+#: Precise strategy: a candidate is a solution when position error + weight x angle is below this times the
+#: arm's length scale (C-Arm: 2e-13 x 2752 mm = 5.5e-10 mm). Simple roots refine to ~1e-13 mm, double
+#: roots to ~1e-14 mm; a near miss of the residual above this is not a solution.
+ACCEPT_TOL_REL = 2e-13
+#: Paper strategy: the paper's acceptance threshold J < 1e-5 mm (section 4).
+PAPER_ACCEPT_MM = 1e-5
+#: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
+DEDUPE_ANGLE = 1e-6
+#: ... and every prismatic joint within this times the arm's length scale.
+DEDUPE_LENGTH_REL = 1e-8
+#: Poses per chunk of ``solve_many``: bounds memory at (chunk x samples x branches) residuals.
+CHUNK = 2048
+
+
+def _chain_poses(robot: Robot, poses: Array) -> Array:
+    return np.linalg.inv(robot.T_world_base) @ poses @ np.linalg.inv(robot.T_flange_tool)
+
+
+def _theta_range(robot: Robot, red: Reduction, chain: Array, limits: bool) -> tuple[Array, Array]:
+    n = chain.shape[0]
+    j = red.free_joint
+    if red.periodic:
+        return np.full(n, -np.pi), np.full(n, np.pi)
+    lo, hi = np.full(n, robot.lower[j]), np.full(n, robot.upper[j])
+    if not limits:
+        rng = red.search_range(chain)
+        if rng is not None:
+            lo, hi = rng[:, 0], rng[:, 1]
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        raise ShapeError(f"joint {robot.joint_names[j]} (theta*) needs finite limits to be swept")
+    return lo, hi
+
+
+def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:
+    """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one."""
+    if q.shape[0] == 0:
+        return np.zeros(0, dtype=bool)
+    order = np.lexsort((err, pose_idx))
+    ps, qs = pose_idx[order], q[order]
+    counts = np.bincount(ps)
+    kmax = int(counts.max())
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    slot = np.arange(ps.size) - starts[ps]
+    pad = np.full((counts.size, kmax, q.shape[1]), np.nan)
+    pad[ps, slot] = qs
+    diff = pad[:, :, None, :] - pad[:, None, :, :]
+    wrapped = np.abs(np.pi - np.mod(np.pi - diff, 2.0 * np.pi))
+    tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
+    dist = np.where(robot.is_revolute, wrapped, np.abs(diff))
+    same = np.all(dist <= tol, axis=-1)  # (P, K, K)
+    earlier = np.tril(np.ones((kmax, kmax), dtype=bool), k=-1)  # j < i
+    dup = np.any(same & earlier[None], axis=-1)
+    keep_sorted = ~dup[ps, slot]
+    keep = np.empty_like(keep_sorted)
+    keep[order] = keep_sorted
+    return keep
+
+
+def _families(
+    robot: Robot, red: Reduction, chain: Array, spans: list[FamilySpan], limits: bool
+) -> dict[int, list[Family]]:
+    """Family objects per pose; with limits, each span is cut to the sub-intervals inside the limits."""
+    out: dict[int, list[Family]] = {}
+    for sp in spans:
+        grid = np.linspace(sp.lo, sp.hi, 257)
+        q = red.solve_rest(chain[sp.pose][None], grid[None], np.full((1, grid.size), sp.branch))[0]
+        ok = np.all(np.isfinite(q), axis=-1)
+        if limits:
+            ok &= robot.within_limits(np.nan_to_num(q))
+        edges = np.diff(np.concatenate([[0], ok.astype(np.int8), [0]]))
+        for s, e in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0], strict=True):
+            if e - 1 > s:
+                fam = Family(red.free_joint, (float(grid[s]), float(grid[e - 1])), red, chain[sp.pose], sp.branch)
+                out.setdefault(sp.pose, []).append(fam)
+    return out
+
+
+def _solve_chunk(
+    robot: Robot, red: Reduction, poses: Array, strategy: str, limits: bool, n_samples: int
+) -> list[Solutions]:
+    chain = _chain_poses(robot, poses)
+    lo, hi = _theta_range(robot, red, chain, limits)
+    weight = orientation_weight(robot.length_unit)
+    spans: list[FamilySpan] = []
+    if strategy == "precise":
+        cand, spans = find_candidates(red, chain, lo, hi, n_samples)
+        q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+        pose_idx = cand.pose
+        special = red.special_solutions(chain)
+        if special is not None:
+            sp_ok = np.all(np.isfinite(special), axis=-1)
+            sp_p, sp_k = np.nonzero(sp_ok)
+            q = np.concatenate([q, special[sp_p, sp_k]])
+            pose_idx = np.concatenate([pose_idx, sp_p])
+    else:
+        pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
+    finite = np.all(np.isfinite(q), axis=-1)
+    pose_idx, q = pose_idx[finite], q[finite]
+    T = kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool
+    target = poses[pose_idx]
+    err_paper = pose_error_paper(T, target, weight)
+    err_geo = pose_error_geodesic(T, target, weight)
+    if strategy == "precise":
+        certified = err_geo <= ACCEPT_TOL_REL * robot.length_scale
+    else:
+        certified = err_paper < PAPER_ACCEPT_MM / mm_per_unit(robot.length_unit)
+    pose_idx, q, err_paper, err_geo = pose_idx[certified], q[certified], err_paper[certified], err_geo[certified]
+    q = robot.wrap(q)
+    inside = robot.within_limits(q)
+    n_reachable = np.bincount(pose_idx, minlength=len(poses))
+    if limits:
+        pose_idx, q, err_paper, err_geo, inside = (
+            pose_idx[inside], q[inside], err_paper[inside], err_geo[inside], inside[inside]
+        )
+    keep = _dedupe(robot, pose_idx, q, err_geo)
+    pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
+    fams = _families(robot, red, chain, spans, limits) if spans else {}
+
+    order = np.argsort(pose_idx, kind="stable")
+    pose_idx, q, err_paper, err_geo, inside = (
+        pose_idx[order], q[order], err_paper[order], err_geo[order], inside[order]
+    )
+    bounds = np.searchsorted(pose_idx, np.arange(len(poses) + 1))
+    results = []
+    for i in range(len(poses)):
+        s, e = bounds[i], bounds[i + 1]
+        fam = tuple(fams.get(i, ()))
+        qi = q[s:e]
+        if fam and e > s:  # isolated points that lie on a family are reported by the family
+            on = np.zeros(e - s, dtype=bool)
+            for f in fam:
+                th = qi[:, f.free_joint]
+                inn = (th >= f.interval[0]) & (th <= f.interval[1])
+                if inn.any():
+                    member = f.at(np.clip(th, *f.interval))
+                    d = np.abs(np.pi - np.mod(np.pi - (member - qi), 2 * np.pi))
+                    on |= inn & np.all(d <= 1e-6 * np.maximum(1.0, np.abs(qi)), axis=-1)
+            s_keep = ~on
+        else:
+            s_keep = slice(None)  # type: ignore[assignment]
+        reason = None
+        if e == s and not fam:
+            reason = (
+                f"out of joint limits: {n_reachable[i]} solution(s) reach the pose but violate the limits"
+                if n_reachable[i] > 0
+                else "unreachable: no configuration of the arm reaches this pose"
+            )
+        results.append(
+            Solutions(
+                q=qi[s_keep],
+                error=err_paper[s:e][s_keep],
+                error_geodesic=err_geo[s:e][s_keep],
+                within_limits=inside[s:e][s_keep],
+                families=fam,
+                reason=reason,
+                pose=poses[i].copy(),
+                robot=robot,
+            )
+        )
+    return results
+
+
+def _check_strategy(strategy: str) -> None:
+    if strategy not in STRATEGIES:
+        raise UnknownOptionError(f"unknown strategy {strategy!r}; choose one of {', '.join(STRATEGIES)}")
+
+
+def solve_many(
+    robot: Robot,
+    poses: ArrayLike,
+    *,
+    reduction: str | Reduction | None = None,
+    strategy: Strategy = "precise",
+    limits: bool = True,
+    n_samples: int = N_SAMPLES,
+    chunk_size: int = CHUNK,
+) -> list[Solutions]:
+    """All IK solutions of each pose in ``poses (N, 4, 4)`` (world frame, robot's length unit).
+
+    Vectorised over poses, samples and branches, in chunks of ``chunk_size`` poses (bounded memory).
+    Results are identical to calling :func:`solve` on each pose.
+    """
+    _check_strategy(strategy)
+    P = check_poses(poses, "poses")
+    if P.ndim != 3:
+        raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
+    if n_samples < 8:
+        raise ShapeError(f"n_samples must be at least 8, got {n_samples}")
+    red = get_reduction(robot, reduction)
+    if red.robot is not robot:
+        red = type(red)(robot) if type(red).__init__ is not Reduction.__init__ else red
+    out: list[Solutions] = []
+    for s in range(0, P.shape[0], chunk_size):
+        out.extend(_solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples))
+    return out
+
+
+def solve(
+    robot: Robot,
+    pose: ArrayLike,
+    *,
+    reduction: str | Reduction | None = None,
+    strategy: Strategy = "precise",
+    limits: bool = True,
+    n_samples: int = N_SAMPLES,
+) -> Solutions:
+    """All IK solutions of one pose ``(4, 4)`` (world frame, robot's length unit).
+
+    Args:
+        robot: the arm (e.g. ``load_robot("carm")``).
+        pose: target tool pose.
+        reduction: name (``"carm-d1"``, ``"carm-theta2"``), a Reduction instance, or None for the
+            robot's default.
+        strategy: ``"precise"`` (every root to full precision, double roots and close roots included) or
+            ``"paper"`` (the paper's 10 mm sweep refined to 0.001 mm, J < 1e-5 mm).
+        limits: drop solutions outside the joint limits (True) or keep and flag them (False).
+
+    >>> import numpy as np
+    >>> from sweepik import load_robot, solve
+    >>> arm = load_robot("carm")
+    >>> q = np.array([800.0, 0.3, 0.2, -0.4, 0.5, 0.1])
+    >>> sols = solve(arm, arm.fk(q))
+    >>> bool(np.allclose(sols.nearest(q), q, atol=1e-9))
+    True
+    """
+    P = check_poses(pose, "pose")
+    if P.shape != (4, 4):
+        raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
+    return solve_many(robot, P[None], reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples)[0]
