@@ -15,6 +15,7 @@ from . import kinematics
 from ._validate import check_poses
 from .errors import ShapeError, UnknownOptionError
 from .paper_sweep import paper_candidates
+from .polish import polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, get_reduction
 from .robot import Robot
@@ -32,6 +33,11 @@ STRATEGIES = ("precise", "paper")
 #: arm's length scale (C-Arm: 2e-13 x 2752 mm = 5.5e-10 mm). Simple roots refine to ~1e-13 mm, double
 #: roots to ~1e-14 mm; a near miss of the residual above this is not a solution.
 ACCEPT_TOL_REL = 2e-13
+#: Candidates with a pose error below this times the length scale get a Newton polish on the full pose
+#: (removes the ill-conditioning of a reduction; spurious candidates are far above it).
+POLISH_BELOW_REL = 1e-6
+#: ... and above this (already at rounding level: nothing to gain).
+POLISH_ABOVE_REL = 1e-14
 #: Paper strategy: the paper's acceptance threshold J < 1e-5 mm (section 4).
 PAPER_ACCEPT_MM = 1e-5
 #: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
@@ -128,8 +134,16 @@ def _solve_chunk(
     pose_idx, q = pose_idx[finite], q[finite]
     T = kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool
     target = poses[pose_idx]
-    err_paper = pose_error_paper(T, target, weight)
     err_geo = pose_error_geodesic(T, target, weight)
+    if strategy == "precise":
+        near = np.nonzero(
+            (err_geo <= POLISH_BELOW_REL * robot.length_scale) & (err_geo > POLISH_ABOVE_REL * robot.length_scale)
+        )[0]
+        if near.size:
+            q[near] = polish(robot, q[near], target[near], weight)
+            T[near] = kinematics.chain_frames(robot, q[near])[:, -1] @ robot.T_flange_tool
+            err_geo[near] = pose_error_geodesic(T[near], target[near], weight)
+    err_paper = pose_error_paper(T, target, weight)
     if strategy == "precise":
         certified = err_geo <= ACCEPT_TOL_REL * robot.length_scale
     else:

@@ -1,13 +1,16 @@
 """The one-joint sweep engine, precise strategy: every zero of a reduction's residual along theta*.
 
-For N poses at once: sample theta* (uniform grid plus the reduction's hints), evaluate the residual of every
-branch ``(N, M, B)``, then
+For N poses at once: sample theta* (uniform grid plus the reduction's hints) and evaluate every branch,
+giving one residual sequence per (pose, branch). On each sequence:
 
 * sign changes between consecutive valid samples -> bracketed roots (Chandrupatla, to full precision);
 * local extrema of |residual| that do not cross zero at the samples -> the extremum is located precisely
   (as the root of a central difference of the residual); if it crosses zero there are two close roots
   (bracketed on either side), if it touches zero it is a double root (certified later by forward kinematics);
-* extrema at the edge of a branch's domain (next to NaN) and at the ends of the range -> the edge sample;
+* samples at the edge of a branch's domain (next to NaN) and at the ends of the range -> candidates;
+* intervals where the curve bends enough to hide two roots between its samples (judged from second
+  differences), or that touch a domain edge (square-root behaviour), are resampled more finely, recursively,
+  and searched the same way;
 * runs of samples where the residual vanishes identically -> self-motion families.
 
 The result is a flat list of candidates ``(pose index, branch, theta*)``; ``solve`` turns them into
@@ -24,9 +27,17 @@ from numpy.typing import NDArray
 from .reductions.base import Array, IntArray, Reduction
 from .rootfind import find_roots
 
-#: Default number of uniform samples of theta* over its range (hints come on top). Checked against an
-#: independent polynomial solver (tests/carm_oracle.py) and against 16x denser sampling.
-N_SAMPLES = 96
+#: Default number of uniform samples of theta* over its range (hints and refinements come on top).
+#: Checked against an independent polynomial solver (tests/carm_oracle.py) and against dense sampling.
+N_SAMPLES = 64
+#: Samples per refined interval, and the number of refinement levels (resolution: step / SUB**LEVELS).
+SUB_SAMPLES = 8
+MAX_LEVELS = 4
+#: An interval with same-signed ends is refined when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola
+#: dips h^2 |f''| / 8 below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step),
+#: or, next to a domain edge or range end (no curvature estimate), when it is <= EDGE_VAR * |f_i+1 - f_i|.
+BEND = 1.0
+EDGE_VAR = 2.0
 #: |residual| at or below which a sample counts as lying on a self-motion family (residuals are computed to
 #: ~1e-15; an isolated root makes three consecutive samples this small only with probability ~0).
 FAMILY_TOL = 1e-10
@@ -72,13 +83,155 @@ def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samp
     return np.sort(grid, axis=1)
 
 
-def _branch_eval(reduction: Reduction, poses: Array, pose_idx: IntArray, branch: IntArray):  # type: ignore[no-untyped-def]
-    def f(x: Array, sel: IntArray) -> Array:
-        r = reduction.residual(poses[pose_idx[sel]], x[:, None], branch[sel][:, None])
-        assert r is not None
-        return r[:, 0]
+class _Search:
+    """Candidate search over residual sequences ``theta, f (S, M)`` with pose/branch per sequence."""
 
-    return f
+    def __init__(self, reduction: Reduction, poses: Array, span: Array) -> None:
+        self.red = reduction
+        self.poses = poses
+        self.span = span
+        self.roots_p: list[IntArray] = []
+        self.roots_b: list[IntArray] = []
+        self.roots_t: list[Array] = []
+        self.br: list[tuple[IntArray, IntArray, Array, Array, Array, Array]] = []
+
+    def residual(self, pose: IntArray, branch: IntArray, theta: Array) -> Array:
+        """Residual ``(K, M)`` of one branch per row."""
+        r = self.red.residual(self.poses[pose], theta, np.broadcast_to(branch[:, None], theta.shape))
+        assert r is not None
+        return r
+
+    def _root(self, p: IntArray, b: IntArray, t: Array) -> None:
+        self.roots_p.append(p)
+        self.roots_b.append(b)
+        self.roots_t.append(t)
+
+    def scan(self, p: IntArray, b: IntArray, th: Array, f: Array, valid: NDArray[np.bool_], level: int) -> None:
+        """Find candidates on sequences ``th, f (S, M)`` (``valid``: usable samples); recurse into bends."""
+        S, M = f.shape
+        absf = np.abs(f)
+        rows = np.arange(S)
+        fin = np.where(valid, f, np.nan)
+        t0, t1 = th[:, :-1], th[:, 1:]
+        v0, v1 = valid[:, :-1], valid[:, 1:]
+        both = v0 & v1 & (t1 > t0)
+        # 1) sign changes, 2) exact zeros
+        s_i, s_j = np.nonzero(both & (fin[:, :-1] * fin[:, 1:] < 0))
+        if s_i.size:
+            self.br.append((p[s_i], b[s_i], th[s_i, s_j], th[s_i, s_j + 1], f[s_i, s_j], f[s_i, s_j + 1]))
+        z_i, z_j = np.nonzero(valid & (f == 0))
+        self._root(p[z_i], b[z_i], th[z_i, z_j])
+        # 3) interior extrema of |f| with no sign change around them
+        if M >= 3:
+            fm, fc, fp = fin[:, :-2], fin[:, 1:-1], fin[:, 2:]
+            ext = (
+                (absf[:, 1:-1] <= absf[:, :-2])
+                & (absf[:, 1:-1] <= absf[:, 2:])
+                & (fm * fc > 0)
+                & (fc * fp > 0)
+                & (th[:, 2:] > th[:, :-2])
+            )
+            e_i, e_j = np.nonzero(ext)
+            if e_i.size:
+                self._extrema(p[e_i], b[e_i], th[e_i, e_j], th[e_i, e_j + 1], th[e_i, e_j + 2], f[e_i, e_j + 1],
+                              f[e_i, e_j], f[e_i, e_j + 2])
+        # 4) samples next to a domain edge (NaN) or at the range ends (level 0 only)
+        end = level == 0
+        left_open = np.concatenate([np.full((S, 1), end), ~valid[:, :-1]], axis=1)
+        right_open = np.concatenate([~valid[:, 1:], np.full((S, 1), end)], axis=1)
+        nb_r = np.concatenate([absf[:, 1:], np.full((S, 1), np.inf)], axis=1)
+        nb_l = np.concatenate([np.full((S, 1), np.inf), absf[:, :-1]], axis=1)
+        nb_r = np.where(np.isfinite(nb_r), nb_r, np.inf)
+        nb_l = np.where(np.isfinite(nb_l), nb_l, np.inf)
+        edge = valid & ((left_open & (absf <= nb_r)) | (right_open & (absf <= nb_l)))
+        d_i, d_j = np.nonzero(edge)
+        self._root(p[d_i], b[d_i], th[d_i, d_j])
+        if level >= MAX_LEVELS:
+            return
+        # 5) intervals that may hide a pair of roots: refine
+        h = t1 - t0
+        prod = fin[:, :-1] * fin[:, 1:]
+        # same sign, or an exact zero at one end (the other end may hide a second root next to it)
+        same = both & ((prod > 0) | ((prod == 0) & (np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0)))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dd = np.full((S, M), np.nan)  # second divided difference x h^2 scale, at interior samples
+            if M >= 3:
+                hl, hr = th[:, 1:-1] - th[:, :-2], th[:, 2:] - th[:, 1:-1]
+                dd[:, 1:-1] = 2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
+            curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
+            lowest = np.minimum(absf[:, :-1], absf[:, 1:])
+            bend = lowest <= BEND * curv * h * h
+            near_edge = ~np.isfinite(dd[:, :-1]) | ~np.isfinite(dd[:, 1:])
+            steep = lowest <= EDGE_VAR * np.abs(fin[:, 1:] - fin[:, :-1])
+        r_i, r_j = np.nonzero(same & (bend | (near_edge & steep)))
+        if r_i.size == 0:
+            return
+        u = np.linspace(0.0, 1.0, SUB_SAMPLES + 2)
+        sub = th[r_i, r_j, None] + (th[r_i, r_j + 1] - th[r_i, r_j])[:, None] * u[None, :]
+        pp, bb = p[r_i], b[r_i]
+        fs = self.residual(pp, bb, sub)
+        fs[:, 0], fs[:, -1] = f[r_i, r_j], f[r_i, r_j + 1]
+        vs = np.isfinite(fs)
+        # the parent already handled the interval's end samples as candidates: only interior ones are new
+        self.scan(pp, bb, sub, fs, vs, level + 1)
+
+    def _extrema(self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array,
+                 fa: Array, fb: Array) -> None:
+        """Locate the extremum between ta and tb, then classify (two roots / touching / nothing)."""
+        span = self.span[p]
+        h = DIFF_STEP_REL * span
+        a, c = ta + h, tb - h
+        idx = np.arange(p.size)
+
+        def fe(x: Array, sel: IntArray) -> Array:
+            return self.residual(p[sel], b[sel], x[:, None])[:, 0]
+
+        def g(x: Array, sel: IntArray) -> Array:
+            return fe(x + h[sel], sel) - fe(x - h[sel], sel)
+
+        ga, gc = g(a, idx), g(c, idx)
+        ok = (ga * gc < 0) & (a < c)
+        xe = tc.copy()
+        if ok.any():
+            k = np.nonzero(ok)[0]
+            xe[k] = find_roots(lambda x, s: g(x, k[s]), a[k], c[k], ga[k], gc[k], 1e-3 * float(h[k].min()))
+        fx = fe(xe, idx)
+        cross = np.isfinite(fx) & (np.sign(fc) * fx < 0)
+        k = np.nonzero(cross)[0]
+        if k.size:
+            self.br.append((p[k], b[k], ta[k], xe[k], fa[k], fx[k]))
+            self.br.append((p[k], b[k], xe[k], tb[k], fx[k], fb[k]))
+        k = np.nonzero(~cross & np.isfinite(fx))[0]
+        self._root(p[k], b[k], xe[k])
+
+    def finish(self) -> Candidates:
+        if self.br:
+            p, b, a, c, fa, fc = (np.concatenate(x) for x in zip(*self.br, strict=True))
+            xtol = float(XTOL_REL * self.span.min())
+            x = find_roots(lambda x, s: self.residual(p[s], b[s], x[:, None])[:, 0], a, c, fa, fc, xtol)
+            self._root(p, b, x)
+        return Candidates(
+            pose=np.concatenate(self.roots_p).astype(np.intp),
+            branch=np.concatenate(self.roots_b).astype(np.intp),
+            theta=np.concatenate(self.roots_t),
+        )
+
+
+def _families(theta: Array, f: Array, valid: NDArray[np.bool_]) -> tuple[list[FamilySpan], NDArray[np.bool_]]:
+    """Runs of vanishing samples ``(N, M, B)`` -> family spans, and the mask of samples they cover."""
+    flat = valid & (np.abs(f) <= FAMILY_TOL)
+    in_family = np.zeros_like(flat)
+    spans: list[FamilySpan] = []
+    if not flat.any():
+        return spans, in_family
+    for p, b in zip(*np.nonzero(flat.sum(axis=1) >= FAMILY_MIN_RUN), strict=True):
+        col = flat[p, :, b]
+        edges = np.diff(np.concatenate([[0], col.astype(np.int8), [0]]))
+        for s0, e0 in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0], strict=True):
+            if e0 - s0 >= FAMILY_MIN_RUN and theta[p, e0 - 1] > theta[p, s0]:
+                spans.append(FamilySpan(int(p), int(b), float(theta[p, s0]), float(theta[p, e0 - 1])))
+                in_family[p, s0:e0, b] = True
+    return spans, in_family
 
 
 def find_candidates(
@@ -92,114 +245,15 @@ def find_candidates(
     theta = sample_grid(reduction, poses, lo, hi, n_samples)
     f = reduction.residual(poses, theta)
     if f is None:
-        raise NotImplementedError("reductions without a residual are handled by sweep_error_minima")
+        raise NotImplementedError("sweepik's precise strategy needs a reduction with a residual")
     N, M, B = f.shape
-    span = hi - lo
-    xtol = XTOL_REL * span
     valid = np.isfinite(f)
-    absf = np.abs(f)
-
-    # Self-motion families: runs of vanishing samples.
-    flat = valid & (absf <= FAMILY_TOL)
-    families: list[FamilySpan] = []
-    in_family = np.zeros_like(flat)
-    if flat.any():
-        for p, b in zip(*np.nonzero(flat.sum(axis=1) >= FAMILY_MIN_RUN), strict=True):
-            col = flat[p, :, b]
-            edges = np.diff(np.concatenate([[0], col.astype(np.int8), [0]]))
-            starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
-            for s0, e0 in zip(starts, ends, strict=True):
-                if e0 - s0 >= FAMILY_MIN_RUN and theta[p, e0 - 1] > theta[p, s0]:
-                    families.append(FamilySpan(int(p), int(b), float(theta[p, s0]), float(theta[p, e0 - 1])))
-                    in_family[p, s0:e0, b] = True
-        valid = valid & ~in_family
-
-    th0 = theta[:, :-1, None]
-    th1 = theta[:, 1:, None]
-    f0, f1 = f[:, :-1], f[:, 1:]
-    v0, v1 = valid[:, :-1], valid[:, 1:]
-    both = v0 & v1 & (th1 > th0)
-
-    # 1) sign changes
-    sc_p, sc_i, sc_b = np.nonzero(both & (f0 * f1 < 0))
-    # 2) exact zeros at samples
-    z_p, z_i, z_b = np.nonzero(valid & (f == 0))
-    # 3) interior extrema of |f| with no sign change around them
-    fm, fc, fp = f[:, :-2], f[:, 1:-1], f[:, 2:]
-    vm, vc, vp = valid[:, :-2], valid[:, 1:-1], valid[:, 2:]
-    ext = (
-        vm & vc & vp
-        & (absf[:, 1:-1] <= absf[:, :-2]) & (absf[:, 1:-1] <= absf[:, 2:])
-        & (fm * fc > 0) & (fc * fp > 0)
-        & (theta[:, 2:, None] > theta[:, :-2, None])
-    )
-    ex_p, ex_i, ex_b = np.nonzero(ext)
-    ex_i = ex_i + 1
-    # 4) edge samples (next to NaN or at the range ends) that are closer to zero than their neighbour
-    left_open = np.concatenate([np.ones((N, 1, B), bool), ~valid[:, :-1]], axis=1)
-    right_open = np.concatenate([~valid[:, 1:], np.ones((N, 1, B), bool)], axis=1)
-    nb_left = np.concatenate([absf[:, 1:], np.full((N, 1, B), np.inf)], axis=1)
-    nb_right = np.concatenate([np.full((N, 1, B), np.inf), absf[:, :-1]], axis=1)
-    edge = valid & ((left_open & (absf <= np.where(np.isfinite(nb_left), nb_left, np.inf)))
-                    | (right_open & (absf <= np.where(np.isfinite(nb_right), nb_right, np.inf))))
-    ed_p, ed_i, ed_b = np.nonzero(edge)
-
-    # Locate interior extrema precisely: root of the central difference g(x) = f(x + h) - f(x - h).
-    roots_p: list[IntArray] = [z_p, ed_p]
-    roots_b: list[IntArray] = [z_b, ed_b]
-    roots_t: list[Array] = [theta[z_p, z_i], theta[ed_p, ed_i]]
-    br_p, br_b = [sc_p], [sc_b]
-    br_a, br_c = [theta[sc_p, sc_i]], [theta[sc_p, sc_i + 1]]
-    br_fa, br_fc = [f[sc_p, sc_i, sc_b]], [f[sc_p, sc_i + 1, sc_b]]
-    if ex_p.size:
-        h = DIFF_STEP_REL * span[ex_p]
-        a = theta[ex_p, ex_i - 1] + h
-        c = theta[ex_p, ex_i + 1] - h
-        fe = _branch_eval(reduction, poses, ex_p, ex_b)
-
-        def g(x: Array, sel: IntArray) -> Array:
-            return fe(x + h[sel], sel) - fe(x - h[sel], sel)
-
-        idx = np.arange(ex_p.size)
-        ga, gc = g(a, idx), g(c, idx)
-        ok = (ga * gc < 0) & (a < c)
-        xe = theta[ex_p, ex_i].copy()
-        if ok.any():
-            k = np.nonzero(ok)[0]
-            xe[k] = find_roots(lambda x, s: g(x, k[s]), a[k], c[k], ga[k], gc[k], 1e-3 * h[k].min())
-        fx = fe(xe, idx)
-        sgn = np.sign(f[ex_p, ex_i, ex_b])
-        cross = np.isfinite(fx) & (sgn * fx < 0)
-        # two close roots: brackets on either side of the extremum
-        kc = np.nonzero(cross)[0]
-        for lo_t, hi_t, flo, fhi in (
-            (theta[ex_p[kc], ex_i[kc] - 1], xe[kc], f[ex_p[kc], ex_i[kc] - 1, ex_b[kc]], fx[kc]),
-            (xe[kc], theta[ex_p[kc], ex_i[kc] + 1], fx[kc], f[ex_p[kc], ex_i[kc] + 1, ex_b[kc]]),
-        ):
-            br_p.append(ex_p[kc])
-            br_b.append(ex_b[kc])
-            br_a.append(lo_t)
-            br_c.append(hi_t)
-            br_fa.append(flo)
-            br_fc.append(fhi)
-        # touching (or near-missing) extrema: double-root candidates, certified by FK later
-        kt = np.nonzero(~cross & np.isfinite(fx))[0]
-        roots_p.append(ex_p[kt])
-        roots_b.append(ex_b[kt])
-        roots_t.append(xe[kt])
-
-    bp = np.concatenate(br_p)
-    bb = np.concatenate(br_b)
-    if bp.size:
-        ba, bc = np.concatenate(br_a), np.concatenate(br_c)
-        fa, fc = np.concatenate(br_fa), np.concatenate(br_fc)
-        x = find_roots(_branch_eval(reduction, poses, bp, bb), ba, bc, fa, fc, float(np.min(xtol)))
-        roots_p.append(bp)
-        roots_b.append(bb)
-        roots_t.append(x)
-    cand = Candidates(
-        pose=np.concatenate(roots_p).astype(np.intp),
-        branch=np.concatenate(roots_b).astype(np.intp),
-        theta=np.concatenate(roots_t),
-    )
-    return cand, families
+    spans, in_family = _families(theta, f, valid)
+    valid &= ~in_family
+    search = _Search(reduction, poses, hi - lo)
+    p = np.repeat(np.arange(N), B)
+    b = np.tile(np.arange(B), N)
+    fs = f.transpose(0, 2, 1).reshape(N * B, M)
+    vs = valid.transpose(0, 2, 1).reshape(N * B, M)
+    search.scan(p, b, theta[p], fs, vs, 0)
+    return search.finish(), spans

@@ -29,6 +29,10 @@ _STRUCT_TOL = 1e-9
 #: rho^2 - k^2 down to -DISC_TOL * (L1 + L2)^2 counts as 0: the elbow domain edges are sampled exactly
 #: (sample hints) and must not turn into NaN by rounding.
 DISC_TOL = 1e-12
+#: The theta2 reduction hands poses with |Px| <= BLIND_PX_REL * (L1 + L2) to the d1 sweep for the
+#: solutions with |cos(theta2)| <= BLIND_COS (its blind spot and ill-conditioned neighbourhood).
+BLIND_PX_REL = 1e-2
+BLIND_COS = 2e-2
 #: Number of extra samples placed across the narrow window |Pz - d1| ~ |Px| where theta2 swings by pi.
 _SWING_SAMPLES = 16
 
@@ -200,9 +204,9 @@ class CArmTheta2(_CArmBase):
     """theta* = theta2 (revolute, periodic). Two branches (elbow eps = +1 for b = 0).
 
     Given theta2, entry {2,4} fixes ``d1 = Pz - Px tan(theta2)``. Blind spot: cos(theta2) = 0, where d1
-    drops out of that equation (possible only when Px = 0); ``special_solutions`` solves the slices
-    theta2 = +-90 deg in closed form (theta34 from the orientation, then d1 from the two-link circle).
-    Self-motion families (theta2 = +-90 deg with theta5 = 0) lie entirely in that slice: use carm-d1 there.
+    drops out of that equation (possible only when Px = 0), and its neighbourhood, where d1 is
+    ill-conditioned; ``special_solutions`` covers it with the d1 reduction. Self-motion families
+    (theta2 = +-90 deg with theta5 = 0) lie entirely in that slice: they are reported by carm-d1 only.
     """
 
     name = "carm-theta2"
@@ -240,6 +244,11 @@ class CArmTheta2(_CArmBase):
         L1, L2 = self.L1, self.L2
         Px, Py = poses[:, 0, 3], poses[:, 1, 3]
         cols = [np.full_like(Px, np.pi / 2), np.full_like(Px, -np.pi / 2)]
+        # Near cos(theta2) = 0, d1 = Pz - Px tan(theta2) races through its whole range within a window of
+        # width ~|Px| / (L1 + L2): sample that window uniformly in d1 (i.e. theta2 = atan(t / Px)).
+        t = np.linspace(-(L1 + L2), L1 + L2, _SWING_SAMPLES * 2 + 1)
+        win = np.arctan2(t[None, :], Px[:, None])
+        cols += list(win.T) + list((win - np.pi).T)
         for bound in ((L1 + L2) ** 2, (L1 - L2) ** 2):
             with np.errstate(invalid="ignore", divide="ignore"):
                 umax = np.sqrt(bound - Py * Py)  # |u| = |Px / cos theta2| at the domain edge
@@ -249,23 +258,33 @@ class CArmTheta2(_CArmBase):
         return np.stack(cols, axis=-1)
 
     def special_solutions(self, poses: Array) -> Array:
-        """theta2 = +-90 deg (requires Px = 0): theta34 from N[1,2] = 0, u from the two-link circle."""
-        Px, Py, Pz, z, R = _unpack(poses, 0)
-        L1, L2 = self.L1, self.L2
-        sel = np.abs(Px) <= 1e-9 * (L1 + L2)
-        out = []
-        for s2v in (1.0, -1.0):
-            c2 = np.zeros_like(Px)
-            s2 = np.full_like(Px, s2v)
-            nrm = np.hypot(z[1], z[2])
-            for sg in (1.0, -1.0):
-                with np.errstate(invalid="ignore", divide="ignore"):
-                    c34 = sg * z[1] / nrm
-                    s34 = -sg * s2v * z[2] / nrm
-                    root = np.sqrt(L1 * L1 - (L2 * s34 - Py) ** 2)
-                for sr in (1.0, -1.0):
-                    u = L2 * c34 + sr * root
-                    d1 = Pz - u / s2v
-                    q = self._configuration(d1, c2, s2, u, Py, c34, s34, R)
-                    out.append(np.where(sel[..., None], q, np.nan))
-        return np.stack(out, axis=1)
+        """Solutions near the blind spot cos(theta2) = 0, found with the d1 reduction.
+
+        Near theta2 = +-90 deg, d1 = Pz - Px tan(theta2) races through its range within a window of width
+        ~|Px| / (L1 + L2) in theta2, so a theta2 sweep is ill-conditioned there and blind at its centre.
+        For poses with |Px| below ``BLIND_PX_REL * (L1 + L2)`` the d1 sweep supplies the solutions with
+        |cos(theta2)| <= ``BLIND_COS``; the theta2 sweep supplies all others.
+        """
+        from ..sweep import find_candidates  # local import: the engine imports this package
+
+        Px = poses[:, 0, 3]
+        idx = np.nonzero(np.abs(Px) <= BLIND_PX_REL * (self.L1 + self.L2))[0]
+        out = np.full((poses.shape[0], 8, 6), np.nan)
+        if idx.size == 0:
+            return out
+        d1red = CArmD1(self.robot)
+        rng = d1red.search_range(poses[idx])
+        cand, _ = find_candidates(d1red, poses[idx], rng[:, 0], rng[:, 1])
+        q = d1red.solve_rest(poses[idx][cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+        keep = np.all(np.isfinite(q), axis=-1) & (np.abs(np.cos(q[:, 1])) <= BLIND_COS)
+        pose, q = cand.pose[keep], q[keep]
+        if pose.size == 0:
+            return out
+        counts = np.bincount(pose, minlength=idx.size)
+        width = max(8, int(counts.max()))
+        out = np.full((poses.shape[0], width, 6), np.nan)
+        order = np.argsort(pose, kind="stable")
+        pose, q = pose[order], q[order]
+        slot = np.arange(pose.size) - np.concatenate([[0], np.cumsum(counts)[:-1]])[pose]
+        out[idx[pose], slot] = q
+        return out
