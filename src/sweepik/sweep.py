@@ -33,7 +33,7 @@ N_SAMPLES = 64
 #: Samples per refined interval, and the number of refinement levels (resolution: step / SUB**LEVELS).
 SUB_SAMPLES = 8
 MAX_LEVELS = 4
-#: An interval with same-signed ends is refined when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola
+#: An interval is resampled when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola
 #: dips h^2 |f''| / 8 below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step),
 #: or, next to a domain edge or range end (no curvature estimate), when it is <= EDGE_VAR * |f_i+1 - f_i|.
 BEND = 1.0
@@ -115,10 +115,7 @@ class _Search:
         t0, t1 = th[:, :-1], th[:, 1:]
         v0, v1 = valid[:, :-1], valid[:, 1:]
         both = v0 & v1 & (t1 > t0)
-        # 1) sign changes, 2) exact zeros
-        s_i, s_j = np.nonzero(both & (fin[:, :-1] * fin[:, 1:] < 0))
-        if s_i.size:
-            self.br.append((p[s_i], b[s_i], th[s_i, s_j], th[s_i, s_j + 1], f[s_i, s_j], f[s_i, s_j + 1]))
+        # exact zeros
         z_i, z_j = np.nonzero(valid & (f == 0))
         self._root(p[z_i], b[z_i], th[z_i, z_j])
         # 3) interior extrema of |f| with no sign change around them
@@ -146,24 +143,29 @@ class _Search:
         edge = valid & ((left_open & (absf <= nb_r)) | (right_open & (absf <= nb_l)))
         d_i, d_j = np.nonzero(edge)
         self._root(p[d_i], b[d_i], th[d_i, d_j])
-        if level >= MAX_LEVELS:
-            return
-        # 5) intervals that may hide a pair of roots: refine
+        # 5) intervals that may hide a pair of roots (besides a sign change they may have) are resampled;
+        #    sign changes of the other intervals are bracketed
         h = t1 - t0
         prod = fin[:, :-1] * fin[:, 1:]
-        # same sign, or an exact zero at one end (the other end may hide a second root next to it)
-        same = both & ((prod > 0) | ((prod == 0) & (np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0)))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            dd = np.full((S, M), np.nan)  # second divided difference x h^2 scale, at interior samples
-            if M >= 3:
-                hl, hr = th[:, 1:-1] - th[:, :-2], th[:, 2:] - th[:, 1:-1]
-                dd[:, 1:-1] = 2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
-            curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
-            lowest = np.minimum(absf[:, :-1], absf[:, 1:])
-            bend = lowest <= BEND * curv * h * h
-            near_edge = ~np.isfinite(dd[:, :-1]) | ~np.isfinite(dd[:, 1:])
-            steep = lowest <= EDGE_VAR * np.abs(fin[:, 1:] - fin[:, :-1])
-        r_i, r_j = np.nonzero(same & (bend | (near_edge & steep)))
+        if level < MAX_LEVELS:
+            with np.errstate(invalid="ignore", divide="ignore"):
+                dd = np.full((S, M), np.nan)  # second divided difference at interior samples
+                if M >= 3:
+                    hl, hr = th[:, 1:-1] - th[:, :-2], th[:, 2:] - th[:, 1:-1]
+                    dd[:, 1:-1] = 2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
+                curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
+                lowest = np.minimum(absf[:, :-1], absf[:, 1:])
+                bend = lowest <= BEND * curv * h * h
+                near_edge = ~np.isfinite(dd[:, :-1]) | ~np.isfinite(dd[:, 1:])
+                steep = lowest <= EDGE_VAR * np.abs(fin[:, 1:] - fin[:, :-1])
+            nonzero = np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0
+            refine = both & nonzero & (bend | (near_edge & steep))
+        else:
+            refine = np.zeros_like(both)
+        s_i, s_j = np.nonzero(both & ~refine & (prod < 0))
+        if s_i.size:
+            self.br.append((p[s_i], b[s_i], th[s_i, s_j], th[s_i, s_j + 1], f[s_i, s_j], f[s_i, s_j + 1]))
+        r_i, r_j = np.nonzero(refine)
         if r_i.size == 0:
             return
         u = np.linspace(0.0, 1.0, SUB_SAMPLES + 2)
