@@ -33,11 +33,12 @@ N_SAMPLES = 64
 #: Samples per refined interval, and the number of refinement levels (resolution: step / SUB**LEVELS).
 SUB_SAMPLES = 8
 MAX_LEVELS = 4
-#: An interval is resampled when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola
-#: dips h^2 |f''| / 8 below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step),
-#: or, next to a domain edge or range end (no curvature estimate), when it is <= EDGE_VAR * |f_i+1 - f_i|.
+#: An interval is resampled when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola dips h^2 |f''| / 8
+#: below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step), and always next to
+#: a domain edge or range end (no curvature estimate there; square-root behaviour at a domain edge).
 BEND = 1.0
-EDGE_VAR = 2.0
+_U_UNIFORM = np.linspace(0.0, 1.0, SUB_SAMPLES + 2)
+_U_EDGE = 0.5 * (1.0 - np.cos(np.pi * _U_UNIFORM))
 #: |residual| at or below which a sample counts as lying on a self-motion family (residuals are computed to
 #: ~1e-15; an isolated root makes three consecutive samples this small only with probability ~0).
 FAMILY_TOL = 1e-10
@@ -106,9 +107,24 @@ class _Search:
         self.roots_b.append(b)
         self.roots_t.append(t)
 
-    def scan(self, p: IntArray, b: IntArray, th: Array, f: Array, valid: NDArray[np.bool_], level: int) -> None:
-        """Find candidates on sequences ``th, f (S, M)`` (``valid``: usable samples); recurse into bends."""
+    def scan(
+        self,
+        p: IntArray,
+        b: IntArray,
+        th: Array,
+        f: Array,
+        valid: NDArray[np.bool_],
+        level: int,
+        edge_left: NDArray[np.bool_] | None = None,
+        edge_right: NDArray[np.bool_] | None = None,
+    ) -> None:
+        """Find candidates on sequences ``th, f (S, M)`` (``valid``: usable samples); recurse into bends.
+
+        ``edge_left``/``edge_right`` ``(S,)``: the sequence's first/last sample borders a domain edge.
+        """
         S, M = f.shape
+        if edge_left is None or edge_right is None:
+            edge_left = edge_right = np.zeros(S, dtype=bool)
         absf = np.abs(f)
         rows = np.arange(S)
         fin = np.where(valid, f, np.nan)
@@ -156,10 +172,12 @@ class _Search:
                 curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
                 lowest = np.minimum(absf[:, :-1], absf[:, 1:])
                 bend = lowest <= BEND * curv * h * h
-                near_edge = ~np.isfinite(dd[:, :-1]) | ~np.isfinite(dd[:, 1:])
-                steep = lowest <= EDGE_VAR * np.abs(fin[:, 1:] - fin[:, :-1])
+                # sample j borders a domain edge on its left / right
+                open_l = np.concatenate([edge_left[:, None], ~valid[:, :-1]], axis=1)
+                open_r = np.concatenate([~valid[:, 1:], edge_right[:, None]], axis=1)
+                near_edge = open_l[:, :-1] | open_r[:, 1:]
             nonzero = np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0
-            refine = both & nonzero & (bend | (near_edge & steep))
+            refine = both & nonzero & (bend | near_edge)
         else:
             refine = np.zeros_like(both)
         s_i, s_j = np.nonzero(both & ~refine & (prod < 0))
@@ -168,14 +186,15 @@ class _Search:
         r_i, r_j = np.nonzero(refine)
         if r_i.size == 0:
             return
-        u = np.linspace(0.0, 1.0, SUB_SAMPLES + 2)
-        sub = th[r_i, r_j, None] + (th[r_i, r_j + 1] - th[r_i, r_j])[:, None] * u[None, :]
+        # uniform sub-samples; next to a domain edge (square-root behaviour) clustered towards both ends
+        u = np.where(near_edge[r_i, r_j, None], _U_EDGE[None, :], _U_UNIFORM[None, :])
+        sub = th[r_i, r_j, None] + (th[r_i, r_j + 1] - th[r_i, r_j])[:, None] * u
         pp, bb = p[r_i], b[r_i]
         fs = self.residual(pp, bb, sub)
         fs[:, 0], fs[:, -1] = f[r_i, r_j], f[r_i, r_j + 1]
         vs = np.isfinite(fs)
         # the parent already handled the interval's end samples as candidates: only interior ones are new
-        self.scan(pp, bb, sub, fs, vs, level + 1)
+        self.scan(pp, bb, sub, fs, vs, level + 1, open_l[r_i, r_j], open_r[r_i, r_j + 1])
 
     def _extrema(self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array,
                  fa: Array, fb: Array) -> None:

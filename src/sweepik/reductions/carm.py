@@ -243,7 +243,7 @@ class CArmTheta2(_CArmBase):
     def sample_hints(self, poses: Array) -> Array:
         L1, L2 = self.L1, self.L2
         Px, Py = poses[:, 0, 3], poses[:, 1, 3]
-        cols = [np.full_like(Px, np.pi / 2), np.full_like(Px, -np.pi / 2)]
+        cols = [np.full_like(Px, np.pi / 2), np.full_like(Px, -np.pi / 2), np.zeros_like(Px), np.full_like(Px, np.pi)]
         # Near cos(theta2) = 0, d1 = Pz - Px tan(theta2) races through its whole range within a window of
         # width ~|Px| / (L1 + L2): sample that window uniformly in d1 (i.e. theta2 = atan(t / Px)).
         t = np.linspace(-(L1 + L2), L1 + L2, _SWING_SAMPLES * 2 + 1)
