@@ -26,8 +26,11 @@ from .pose import (
     xyz_zyz_from_pose,
     zyz_from_matrix,
 )
+from .reductions import REDUCTIONS, CArmD1, CArmTheta2, Reduction, get_reduction
 from .robot import Joint, Robot
 from .robot_file import bundled_robots, load_robot, robot_from_dict
+from .solutions import Family, Solutions
+from .solver import STRATEGIES, solve, solve_many
 
 try:
     __version__ = version("sweepik")
@@ -41,6 +44,16 @@ __all__ = [
     "load_robot",
     "bundled_robots",
     "robot_from_dict",
+    "solve",
+    "solve_many",
+    "Solutions",
+    "Family",
+    "STRATEGIES",
+    "Reduction",
+    "CArmD1",
+    "CArmTheta2",
+    "REDUCTIONS",
+    "get_reduction",
     "zyz_from_matrix",
     "matrix_from_zyz",
     "pose_from_xyz_zyz",

@@ -27,12 +27,13 @@ def check_finite(arr: NDArray[np.float64], what: str) -> None:
         raise NonFiniteError(f"{what} holds NaN or infinite values (first at index {tuple(int(i) for i in bad)})")
 
 
-def check_configuration(q: ArrayLike, n: int, what: str = "q") -> NDArray[np.float64]:
-    """Return ``q`` as float array of shape (..., n), finite."""
+def check_configuration(q: ArrayLike, n: int, what: str = "q", finite: bool = True) -> NDArray[np.float64]:
+    """Return ``q`` as float array of shape (..., n), finite unless ``finite=False``."""
     arr = as_float_array(q, what)
     if arr.ndim == 0 or arr.shape[-1] != n:
         raise ShapeError(f"{what} must have shape (..., {n}) for this {n}-joint robot, got shape {arr.shape}")
-    check_finite(arr, what)
+    if finite:
+        check_finite(arr, what)
     return arr
 
 

@@ -62,7 +62,9 @@ def zyz_from_matrix(R: ArrayLike) -> Array:
     sb = np.hypot(r31, r32)
     beta = np.arctan2(sb, r33)
     alpha = np.arctan2(r23, r13)
-    gamma = np.arctan2(r32, -r31)
+    # gamma from the first two columns rotated back by alpha: well conditioned for every beta
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    gamma = np.arctan2(ca * R[..., 1, 0] - sa * R[..., 0, 0], ca * R[..., 1, 1] - sa * R[..., 0, 1])
     # Gimbal cases (exactly degenerate up to rounding): Craig's choice alpha = 0.
     zero = sb <= _EXACT_GIMBAL
     up = zero & (r33 > 0)
@@ -71,7 +73,7 @@ def zyz_from_matrix(R: ArrayLike) -> Array:
     beta = np.where(up, 0.0, np.where(down, np.pi, beta))
     gamma = np.where(up, np.arctan2(-R[..., 0, 1], R[..., 0, 0]), gamma)
     gamma = np.where(down, np.arctan2(R[..., 0, 1], -R[..., 0, 0]), gamma)
-    return np.stack([alpha, beta, gamma], axis=-1)
+    return np.stack([wrap_angle(alpha), beta, wrap_angle(gamma)], axis=-1)
 
 
 def _rot_z(a: Array) -> Array:

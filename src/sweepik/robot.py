@@ -13,6 +13,8 @@ Conventions
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -56,13 +58,11 @@ class Joint:
             raise RobotDefinitionError(f"{label}: type must be 'revolute' or 'prismatic', got {self.type!r}")
         for f in ("a", "alpha", "d", "theta", "lower", "upper"):
             v = getattr(self, f)
-            if not isinstance(v, int | float) or not np.isfinite(v):
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(float(v)):
                 raise RobotDefinitionError(f"{label}: {f} must be a finite number, got {v!r}")
             object.__setattr__(self, f, float(v))
         if self.lower > self.upper:
-            raise RobotDefinitionError(
-                f"{label}: lower limit {self.lower:g} is above upper limit {self.upper:g}"
-            )
+            raise RobotDefinitionError(f"{label}: lower limit {self.lower:g} is above upper limit {self.upper:g}")
 
     @property
     def is_revolute(self) -> bool:
@@ -186,7 +186,7 @@ class Robot:
         Each revolute value is first wrapped into (-pi, pi], then moved by +-2 pi if that brings it inside
         the limits. Prismatic values are unchanged.
         """
-        qa = np.array(q, dtype=np.float64)
+        qa = check_configuration(q, self.n_joints, finite=False)
         w = np.pi - np.mod(np.pi - qa, 2.0 * np.pi)
         for shift in (2.0 * np.pi, -2.0 * np.pi):
             cand = w + shift

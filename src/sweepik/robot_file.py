@@ -129,7 +129,7 @@ def robot_from_dict(data: dict[str, Any], source: str = "<dict>") -> Robot:
     )
 
 
-def load_robot(name_or_path: str | Path) -> Robot:
+def load_robot(name_or_path: str | Path | Robot) -> Robot:
     """Load a bundled robot by name (e.g. ``"carm"``) or a robot file (TOML) by path.
 
     >>> load_robot("carm").n_joints
@@ -144,9 +144,14 @@ def load_robot(name_or_path: str | Path) -> Robot:
         res = resources.files("sweepik") / "robots" / f"{text_name}.toml"
         raw, source = res.read_text(encoding="utf-8"), f"{text_name}.toml (bundled)"
     elif path.suffix == ".toml" or path.exists():
-        if not path.is_file():
+        if not path.exists():
             raise UnknownRobotError(f"robot file {text_name!r} does not exist; bundled robots: {', '.join(bundled)}")
-        raw, source = path.read_text(encoding="utf-8"), str(path)
+        if not path.is_file():
+            raise RobotFileError(f"{text_name}: is not a file")
+        try:
+            raw, source = path.read_text(encoding="utf-8"), str(path)
+        except (OSError, UnicodeDecodeError) as exc:
+            raise RobotFileError(f"{path}: cannot read robot file: {exc}") from None
     else:
         raise UnknownRobotError(
             f"unknown robot {text_name!r}: not a bundled robot nor a file; bundled robots: {', '.join(bundled)}"

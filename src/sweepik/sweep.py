@@ -126,7 +126,6 @@ class _Search:
         if edge_left is None or edge_right is None:
             edge_left = edge_right = np.zeros(S, dtype=bool)
         absf = np.abs(f)
-        rows = np.arange(S)
         fin = np.where(valid, f, np.nan)
         t0, t1 = th[:, :-1], th[:, 1:]
         v0, v1 = valid[:, :-1], valid[:, 1:]
@@ -146,8 +145,16 @@ class _Search:
             )
             e_i, e_j = np.nonzero(ext)
             if e_i.size:
-                self._extrema(p[e_i], b[e_i], th[e_i, e_j], th[e_i, e_j + 1], th[e_i, e_j + 2], f[e_i, e_j + 1],
-                              f[e_i, e_j], f[e_i, e_j + 2])
+                self._extrema(
+                    p[e_i],
+                    b[e_i],
+                    th[e_i, e_j],
+                    th[e_i, e_j + 1],
+                    th[e_i, e_j + 2],
+                    f[e_i, e_j + 1],
+                    f[e_i, e_j],
+                    f[e_i, e_j + 2],
+                )
         # 4) samples next to a domain edge (NaN) or at the range ends (level 0 only)
         end = level == 0
         left_open = np.concatenate([np.full((S, 1), end), ~valid[:, :-1]], axis=1)
@@ -168,7 +175,9 @@ class _Search:
                 dd = np.full((S, M), np.nan)  # second divided difference at interior samples
                 if M >= 3:
                     hl, hr = th[:, 1:-1] - th[:, :-2], th[:, 2:] - th[:, 1:-1]
-                    dd[:, 1:-1] = 2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
+                    dd[:, 1:-1] = (
+                        2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
+                    )
                 curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
                 lowest = np.minimum(absf[:, :-1], absf[:, 1:])
                 bend = lowest <= BEND * curv * h * h
@@ -196,8 +205,9 @@ class _Search:
         # the parent already handled the interval's end samples as candidates: only interior ones are new
         self.scan(pp, bb, sub, fs, vs, level + 1, open_l[r_i, r_j], open_r[r_i, r_j + 1])
 
-    def _extrema(self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array,
-                 fa: Array, fb: Array) -> None:
+    def _extrema(
+        self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array, fa: Array, fb: Array
+    ) -> None:
         """Locate the extremum between ta and tb, then classify (two roots / touching / nothing)."""
         span = self.span[p]
         h = DIFF_STEP_REL * span

@@ -18,7 +18,6 @@ Geometry used by both (derivation in docs/carm.md). With the chain pose ``R_D, P
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from ..errors import RobotDefinitionError
 from ..robot import Robot
@@ -135,7 +134,7 @@ class CArmD1(_CArmBase):
         eps = np.where(b % 2 == 0, 1.0, -1.0)
         return sigma, eps
 
-    def _position(self, poses: Array, theta: Array, branch: IntArray | None):  # type: ignore[no-untyped-def]
+    def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
         extra = 2 if branch is None else 1
         Px, Py, Pz, z, R = _unpack(poses, extra)
         sigma, eps = self._signs(theta.ndim, branch)
@@ -215,7 +214,7 @@ class CArmTheta2(_CArmBase):
     def __init__(self, robot: Robot) -> None:
         super().__init__(robot, free_joint=1, n_branches=2)
 
-    def _position(self, poses: Array, theta: Array, branch: IntArray | None):  # type: ignore[no-untyped-def]
+    def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
         extra = 2 if branch is None else 1
         Px, Py, Pz, z, R = _unpack(poses, extra)
         th = theta[..., None] if branch is None else theta

@@ -68,28 +68,33 @@ def _theta_range(robot: Robot, red: Reduction, chain: Array, limits: bool) -> tu
 
 
 def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:
-    """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one."""
-    if q.shape[0] == 0:
-        return np.zeros(0, dtype=bool)
-    order = np.lexsort((err, pose_idx))
-    ps, qs = pose_idx[order], q[order]
-    counts = np.bincount(ps)
-    kmax = int(counts.max())
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    slot = np.arange(ps.size) - starts[ps]
-    pad = np.full((counts.size, kmax, q.shape[1]), np.nan)
-    pad[ps, slot] = qs
-    diff = pad[:, :, None, :] - pad[:, None, :, :]
-    wrapped = np.abs(np.pi - np.mod(np.pi - diff, 2.0 * np.pi))
+    """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one.
+
+    Candidates are sorted by pose and by their joint values rounded to 10x the tolerance; equal ones are
+    then at most ``_DEDUPE_WINDOW`` places apart, so each is compared with its next neighbours only.
+    """
+    K = q.shape[0]
+    keep = np.ones(K, dtype=bool)
+    if K == 0:
+        return keep
     tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
-    dist = np.where(robot.is_revolute, wrapped, np.abs(diff))
-    same = np.all(dist <= tol, axis=-1)  # (P, K, K)
-    earlier = np.tril(np.ones((kmax, kmax), dtype=bool), k=-1)  # j < i
-    dup = np.any(same & earlier[None], axis=-1)
-    keep_sorted = ~dup[ps, slot]
-    keep = np.empty_like(keep_sorted)
-    keep[order] = keep_sorted
+    keys = np.round(q / (10.0 * tol))
+    order = np.lexsort((*keys.T[::-1], pose_idx))
+    ps, qs, es = pose_idx[order], q[order], err[order]
+    drop = np.zeros(K, dtype=bool)
+    for w in range(1, min(_DEDUPE_WINDOW, K - 1) + 1):
+        d = qs[w:] - qs[:-w]
+        d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
+        same = (ps[w:] == ps[:-w]) & np.all(d <= tol, axis=-1)
+        i = np.nonzero(same)[0]
+        worse_later = es[i + w] >= es[i]
+        drop[np.where(worse_later, i + w, i)] = True
+    keep[order] = ~drop
     return keep
+
+
+#: Candidates compared by ``_dedupe`` on each side in sorted order (duplicates of one solution are few).
+_DEDUPE_WINDOW = 16
 
 
 def _families(
@@ -154,7 +159,11 @@ def _solve_chunk(
     n_reachable = np.bincount(pose_idx, minlength=len(poses))
     if limits:
         pose_idx, q, err_paper, err_geo, inside = (
-            pose_idx[inside], q[inside], err_paper[inside], err_geo[inside], inside[inside]
+            pose_idx[inside],
+            q[inside],
+            err_paper[inside],
+            err_geo[inside],
+            inside[inside],
         )
     keep = _dedupe(robot, pose_idx, q, err_geo)
     pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
@@ -162,7 +171,11 @@ def _solve_chunk(
 
     order = np.argsort(pose_idx, kind="stable")
     pose_idx, q, err_paper, err_geo, inside = (
-        pose_idx[order], q[order], err_paper[order], err_geo[order], inside[order]
+        pose_idx[order],
+        q[order],
+        err_paper[order],
+        err_geo[order],
+        inside[order],
     )
     bounds = np.searchsorted(pose_idx, np.arange(len(poses) + 1))
     results = []
@@ -232,7 +245,9 @@ def solve_many(
         raise ShapeError(f"n_samples must be at least 8, got {n_samples}")
     red = get_reduction(robot, reduction)
     if red.robot is not robot:
-        red = type(red)(robot) if type(red).__init__ is not Reduction.__init__ else red
+        raise UnknownOptionError(
+            f"the reduction {red.name!r} was built for robot {red.robot.name!r}, not for {robot.name!r}"
+        )
     out: list[Solutions] = []
     for s in range(0, P.shape[0], chunk_size):
         out.extend(_solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples))

@@ -1,0 +1,413 @@
+"""The ``sweepik`` command line.
+
+Each subcommand is one pair of functions, ``_add_<name>_parser(sub)`` (creates its subparser with
+``_subparser`` and declares its arguments) and ``_cmd_<name>(args) -> int`` (runs it and returns the exit
+status), registered in ``_COMMANDS``. To add a subcommand, write the pair and add one line to
+``_COMMANDS``; the helpers below (robot and number parsing, unit conversion, matrix and table formatting,
+JSON output) are meant to be shared. Raise a :class:`SweepikError` (e.g. ``CliInputError``) for bad input:
+``main`` turns it into the one-line error and exit status 2.
+
+Exit status: 0 on success, 2 on bad input (usage errors, bad numbers, any :class:`SweepikError`), 1 when
+a file cannot be read or decoded. Errors print one line ``sweepik: error: <message>`` on stderr, never a
+traceback.
+
+>>> main(["fk", "carm", "500", "0", "0", "0", "0", "0", "--json"])  # doctest: +ELLIPSIS
+{
+  "robot": "carm",
+...
+0
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+import sys
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import __version__
+from .errors import SweepikError
+from .pose import GIMBAL_TOL, zyz_from_matrix
+from .robot import LIMIT_TOL, Robot
+from .robot_file import bundled_robots, load_robot
+
+__all__ = ["main", "build_parser"]
+
+PROG = "sweepik"
+#: Robot used when a subcommand's optional ROBOT argument is left out.
+DEFAULT_ROBOT = "carm"
+#: Exit status for bad input (the same as argparse's usage errors).
+EXIT_USAGE = 2
+#: Exit status when a file cannot be read.
+EXIT_IO = 1
+#: Largest --precision (float64 carries 15-17 significant digits).
+MAX_PRECISION = 17
+VERBOSE_HELP = "print more detail (and log at INFO level)"
+
+_SubParsers = Any  # argparse's _SubParsersAction (a private type)
+
+
+class CliInputError(SweepikError):
+    """A command-line value is malformed (not a number, wrong count, ...)."""
+
+
+# --------------------------------------------------------------------------------------------------
+# Shared helpers for subcommands
+# --------------------------------------------------------------------------------------------------
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
+def _protect_negative_numbers(argv: Sequence[str]) -> list[str]:
+    """Make every number-looking token that starts with '-' a positional for argparse.
+
+    argparse takes ``-30`` and ``-0.5`` as positionals (no option of ours looks like a number) but
+    ``-1e3``, ``-inf`` or ``-nan`` as unknown options. A leading space makes argparse treat a token as a
+    positional; ``float`` ignores it.
+    """
+    return [f" {tok}" if tok.startswith("-") and len(tok) > 1 and _is_number(tok) else tok for tok in argv]
+
+
+def _parse_numbers(tokens: Sequence[str], names: Sequence[str]) -> NDArray[np.float64]:
+    """Floats from command-line tokens; ``names`` label each value in error messages. Rejects NaN/inf."""
+    values = []
+    for tok, name in zip(tokens, names, strict=True):
+        text = tok.strip()
+        try:
+            v = float(text)
+        except ValueError:
+            raise CliInputError(f"value for {name} must be a number, got {text!r}") from None
+        if not math.isfinite(v):
+            raise CliInputError(f"value for {name} must be finite, got {text!r}")
+        values.append(v)
+    return np.array(values, dtype=np.float64)
+
+
+def _split_robot(tokens: Sequence[str]) -> tuple[str, list[str]]:
+    """Split ``[ROBOT] X1 ... Xk`` into the robot (``DEFAULT_ROBOT`` if the first token is a number)."""
+    if tokens and not _is_number(tokens[0]):
+        return tokens[0], list(tokens[1:])
+    return DEFAULT_ROBOT, list(tokens)
+
+
+def _joint_units(robot: Robot, rad: bool) -> list[str]:
+    """Display unit of each joint: 'deg' (or 'rad') for revolute joints, the length unit for prismatic."""
+    ang = "rad" if rad else "deg"
+    return [ang if rev else robot.length_unit for rev in robot.is_revolute]
+
+
+def _config_from_cli(robot: Robot, tokens: Sequence[str], rad: bool) -> NDArray[np.float64]:
+    """Configuration ``(n,)`` (radians, length unit) from joint values typed in display units."""
+    units = _joint_units(robot, rad)
+    labels = [f"{name} [{u}]" for name, u in zip(robot.joint_names, units, strict=True)]
+    if len(tokens) != robot.n_joints:
+        raise CliInputError(
+            f"robot {robot.name!r} needs {robot.n_joints} joint values ({', '.join(labels)}), "
+            f"got {len(tokens)}"
+        )
+    values = _parse_numbers(tokens, labels)
+    if rad:
+        return values
+    return np.asarray(np.where(robot.is_revolute, np.radians(values), values), dtype=np.float64)
+
+
+def _num(v: float, decimals: int) -> str:
+    """A number with at most ``decimals`` decimals, trailing zeros dropped (500.000000 -> 500)."""
+    text = f"{float(_clean(v, decimals)):.{decimals}f}"
+    return text.rstrip("0").rstrip(".") if "." in text else text
+
+
+def _clean(x: ArrayLike, decimals: int) -> NDArray[np.float64]:
+    """Round for display, turning -0.0 into 0.0."""
+    return np.asarray(np.round(np.asarray(x, dtype=np.float64), decimals) + 0.0, dtype=np.float64)
+
+
+def _format_matrix(M: NDArray[np.float64], decimals: int, indent: str = "  ") -> str:
+    C = _clean(M, decimals)
+    cells = [[f"{v:.{decimals}f}" for v in row] for row in C]
+    width = max(len(c) for row in cells for c in row)
+    return "\n".join(indent + "  ".join(c.rjust(width) for c in row) for row in cells)
+
+
+def _format_table(header: Sequence[str], rows: Sequence[Sequence[str]], indent: str = "  ") -> str:
+    """Columns padded to equal width; columns holding only numbers are right-aligned."""
+    table = [list(header), *(list(r) for r in rows)]
+    widths = [max(len(r[i]) for r in table) for i in range(len(header))]
+    right = [bool(rows) and all(_is_number(r[i]) for r in rows) for i in range(len(header))]
+    lines = []
+    for r in table:
+        cells = [c.rjust(w) if rj else c.ljust(w) for c, w, rj in zip(r, widths, right, strict=True)]
+        lines.append((indent + "  ".join(cells)).rstrip())
+    return "\n".join(lines)
+
+
+def _print_json(obj: Any) -> None:
+    print(json.dumps(obj, indent=2, allow_nan=False))
+
+
+def _precision(text: str) -> int:
+    try:
+        n = int(text.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text.strip()!r}") from None
+    if not 0 <= n <= MAX_PRECISION:
+        raise argparse.ArgumentTypeError(f"must be between 0 and {MAX_PRECISION}, got {n}")
+    return n
+
+
+def _add_precision(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--precision",
+        type=_precision,
+        default=6,
+        metavar="N",
+        help="decimals shown in tables and matrices (default: 6)",
+    )
+
+
+def _add_json(p: argparse.ArgumentParser, what: str = "") -> None:
+    p.add_argument("--json", action="store_true", help=f"print JSON instead of text{what}")
+
+
+def _subparser(sub: _SubParsers, name: str, **kwargs: Any) -> argparse.ArgumentParser:
+    """A subparser that also accepts the common options (``-v``); ``kwargs`` go to ``add_parser``."""
+    parser: argparse.ArgumentParser = sub.add_parser(name, parents=[_verbose_parent()], **kwargs)
+    return parser
+
+
+def _verbose_parent() -> argparse.ArgumentParser:
+    """``-v`` for the subcommands: SUPPRESS keeps a subparser from resetting a ``-v`` given before it."""
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help=VERBOSE_HELP)
+    return common
+
+
+# --------------------------------------------------------------------------------------------------
+# fk
+# --------------------------------------------------------------------------------------------------
+
+
+def _add_fk_parser(sub: _SubParsers) -> None:
+    p = _subparser(
+        sub,
+        "fk",
+        usage="%(prog)s [-h] [-v] [--rad] [--json] [--precision N] [ROBOT] Q1 ... Qn",
+        help="forward kinematics: tool pose of a configuration",
+        description=(
+            "Print the tool pose (4x4 matrix, position, Z-Y-Z Euler angles) of a configuration. "
+            f"ROBOT is a bundled robot name or a robot file (default: {DEFAULT_ROBOT}). Joint values are "
+            "degrees for revolute joints (radians with --rad) and the robot's length unit for prismatic "
+            "ones. Negative values need no quoting: sweepik fk carm 500 -30 0 0 0 0"
+        ),
+    )
+    p.add_argument(
+        "values", nargs="+", metavar="[ROBOT] Q1 ... Qn", help="robot (optional), then one value per joint"
+    )
+    p.add_argument("--rad", action="store_true", help="revolute joint values are in radians")
+    _add_json(p, ": robot, joint_names, q (radians / length unit), pose, xyz, zyz_deg, ...")
+    _add_precision(p)
+
+
+def _cmd_fk(args: argparse.Namespace) -> int:
+    name, tokens = _split_robot(args.values)
+    robot = load_robot(name)
+    q = _config_from_cli(robot, tokens, args.rad)
+    T = robot.fk(q)
+    xyz = T[:3, 3]
+    zyz_deg = np.degrees(zyz_from_matrix(T))
+    inside = bool(robot.within_limits(q))
+    if args.json:
+        _print_json(
+            {
+                "robot": robot.name,
+                "joint_names": robot.joint_names,
+                "q": q.tolist(),
+                "pose": T.tolist(),
+                "xyz": xyz.tolist(),
+                "zyz_deg": zyz_deg.tolist(),
+                "length_unit": robot.length_unit,
+                "within_limits": inside,
+            }
+        )
+        return 0
+    dec = args.precision
+    unit = robot.length_unit
+    shown = q if args.rad else np.where(robot.is_revolute, np.degrees(q), q)
+    joints = ", ".join(
+        f"{n} = {_num(v, dec)} {u}"
+        for n, v, u in zip(robot.joint_names, shown, _joint_units(robot, args.rad), strict=True)
+    )
+    x, y, z = _clean(xyz, dec)
+    a, b, g = _clean(zyz_deg, dec)
+    print(f"robot: {robot.name} ({robot.dh_convention} DH, lengths in {unit})")
+    print(f"joints: {joints}")
+    if not inside:
+        out = [n for n, ok in zip(robot.joint_names, _joints_inside(robot, q), strict=True) if not ok]
+        print(f"note: outside joint limits: {', '.join(out)}")
+    print(f"pose T_world_tool (rotation, translation in {unit}):")
+    print(_format_matrix(T, dec))
+    print(f"position [{unit}]: x = {x:.{dec}f}  y = {y:.{dec}f}  z = {z:.{dec}f}")
+    print(f"ZYZ Euler [deg]: alpha = {a:.{dec}f}  beta = {b:.{dec}f}  gamma = {g:.{dec}f}")
+    beta = np.radians(zyz_deg[1])
+    if beta < GIMBAL_TOL or np.pi - beta < GIMBAL_TOL:
+        which = "alpha + gamma" if beta < GIMBAL_TOL else "alpha - gamma"
+        print(f"note: ZYZ gimbal case (beta = {b:.0f} deg): only {which} is defined; alpha = 0 chosen")
+    if args.verbose:
+        origins = robot.frames(q)[:, :3, 3]
+        labels = ["base", *robot.joint_names, "tool"]
+        rows = [
+            [lab, *(f"{v:.{dec}f}" for v in _clean(o, dec))] for lab, o in zip(labels, origins, strict=True)
+        ]
+        print(f"frame origins [{unit}]:")
+        print(_format_table(["frame", "x", "y", "z"], rows))
+    return 0
+
+
+def _joints_inside(robot: Robot, q: NDArray[np.float64]) -> list[bool]:
+    """Per joint: inside its limits (revolute values after ``Robot.wrap``), as ``Robot.within_limits``."""
+    w = robot.wrap(q)
+    return [
+        bool(lo - LIMIT_TOL <= v <= hi + LIMIT_TOL)
+        for v, lo, hi in zip(w, robot.lower, robot.upper, strict=True)
+    ]
+
+
+# --------------------------------------------------------------------------------------------------
+# robots
+# --------------------------------------------------------------------------------------------------
+
+
+def _add_robots_parser(sub: _SubParsers) -> None:
+    p = _subparser(
+        sub,
+        "robots",
+        help="list the bundled robots and their DH tables",
+        description="Show robots: the bundled ones, or the named robots / robot files.",
+    )
+    p.add_argument("robots", nargs="*", metavar="ROBOT", help="robot names or files (default: all bundled)")
+    _add_json(p)
+    _add_precision(p)
+
+
+def _robot_summary(robot: Robot) -> dict[str, Any]:
+    return {
+        "name": robot.name,
+        "description": robot.description,
+        "dh_convention": robot.dh_convention,
+        "length_unit": robot.length_unit,
+        "default_reduction": robot.default_reduction,
+        "n_joints": robot.n_joints,
+        "dh_table": robot.dh_table(),
+        "T_world_base": robot.T_world_base.tolist(),
+        "T_flange_tool": robot.T_flange_tool.tolist(),
+    }
+
+
+def _cmd_robots(args: argparse.Namespace) -> int:
+    robots = [load_robot(name) for name in (args.robots or bundled_robots())]
+    if args.json:
+        _print_json([_robot_summary(r) for r in robots])
+        return 0
+    dec = args.precision
+    for i, robot in enumerate(robots):
+        if i:
+            print()
+        unit = robot.length_unit
+        print(f"{robot.name}: {robot.description}" if robot.description else robot.name)
+        extra = f", default reduction {robot.default_reduction}" if robot.default_reduction else ""
+        print(f"  {robot.n_joints} joints, {robot.dh_convention} DH, lengths in {unit}, angles in deg{extra}")
+        a_label = "a_{i-1}" if robot.dh_convention == "modified" else "a_i"
+        al_label = "alpha_{i-1}" if robot.dh_convention == "modified" else "alpha_i"
+        header = [
+            "joint",
+            "type",
+            f"{a_label} [{unit}]",
+            f"{al_label} [deg]",
+            f"d_i [{unit}]",
+            "theta_i [deg]",
+            "limits",
+        ]
+        rows = []
+        for row, rev in zip(robot.dh_table(), robot.is_revolute, strict=True):
+            num = [_num(float(row[k]), dec) for k in ("a", "alpha_deg", "d", "theta_deg", "lower", "upper")]
+            lim_unit = "deg" if rev else unit
+            rows.append([str(row["joint"]), str(row["type"]), *num[:4], f"[{num[4]}, {num[5]}] {lim_unit}"])
+        print(_format_table(header, rows))
+        for label, T in (
+            ("base T_world_base", robot.T_world_base),
+            ("tool T_flange_tool", robot.T_flange_tool),
+        ):
+            if not np.array_equal(T, np.eye(4)):
+                print(f"  {label}:")
+                print(_format_matrix(T, dec, indent="    "))
+    return 0
+
+
+# --------------------------------------------------------------------------------------------------
+# Parser, dispatch, main
+# --------------------------------------------------------------------------------------------------
+
+_AddParser = Callable[[_SubParsers], None]
+_Run = Callable[[argparse.Namespace], int]
+
+#: Subcommand name -> (function adding its parser, function running it).
+_COMMANDS: dict[str, tuple[_AddParser, _Run]] = {
+    "fk": (_add_fk_parser, _cmd_fk),
+    "robots": (_add_robots_parser, _cmd_robots),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The top-level parser with one subparser per entry of ``_COMMANDS``."""
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="All inverse-kinematics solutions of 6-DOF serial arms by a one-joint sweep.",
+    )
+    parser.add_argument("-v", "--verbose", action="store_true", help=VERBOSE_HELP)
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for add_parser, _ in _COMMANDS.values():
+        add_parser(sub)
+    return parser
+
+
+def _error(message: str) -> None:
+    # One line, whatever the message holds.
+    print(f"{PROG}: error: {' '.join(str(message).split())}", file=sys.stderr)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``sweepik`` command with ``argv`` (default: ``sys.argv[1:]``); return the exit status."""
+    args_in = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    try:
+        args = parser.parse_args(_protect_negative_numbers(args_in))
+    except SystemExit as exc:  # --help, --version, usage errors: argparse has printed its message
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else EXIT_USAGE)
+    if args.verbose:
+        logging.basicConfig(level=logging.INFO, format=f"{PROG}: %(message)s")
+    _, run = _COMMANDS[args.command]
+    try:
+        return run(args)
+    except SweepikError as exc:
+        _error(str(exc))
+        return EXIT_USAGE
+    except (OSError, UnicodeError) as exc:  # unreadable or undecodable robot file
+        _error(str(exc))
+        return EXIT_IO
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,56 @@
+"""The public API: every name in ``sweepik.__all__`` exists, and the docstring examples run."""
+
+from __future__ import annotations
+
+import doctest
+import importlib
+import pkgutil
+from importlib.metadata import version
+
+import pytest
+
+import sweepik
+
+
+def test_all_names_importable() -> None:
+    assert sweepik.__all__, "sweepik.__all__ is empty"
+    missing = [name for name in sweepik.__all__ if not hasattr(sweepik, name)]
+    assert not missing, f"names in sweepik.__all__ but not in sweepik: {missing}"
+    for name in sweepik.__all__:
+        exec(f"from sweepik import {name}", {})  # the form users write
+
+
+def test_all_has_no_duplicates() -> None:
+    dupes = sorted({n for n in sweepik.__all__ if sweepik.__all__.count(n) > 1})
+    assert not dupes, f"duplicated in sweepik.__all__: {dupes}"
+
+
+def test_contract_names_are_public() -> None:
+    # Named in DESIGN.md's public surface; extend, never rename.
+    for name in ("load_robot", "Robot", "Joint", "SweepikError"):
+        assert name in sweepik.__all__
+
+
+def test_version_matches_metadata() -> None:
+    assert sweepik.__version__ == version("sweepik")
+
+
+# Every module of the package (``__main__`` excluded: importing it would run the command).
+MODULES = sorted(
+    m.name
+    for m in pkgutil.walk_packages(sweepik.__path__, prefix="sweepik.")
+    if not m.name.endswith("__main__")
+)
+
+
+@pytest.mark.parametrize("module_name", MODULES)
+def test_docstring_examples_run(module_name: str) -> None:
+    if module_name == "sweepik.plot":
+        pytest.importorskip("matplotlib")
+    module = importlib.import_module(module_name)
+    result = doctest.testmod(
+        module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False
+    )
+    assert result.failed == 0, (
+        f"{result.failed} of {result.attempted} doctest examples failed in {module_name}"
+    )
