@@ -128,8 +128,9 @@ NEWTON_ITERS = 40
 NEWTON_MAX_MOVE = 1e-2
 #: F_e is "zero to rounding" below F_NOISE times the size of its terms.
 F_NOISE = 8.0 * np.finfo(float).eps
-#: A derivative root t* is a multiple root of Q if |Q(t*)| <= Q_NOISE * sum |c_i| |t*|^i (a generous
-#: multiple of the machine eps that bounds the evaluation error of Q).
+#: A derivative root t* is a multiple root of Q if |Q(t*)| <= Q_NOISE * (|T1| + |T2|)(|t*|), where
+#: Q = T1 - T2 and |T| has the absolute values of T's coefficients: a generous multiple of the machine eps
+#: times the size of what cancels in Q.
 Q_NOISE = 1e-13
 
 
@@ -382,7 +383,9 @@ def carm_ik_oracle_ex(T: ArrayLike, L1: float = 350.0, L2: float = 402.0) -> tup
     if abs(T[0, 3]) < DEGEN_PX_MM and np.hypot(P.zy, P.zz) < DEGEN_ANGLE:
         return empty, True
 
-    Q = P.polynomial()[0]
+    Q, T1, T2 = P.polynomial()
+    n = max(T1.coef.size, T2.coef.size)  # Q = T1 - T2: rounding error ~ eps * (|T1| + |T2|)
+    noise_poly = Polynomial(np.abs(np.pad(T1.coef, (0, n - T1.coef.size))) + np.abs(np.pad(T2.coef, (0, n - T2.coef.size))))
     c = Q.coef.copy()
     big = np.max(np.abs(c)) if c.size else 0.0
     degenerate = False
@@ -416,7 +419,7 @@ def carm_ik_oracle_ex(T: ArrayLike, L1: float = 350.0, L2: float = 402.0) -> tup
         for tc, m in _clusters(sorted(best_polished)):
             for order in range(1, m):
                 ts = _newton_poly(Q.deriv(order), tc)
-                if ts is not None and abs(Q(ts)) <= Q_NOISE * _poly_scale(Q, ts):
+                if ts is not None and abs(Q(ts)) <= Q_NOISE * noise_poly(abs(ts)):
                     # A higher order is the simple root when the multiplicity is m: most accurate first.
                     add_t(ts, -order)
     else:  # Q == 0 exactly but not caught above (e.g. zy = zz = 0 and Px = 0 to the bit)
@@ -460,11 +463,6 @@ def _clusters(ts: list[float]) -> list[tuple[float, int]]:
             out.append((float(np.mean(ts[i : j + 1])), j - i + 1))
         i = j + 1
     return out
-
-
-def _poly_scale(p: Polynomial, t: float) -> float:
-    """sum |c_i| |t|^i: the size of the rounding error of evaluating p at t, in units of machine eps."""
-    return float(np.sum(np.abs(p.coef) * np.abs(t) ** np.arange(p.coef.size)))
 
 
 def _newton_poly(p: Polynomial, t0: float) -> float | None:

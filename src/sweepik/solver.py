@@ -169,6 +169,13 @@ def _solve_chunk(
     pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
     fams = _families(robot, red, chain, spans, limits) if spans else {}
 
+    if limits and not red.periodic:
+        # the sweep covered theta*'s limits only: for poses left without any solution, look beyond them
+        # so that the reason can tell "out of joint limits" from "unreachable"
+        empty = np.nonzero((np.bincount(pose_idx, minlength=len(poses)) == 0) & (n_reachable == 0))[0]
+        if empty.size and red.search_range(chain[empty]) is not None:
+            beyond = _solve_chunk(robot, red, poses[empty], strategy, False, n_samples)
+            n_reachable[empty] = [len(b) for b in beyond]
     order = np.argsort(pose_idx, kind="stable")
     pose_idx, q, err_paper, err_geo, inside = (
         pose_idx[order],

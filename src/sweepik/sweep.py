@@ -24,8 +24,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from . import kinematics
+from .pose import pose_error_geodesic
 from .reductions.base import Array, IntArray, Reduction
 from .rootfind import find_roots
+from .units import orientation_weight
 
 #: Default number of uniform samples of theta* over its range (hints and refinements come on top).
 #: Checked against an independent polynomial solver (tests/carm_oracle.py) and against dense sampling.
@@ -227,7 +230,9 @@ class _Search:
             k = np.nonzero(ok)[0]
             xe[k] = find_roots(lambda x, s: g(x, k[s]), a[k], c[k], ga[k], gc[k], 1e-3 * float(h[k].min()))
         fx = fe(xe, idx)
-        cross = np.isfinite(fx) & (np.sign(fc) * fx < 0)
+        # a dip below zero within the residual's rounding noise is a double root, not two roots: bracketing
+        # it would return arbitrary points of the flat bottom (where |f| < noise) instead of the extremum
+        cross = np.isfinite(fx) & (np.sign(fc) * fx < -self.red.residual_noise)
         k = np.nonzero(cross)[0]
         if k.size:
             self.br.append((p[k], b[k], ta[k], xe[k], fa[k], fx[k]))
@@ -265,6 +270,33 @@ def _families(theta: Array, f: Array, valid: NDArray[np.bool_]) -> tuple[list[Fa
     return spans, in_family
 
 
+class PoseErrorResidual(Reduction):
+    """Wraps a reduction without a residual: its "residual" is the pose error (position + weight x angle,
+    length unit) of each branch's configuration. Non-negative, so roots show up as local minima that touch
+    zero; the engine's extremum search and the FK certification handle them (at some cost in speed).
+    """
+
+    def __init__(self, inner: Reduction, weight: float) -> None:
+        super().__init__(inner.robot, inner.free_joint, inner.n_branches)
+        self.inner = inner
+        self.weight = weight
+        self.name = inner.name
+        self.residual_noise = 1e-14 * inner.robot.length_scale
+        self._inv_base = np.linalg.inv(inner.robot.T_world_base)
+
+    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        return self.inner.solve_rest(poses, theta, branch)
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        q = self.inner.solve_rest(poses, theta, branch)
+        T = self._inv_base @ kinematics.chain_frames(self.robot, q)[..., -1, :, :]
+        target = poses.reshape(poses.shape[0], *((1,) * (q.ndim - 2)), 4, 4)
+        return pose_error_geodesic(T, target, self.weight)
+
+    def sample_hints(self, poses: Array) -> Array | None:
+        return self.inner.sample_hints(poses)
+
+
 def find_candidates(
     reduction: Reduction,
     poses: Array,
@@ -276,7 +308,8 @@ def find_candidates(
     theta = sample_grid(reduction, poses, lo, hi, n_samples)
     f = reduction.residual(poses, theta)
     if f is None:
-        raise NotImplementedError("sweepik's precise strategy needs a reduction with a residual")
+        reduction = PoseErrorResidual(reduction, orientation_weight(reduction.robot.length_unit))
+        f = reduction.residual(poses, theta)
     N, M, B = f.shape
     valid = np.isfinite(f)
     spans, in_family = _families(theta, f, valid)

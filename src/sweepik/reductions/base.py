@@ -46,6 +46,9 @@ class Reduction(ABC):
     name: str = "custom"
     #: Known blind spots, for the docs and ``sweepik solve --reduction`` help.
     blind_spots: str = ""
+    #: Rounding noise of ``residual`` (absolute). A residual extremum that dips below zero by less than this
+    #: is treated as one double root. 1e-14 suits residuals built from O(1) sines, cosines and unit vectors.
+    residual_noise: float = 1e-14
 
     def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:
         self.robot = robot

@@ -1,0 +1,250 @@
+"""IK solver: FK(IK(T)) = T, IK(FK(q)) contains q, reductions agree, singular/edge cases, bad input."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import sweepik
+from sweepik import (
+    CArmD1,
+    InvalidPoseError,
+    NonFiniteError,
+    ShapeError,
+    SweepikError,
+    UnknownOptionError,
+    load_robot,
+    solve,
+    solve_many,
+)
+from sweepik.pose import pose_error_paper
+from sweepik.solutions import joint_distance
+
+CARM = load_robot("carm")
+#: "contains q": every joint within this (mm for d1, rad modulo 2 pi for the angles)
+FOUND_TOL = 1e-6
+#: precise strategy: every returned solution has the paper's J at most this (mm)
+J_TOL = 1e-9
+
+
+def random_configs(n: int, seed: int) -> np.ndarray:
+    """In-limit configurations with continuous (off-grid) d1, plus stress subsets: rail ends, joint limits,
+    theta5 near 0 and theta2 near +-90 deg."""
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(CARM.lower, CARM.upper, (n, 6))
+    k = n // 10
+    q[:k, 4] = rng.normal(0.0, 1e-3, k)
+    q[k : 2 * k, 1] = np.pi / 2 * rng.choice([-1, 1], k) + rng.normal(0.0, 1e-4, k)
+    q[2 * k : 3 * k, 0] = rng.choice([CARM.lower[0], CARM.upper[0]], k)
+    q[3 * k : 4 * k, 2] = rng.choice([CARM.lower[2], CARM.upper[2]], k)
+    q[4 * k : 5 * k, 3] = rng.choice([CARM.lower[3], CARM.upper[3]], k)
+    return q
+
+
+def found(sol: sweepik.Solutions, q: np.ndarray) -> bool:
+    if len(sol):
+        if joint_distance(CARM, sol.q, q).max(axis=-1).min() <= FOUND_TOL:
+            return True
+    for fam in sol.families:
+        th = q[fam.free_joint]
+        if fam.interval[0] - FOUND_TOL <= th <= fam.interval[1] + FOUND_TOL:
+            if joint_distance(CARM, fam.at(np.clip(th, *fam.interval)), q).max() <= FOUND_TOL:
+                return True
+    return False
+
+
+def assert_certified(sol: sweepik.Solutions, T: np.ndarray) -> None:
+    if len(sol):
+        J = pose_error_paper(CARM.fk(sol.q), T)
+        assert J.max() <= J_TOL
+        np.testing.assert_allclose(sol.error, J, rtol=0, atol=1e-12)
+        assert np.all(CARM.within_limits(sol.q))
+
+
+@pytest.fixture(scope="module")
+def batch() -> tuple[np.ndarray, np.ndarray, list[sweepik.Solutions]]:
+    q = random_configs(10_000, seed=1234)
+    T = CARM.fk(q)
+    return q, T, solve_many(CARM, T)
+
+
+def test_round_trip_10000_random_configurations(batch) -> None:  # type: ignore[no-untyped-def]
+    q, T, sols = batch
+    missed = [i for i in range(len(q)) if not found(sols[i], q[i])]
+    assert missed == []
+    worst = max(float(s.error.max()) for s in sols if len(s))
+    assert worst <= J_TOL
+    for i in range(0, len(q), 97):
+        assert_certified(sols[i], T[i])
+
+
+def test_both_reductions_give_the_same_solution_sets(batch) -> None:  # type: ignore[no-untyped-def]
+    q, T, sols_d1 = batch
+    sols_t2 = solve_many(CARM, T, reduction="carm-theta2")
+    for i, (a, b) in enumerate(zip(sols_d1, sols_t2, strict=True)):
+        assert len(a) == len(b), (i, q[i])
+        if len(a):
+            d = joint_distance(CARM, a.q[:, None, :], b.q[None, :, :]).max(axis=-1)
+            assert d.min(axis=1).max() <= FOUND_TOL, (i, q[i])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.tuples(
+        st.floats(0.0, 2000.0),
+        st.floats(-np.pi, np.pi),
+        st.floats(np.radians(-84), np.radians(116)),
+        st.floats(np.radians(-178), np.radians(66)),
+        st.one_of(st.floats(-np.pi, np.pi), st.floats(-1e-4, 1e-4)),
+        st.floats(-np.pi, np.pi),
+    )
+)
+def test_property_ik_of_fk_contains_q(qt: tuple[float, ...]) -> None:
+    q = np.array(qt)
+    T = CARM.fk(q)
+    sol = solve(CARM, T)
+    assert found(sol, q)
+    assert_certified(sol, T)
+
+
+def test_agrees_with_independent_polynomial_oracle() -> None:
+    from carm_oracle import carm_ik_oracle_ex
+
+    rng = np.random.default_rng(7)
+    q = rng.uniform(CARM.lower, CARM.upper, (300, 6))
+    T = CARM.fk(q)
+    sols = solve_many(CARM, T, limits=False)
+    compared = 0
+    for i in range(len(q)):
+        ref, degenerate = carm_ik_oracle_ex(T[i])
+        if degenerate:
+            continue
+        # the oracle ignores limits; sweepik's sweep of d1 without limits covers the whole reachable range
+        ours = sols[i].q
+        assert len(ours) == len(ref), (i, q[i])
+        d = joint_distance(CARM, ours[:, None, :], ref[None, :, :]).max(axis=-1)
+        assert d.min(axis=1).max() <= 1e-6
+        compared += 1
+    assert compared >= 290
+
+
+def paper_grid(singular_only: bool) -> np.ndarray:
+    d1 = [500.0, 1000.0, 1500.0]
+    t2 = np.radians(np.arange(-150, 151, 30))
+    t3 = np.radians([-60, -30, 0, 30, 60])
+    t4 = np.radians([-60, -30, 0, 30])
+    t5 = np.radians([-120, -60, 0, 60, 120])
+    t6 = np.radians([-60, -30, 0, 30, 60])
+    g = np.array(list(itertools.product(d1, t2, t3, t4, t5, t6)))
+    sing = np.isclose(np.abs(g[:, 1]), np.pi / 2) & np.isclose(g[:, 2], 0.0)
+    return g[sing] if singular_only else g
+
+
+def test_singular_grid_points_found_or_in_family() -> None:
+    q = paper_grid(singular_only=True)
+    assert len(q) == 600
+    T = CARM.fk(q)
+    sols = solve_many(CARM, T)
+    assert all(found(s, qq) for s, qq in zip(sols, q, strict=True))
+    # theta5 = 0 there: the pose admits a continuum of solutions
+    with_family = [s for s, qq in zip(sols, q, strict=True) if qq[4] == 0.0]
+    assert with_family and all(s.families for s in with_family)
+    for s in with_family:
+        for fam in s.families:
+            lo, hi = fam.interval
+            members = fam.at(np.linspace(lo, hi, 7))
+            np.testing.assert_allclose(CARM.fk(members), np.broadcast_to(s.pose, (7, 4, 4)), atol=1e-9)
+            assert fam.free_joint == 0
+
+
+def test_paper_strategy_on_grid_sample_has_paper_sized_errors() -> None:
+    g = paper_grid(singular_only=False)
+    sing = np.isclose(np.abs(g[:, 1]), np.pi / 2) & np.isclose(g[:, 2], 0.0)
+    q = g[~sing][::53]
+    sols = solve_many(CARM, CARM.fk(q), strategy="paper")
+    J = [float(pose_error_paper(CARM.fk(s.nearest(qq)), s.pose)) for s, qq in zip(sols, q, strict=True)]
+    assert all(found_loose for found_loose in (len(s) > 0 for s in sols))
+    assert max(J) < 1e-5  # the paper's acceptance threshold; Table 3: J_max 3.49e-6 mm
+
+
+def test_solve_many_equals_solve(batch) -> None:  # type: ignore[no-untyped-def]
+    q, T, sols = batch
+    for i in list(range(0, 200, 13)) + list(range(1000, 10_000, 701)):
+        single = solve(CARM, T[i])
+        np.testing.assert_array_equal(single.q, sols[i].q)
+        np.testing.assert_array_equal(single.error, sols[i].error)
+
+
+def test_solutions_api() -> None:
+    q = np.array([800.0, 0.3, 0.2, -0.4, 0.5, 0.1])
+    sol = solve(CARM, CARM.fk(q))
+    assert len(sol) == sol.q.shape[0] == len(list(sol)) >= 1
+    assert bool(sol) and sol.reason is None and sol.families == ()
+    np.testing.assert_allclose(sol.nearest(q + [0, 2 * np.pi, 0, 0, 0, 0]), q, atol=1e-9)
+    assert sol.q.shape[1] == 6 and sol.error.shape == (len(sol),)
+
+
+def test_unreachable_and_out_of_limits_reasons() -> None:
+    far = np.eye(4)
+    far[:3, 3] = [5000.0, 0.0, 1000.0]
+    sol = solve(CARM, far)
+    assert len(sol) == 0 and not sol and "unreachable" in (sol.reason or "")
+    with pytest.raises(SweepikError):
+        sol.nearest(np.zeros(6))
+    # beyond the rail: d1 = 2300 mm is reachable only without limits
+    q = np.array([2300.0, 0.4, 0.3, -0.5, 0.6, 0.2])
+    T = CARM.fk(q)
+    limited = solve(CARM, T)
+    free = solve(CARM, T, limits=False)
+    assert found(free, q)
+    assert not np.all(free.within_limits)
+    assert len(limited) == int(np.sum(free.within_limits))
+    if len(limited) == 0:
+        assert "out of joint limits" in (limited.reason or "")
+
+
+def test_custom_reduction_without_residual_matches() -> None:
+    class NoResidual(CArmD1):
+        name = "carm-d1-no-residual"
+
+        def residual(self, poses, theta, branch=None):  # type: ignore[no-untyped-def]
+            return None
+
+    rng = np.random.default_rng(99)
+    q = rng.uniform(CARM.lower, CARM.upper, (40, 6))
+    T = CARM.fk(q)
+    sols = solve_many(CARM, T, reduction=NoResidual(CARM))
+    for s, qq, t in zip(sols, q, T, strict=True):
+        assert found(s, qq)
+        assert_certified(s, t)
+
+
+@pytest.mark.parametrize(
+    ("pose", "error"),
+    [
+        (np.diag([1.0, 1.0, 2.0, 1.0]), InvalidPoseError),
+        (np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]], float), InvalidPoseError),
+        (np.full((4, 4), np.nan), NonFiniteError),
+        (np.eye(3), ShapeError),
+        (np.eye(4)[None], ShapeError),
+    ],
+)
+def test_bad_poses_raise(pose: np.ndarray, error: type[Exception]) -> None:
+    with pytest.raises(error):
+        solve(CARM, pose)
+
+
+def test_bad_options_raise() -> None:
+    T = CARM.fk(np.zeros(6))
+    with pytest.raises(UnknownOptionError, match="strategy"):
+        solve(CARM, T, strategy="fast")  # type: ignore[arg-type]
+    with pytest.raises(UnknownOptionError, match="carm-d1"):
+        solve(CARM, T, reduction="nope")
+    with pytest.raises(ShapeError):
+        solve_many(CARM, T)
+    with pytest.raises(SweepikError, match="C-Arm"):
+        solve(load_robot("puma560"), np.eye(4), reduction="carm-d1")
