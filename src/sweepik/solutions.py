@@ -113,11 +113,15 @@ class Solutions:
             i = int(np.argmin(d))
             best, best_d = self.q[i], float(d[i])
         for fam in self.families:
-            members = fam.sample(401)
-            d = np.linalg.norm(joint_distance(self.robot, members, ref), axis=-1)
-            i = int(np.argmin(d))
+            lo, hi = fam.interval
+            for _ in range(4):  # coarse-to-fine search along the family
+                grid = np.linspace(lo, hi, 101)
+                d = np.linalg.norm(joint_distance(self.robot, fam.at(grid), ref), axis=-1)
+                i = int(np.nanargmin(d))
+                step = grid[1] - grid[0]
+                lo, hi = max(fam.interval[0], grid[i] - step), min(fam.interval[1], grid[i] + step)
             if d[i] < best_d:
-                best, best_d = members[i], float(d[i])
+                best, best_d = fam.at(grid[i]), float(d[i])
         if best is None:
             raise SweepikError(f"no solution to choose from ({self.reason})")
         return best.copy()

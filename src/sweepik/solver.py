@@ -100,12 +100,17 @@ _DEDUPE_WINDOW = 16
 def _families(
     robot: Robot, red: Reduction, chain: Array, spans: list[FamilySpan], limits: bool
 ) -> dict[int, list[Family]]:
-    """Family objects per pose; with limits, each span is cut to the sub-intervals inside the limits."""
+    """Family objects per pose: each span cut to the sub-intervals whose members are certified by FK
+    (and, with limits, inside the limits)."""
     out: dict[int, list[Family]] = {}
+    weight = orientation_weight(robot.length_unit)
+    inv_base = np.linalg.inv(robot.T_world_base)
     for sp in spans:
         grid = np.linspace(sp.lo, sp.hi, 257)
         q = red.solve_rest(chain[sp.pose][None], grid[None], np.full((1, grid.size), sp.branch))[0]
         ok = np.all(np.isfinite(q), axis=-1)
+        T = inv_base @ kinematics.chain_frames(robot, np.nan_to_num(q))[:, -1]
+        ok &= pose_error_geodesic(T, chain[sp.pose], weight) <= ACCEPT_TOL_REL * robot.length_scale
         if limits:
             ok &= robot.within_limits(np.nan_to_num(q))
         edges = np.diff(np.concatenate([[0], ok.astype(np.int8), [0]]))

@@ -45,6 +45,10 @@ _U_EDGE = 0.5 * (1.0 - np.cos(np.pi * _U_UNIFORM))
 #: |residual| at or below which a sample counts as lying on a self-motion family (residuals are computed to
 #: ~1e-15; an isolated root makes three consecutive samples this small only with probability ~0).
 FAMILY_TOL = 1e-10
+#: Roots of one branch joined by a stretch where the residual stays at rounding noise form a cluster; a
+#: cluster longer than this fraction of the theta* range is reported as a family (a numerical continuum:
+#: every point of it solves the pose to rounding precision), a shorter one as its midpoint.
+CLUSTER_FAMILY_REL = 1e-9
 #: Minimum number of consecutive vanishing samples that make a family.
 FAMILY_MIN_RUN = 3
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
@@ -98,6 +102,7 @@ class _Search:
         self.roots_b: list[IntArray] = []
         self.roots_t: list[Array] = []
         self.br: list[tuple[IntArray, IntArray, Array, Array, Array, Array]] = []
+        self.spans: list[FamilySpan] = []
 
     def residual(self, pose: IntArray, branch: IntArray, theta: Array) -> Array:
         """Residual ``(K, M)`` of one branch per row."""
@@ -246,11 +251,38 @@ class _Search:
             xtol = float(XTOL_REL * self.span.min())
             x = find_roots(lambda x, s: self.residual(p[s], b[s], x[:, None])[:, 0], a, c, fa, fc, xtol)
             self._root(p, b, x)
-        return Candidates(
-            pose=np.concatenate(self.roots_p).astype(np.intp),
-            branch=np.concatenate(self.roots_b).astype(np.intp),
-            theta=np.concatenate(self.roots_t),
+        return self._merge_clusters(
+            np.concatenate(self.roots_p).astype(np.intp),
+            np.concatenate(self.roots_b).astype(np.intp),
+            np.concatenate(self.roots_t),
         )
+
+    def _merge_clusters(self, p: IntArray, b: IntArray, t: Array) -> Candidates:
+        """Merge neighbouring roots of one branch between which the residual stays within its rounding
+        noise: at a root of high multiplicity the residual is flat at noise level over a short stretch and
+        crosses zero there many times at random. Each such cluster becomes one candidate, its midpoint."""
+        order = np.lexsort((t, b, p))
+        p, b, t = p[order], b[order], t[order]
+        if t.size < 2:
+            return Candidates(p, b, t)
+        same = (p[1:] == p[:-1]) & (b[1:] == b[:-1])
+        k = np.nonzero(same & (t[1:] > t[:-1]))[0]
+        joined = np.zeros(t.size - 1, dtype=bool)
+        if k.size:
+            mid = 0.5 * (t[k] + t[k + 1])
+            fm = self.residual(p[k], b[k], mid[:, None])[:, 0]
+            joined[k] = np.abs(fm) <= self.red.residual_noise
+        joined |= same & (t[1:] == t[:-1])
+        start = np.concatenate([[True], ~joined])
+        first = np.nonzero(start)[0]
+        lo = np.minimum.reduceat(t, first)
+        hi = np.maximum.reduceat(t, first)
+        # a cluster longer than CLUSTER_FAMILY_REL of the range is a numerical continuum: a family
+        wide = hi - lo > CLUSTER_FAMILY_REL * self.span[p[first]]
+        for i in np.nonzero(wide)[0]:
+            self.spans.append(FamilySpan(int(p[first[i]]), int(b[first[i]]), float(lo[i]), float(hi[i])))
+        keep = first[~wide]
+        return Candidates(pose=p[keep], branch=b[keep], theta=0.5 * (lo + hi)[~wide])
 
 
 def _families(theta: Array, f: Array, valid: NDArray[np.bool_]) -> tuple[list[FamilySpan], NDArray[np.bool_]]:
@@ -320,4 +352,5 @@ def find_candidates(
     fs = f.transpose(0, 2, 1).reshape(N * B, M)
     vs = valid.transpose(0, 2, 1).reshape(N * B, M)
     search.scan(p, b, theta[p], fs, vs, 0)
-    return search.finish(), spans
+    cand = search.finish()
+    return cand, spans + search.spans

@@ -1,0 +1,145 @@
+"""``sweepik solve`` and ``sweepik path``: all IK solutions of poses, and joint paths along pose lists."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .cli_common import (
+    DEFAULT_ROBOT,
+    CliInputError,
+    _add_json,
+    _add_precision,
+    _config_from_cli,
+    _format_table,
+    _joint_units,
+    _parse_numbers,
+    _print_json,
+    _subparser,
+    _SubParsers,
+)
+from .pose import pose_from_xyz_zyz
+from .reductions import REDUCTIONS
+from .robot import Robot
+from .robot_file import load_robot
+from .solutions import Solutions
+from .solver import STRATEGIES, solve_many
+
+Array = NDArray[np.float64]
+
+
+def _add_ik_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--strategy", choices=STRATEGIES, default="precise", help="search strategy (default: precise)")
+    p.add_argument(
+        "--reduction",
+        metavar="NAME",
+        help=f"reduction (theta* joint): one of {', '.join(sorted(REDUCTIONS))}; default: the robot's own",
+    )
+    p.add_argument("--no-limits", action="store_true", help="keep solutions outside the joint limits (flagged)")
+    p.add_argument("--rad", action="store_true", help="angles in and out in radians instead of degrees")
+
+
+def add_solve_parser(sub: _SubParsers) -> None:
+    p = _subparser(
+        sub,
+        "solve",
+        help="inverse kinematics: every solution of a pose",
+        description=(
+            "Print every IK solution of a pose given as --xyz X Y Z --zyz A B G (Z-Y-Z Euler angles in "
+            "degrees), as --matrix with 16 numbers (row-major 4x4), or of many poses in --poses FILE "
+            f"(CSV, NPY or JSON). ROBOT is a bundled robot or a robot file (default: {DEFAULT_ROBOT})."
+        ),
+    )
+    p.add_argument("robot", nargs="?", default=DEFAULT_ROBOT, help=f"robot name or file (default: {DEFAULT_ROBOT})")
+    p.add_argument("--xyz", nargs=3, metavar=("X", "Y", "Z"), help="position, robot's length unit")
+    p.add_argument("--zyz", nargs=3, metavar=("A", "B", "G"), help="Z-Y-Z Euler angles, degrees (default 0 0 0)")
+    p.add_argument("--matrix", nargs=16, metavar="M", help="the pose as 16 numbers, row-major")
+    p.add_argument("--poses", metavar="FILE", help="many poses: CSV, NPY or JSON (see docs/cli.md)")
+    p.add_argument("--nearest", nargs="+", metavar="Q", help="also report the solution nearest this configuration")
+    _add_ik_options(p)
+    _add_json(p, ": per pose, solutions q (radians / length unit), errors, families")
+    _add_precision(p)
+
+
+def _poses_from_args(args: argparse.Namespace) -> Array:
+    given = [x for x in ("xyz", "matrix", "poses") if getattr(args, x) is not None]
+    if len(given) != 1:
+        raise CliInputError("give exactly one of --xyz (with --zyz), --matrix or --poses")
+    if args.poses is not None:
+        from .trajectory import load_poses
+
+        return load_poses(args.poses)
+    if args.matrix is not None:
+        return _parse_numbers(args.matrix, [f"matrix[{i // 4},{i % 4}]" for i in range(16)]).reshape(1, 4, 4)
+    xyz = _parse_numbers(args.xyz, ["x", "y", "z"])
+    zyz = _parse_numbers(args.zyz or ["0", "0", "0"], ["alpha", "beta", "gamma"])
+    return pose_from_xyz_zyz(xyz, zyz if args.rad else np.radians(zyz))[None]
+
+
+def _display(robot: Robot, q: Array, rad: bool) -> Array:
+    return q if rad else np.where(robot.is_revolute, np.degrees(q), q)
+
+
+def _solution_json(robot: Robot, sol: Solutions, nearest: Array | None) -> dict[str, Any]:
+    out: dict[str, Any] = {
+        "q": sol.q.tolist(),
+        "error_J": sol.error.tolist(),
+        "error_geodesic": sol.error_geodesic.tolist(),
+        "within_limits": sol.within_limits.tolist(),
+        "families": [
+            {"free_joint": robot.joint_names[f.free_joint], "interval": list(f.interval)} for f in sol.families
+        ],
+        "reason": sol.reason,
+    }
+    if nearest is not None and sol:
+        out["nearest"] = sol.nearest(nearest).tolist()
+    return out
+
+
+def cmd_solve(args: argparse.Namespace) -> int:
+    robot = load_robot(args.robot)
+    poses = _poses_from_args(args)
+    nearest = None if args.nearest is None else _config_from_cli(robot, args.nearest, args.rad)
+    sols = solve_many(robot, poses, reduction=args.reduction, strategy=args.strategy, limits=not args.no_limits)
+    if args.json:
+        _print_json(
+            {
+                "robot": robot.name,
+                "joint_names": robot.joint_names,
+                "units": "radians and " + robot.length_unit,
+                "strategy": args.strategy,
+                "poses": [_solution_json(robot, s, nearest) for s in sols],
+            }
+        )
+        return 0
+    dec = args.precision
+    units = _joint_units(robot, args.rad)
+    header = ["#", *(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True)), f"J [{robot.length_unit}]"]
+    if args.no_limits:
+        header.append("in limits")
+    for k, sol in enumerate(sols):
+        if len(sols) > 1:
+            print(f"pose {k + 1}:")
+        if not sol:
+            print(f"  no solution: {sol.reason}")
+            continue
+        rows = []
+        for i, (q, e, ok) in enumerate(zip(sol.q, sol.error, sol.within_limits, strict=True)):
+            row = [str(i + 1), *(f"{v:.{dec}f}" for v in _display(robot, q, args.rad)), f"{e:.2e}"]
+            if args.no_limits:
+                row.append("yes" if ok else "no")
+            rows.append(row)
+        print(f"  {len(sol)} solution(s) ({args.strategy} strategy):")
+        if rows:
+            print(_format_table(header, rows, indent="  "))
+        for f in sol.families:
+            name = robot.joint_names[f.free_joint]
+            lo, hi = _display(robot, np.array(f.interval), args.rad) if robot.is_revolute[f.free_joint] else f.interval
+            print(f"  self-motion family: every {name} in [{lo:.{dec}f}, {hi:.{dec}f}] gives a solution")
+        if nearest is not None:
+            qn = sol.nearest(nearest)
+            print("  nearest: " + "  ".join(f"{v:.{dec}f}" for v in _display(robot, qn, args.rad)))
+    return 0
