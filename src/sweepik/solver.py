@@ -101,24 +101,38 @@ def _families(
     robot: Robot, red: Reduction, chain: Array, spans: list[FamilySpan], limits: bool
 ) -> dict[int, list[Family]]:
     """Family objects per pose: each span cut to the sub-intervals whose members are certified by FK
-    (and, with limits, inside the limits)."""
+    (and, with limits, inside the limits). All spans are sampled in one vectorised pass."""
     out: dict[int, list[Family]] = {}
+    if not spans:
+        return out
     weight = orientation_weight(robot.length_unit)
-    inv_base = np.linalg.inv(robot.T_world_base)
-    for sp in spans:
-        grid = np.linspace(sp.lo, sp.hi, 257)
-        q = red.solve_rest(chain[sp.pose][None], grid[None], np.full((1, grid.size), sp.branch))[0]
-        ok = np.all(np.isfinite(q), axis=-1)
-        T = inv_base @ kinematics.chain_frames(robot, np.nan_to_num(q))[:, -1]
-        ok &= pose_error_geodesic(T, chain[sp.pose], weight) <= ACCEPT_TOL_REL * robot.length_scale
-        if limits:
-            ok &= robot.within_limits(np.nan_to_num(q))
-        edges = np.diff(np.concatenate([[0], ok.astype(np.int8), [0]]))
-        for s, e in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0], strict=True):
+    pose = np.array([sp.pose for sp in spans])
+    branch = np.array([sp.branch for sp in spans])
+    u = np.linspace(0.0, 1.0, _FAMILY_SAMPLES)
+    grid = np.array([sp.lo for sp in spans])[:, None] + np.array([sp.hi - sp.lo for sp in spans])[:, None] * u
+    q = red.solve_rest(chain[pose], grid, np.broadcast_to(branch[:, None], grid.shape))
+    ok = np.all(np.isfinite(q), axis=-1)
+    qz = np.nan_to_num(q)
+    T = np.linalg.inv(robot.T_world_base) @ kinematics.chain_frames(robot, qz)[..., -1, :, :]
+    ok &= pose_error_geodesic(T, chain[pose][:, None], weight) <= ACCEPT_TOL_REL * robot.length_scale
+    if limits:
+        ok &= robot.within_limits(qz)
+    edges = np.diff(
+        np.concatenate(
+            [np.zeros((len(spans), 1), np.int8), ok.astype(np.int8), np.zeros((len(spans), 1), np.int8)], axis=1
+        ),
+        axis=1,
+    )
+    for k, sp in enumerate(spans):
+        for s, e in zip(np.nonzero(edges[k] == 1)[0], np.nonzero(edges[k] == -1)[0], strict=True):
             if e - 1 > s:
-                fam = Family(red.free_joint, (float(grid[s]), float(grid[e - 1])), red, chain[sp.pose], sp.branch)
+                fam = Family(red.free_joint, (float(grid[k, s]), float(grid[k, e - 1])), red, chain[sp.pose], sp.branch)
                 out.setdefault(sp.pose, []).append(fam)
     return out
+
+
+#: Samples along a family span to certify its members and cut it to the joint limits.
+_FAMILY_SAMPLES = 65
 
 
 def _solve_chunk(

@@ -47,8 +47,9 @@ _U_EDGE = 0.5 * (1.0 - np.cos(np.pi * _U_UNIFORM))
 FAMILY_TOL = 1e-10
 #: Roots of one branch joined by a stretch where the residual stays at rounding noise form a cluster; a
 #: cluster longer than this fraction of the theta* range is reported as a family (a numerical continuum:
-#: every point of it solves the pose to rounding precision), a shorter one as its midpoint.
-CLUSTER_FAMILY_REL = 1e-9
+#: every point of it solves the pose to rounding precision), a shorter one as its midpoint. A double root
+#: (f ~ c x^2) is flat at noise level over ~2 sqrt(1e-16 / c), about 1e-8 of the range: far shorter.
+CLUSTER_FAMILY_REL = 1e-6
 #: Minimum number of consecutive vanishing samples that make a family.
 FAMILY_MIN_RUN = 3
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
