@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -148,7 +149,7 @@ class Robot:
         """Joint limits ``(n, 2)``: radians for revolute joints, length unit for prismatic ones."""
         return np.stack([self.lower, self.upper], axis=-1)
 
-    @property
+    @cached_property
     def length_scale(self) -> float:
         """A characteristic length of the arm (sum of |a|, |d| and prismatic ranges), for relative tolerances."""
         span = np.where(self.is_revolute, 0.0, self.upper - self.lower)

@@ -11,7 +11,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import kinematics
+from . import fastsweep, kinematics
 from ._validate import check_poses
 from .errors import ShapeError, UnknownOptionError
 from .paper_sweep import paper_candidates
@@ -143,7 +143,10 @@ def _solve_chunk(
     weight = orientation_weight(robot.length_unit)
     spans: list[FamilySpan] = []
     if strategy == "precise":
-        cand, spans = find_candidates(red, chain, lo, hi, n_samples)
+        if red.kernel_id is not None and fastsweep.AVAILABLE:
+            cand, spans = fastsweep.search(red, chain, lo, hi, n_samples)
+        else:
+            cand, spans = find_candidates(red, chain, lo, hi, n_samples)
         q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         pose_idx = cand.pose
         special = red.special_solutions(chain)
@@ -267,6 +270,18 @@ def solve_many(
     P = check_poses(poses, "poses")
     if P.ndim != 3:
         raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
+    return _solve_checked(robot, P, reduction, strategy, limits, n_samples, chunk_size)
+
+
+def _solve_checked(
+    robot: Robot,
+    P: Array,
+    reduction: str | Reduction | None,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    chunk_size: int = CHUNK,
+) -> list[Solutions]:
     if n_samples < 8:
         raise ShapeError(f"n_samples must be at least 8, got {n_samples}")
     red = get_reduction(robot, reduction)
@@ -311,4 +326,5 @@ def solve(
     P = check_poses(pose, "pose")
     if P.shape != (4, 4):
         raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
-    return solve_many(robot, P[None], reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples)[0]
+    _check_strategy(strategy)
+    return _solve_checked(robot, P[None], reduction, strategy, limits, n_samples)[0]

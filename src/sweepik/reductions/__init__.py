@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import lru_cache
 
 from ..errors import UnknownOptionError
 from ..robot import Robot
@@ -36,4 +37,10 @@ def get_reduction(robot: Robot, reduction: str | Reduction | None) -> Reduction:
         raise UnknownOptionError(
             f"unknown reduction {reduction!r}; choose one of {sorted(REDUCTIONS) + sorted(_ALIASES)}"
         )
+    return _cached(robot, name)
+
+
+@lru_cache(maxsize=64)
+def _cached(robot: Robot, name: str) -> Reduction:
+    # Robots are immutable and hash by identity: one reduction instance per (robot, name).
     return REDUCTIONS[name](robot)

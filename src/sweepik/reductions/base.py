@@ -49,6 +49,12 @@ class Reduction(ABC):
     #: Rounding noise of ``residual`` (absolute). A residual extremum that dips below zero by less than this
     #: is treated as one double root. 1e-14 suits residuals built from O(1) sines, cosines and unit vectors.
     residual_noise: float = 1e-14
+    #: Id of a compiled scalar residual in ``reductions.kernels`` (None: the NumPy engine is used).
+    kernel_id: int | None = None
+
+    def kernel_params(self, poses: Array) -> Array:
+        """Per-pose parameters ``(N, P)`` of the compiled residual kernel (only with ``kernel_id``)."""
+        raise NotImplementedError
 
     def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:
         self.robot = robot

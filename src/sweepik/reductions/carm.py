@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import RobotDefinitionError
 from ..robot import Robot
+from . import kernels
 from .base import Array, IntArray, Reduction
 
 #: Relative tolerance on the structure check of a robot against the C-Arm's DH table.
@@ -62,6 +63,15 @@ class _CArmBase(Reduction):
     def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:
         super().__init__(robot, free_joint, n_branches)
         self.L1, self.L2 = carm_lengths(robot)
+
+    def kernel_params(self, poses: Array) -> Array:
+        """``(N, 8)``: Px, Py, Pz, zx, zy, zz, L1, L2 for the compiled residual (reductions/kernels.py)."""
+        N = poses.shape[0]
+        out = np.empty((N, 8))
+        out[:, 0:3] = poses[:, :3, 3]
+        out[:, 3:6] = poses[:, :3, 2]
+        out[:, 6], out[:, 7] = self.L1, self.L2
+        return out
 
     # --- shared closed form ----------------------------------------------------------------------
     def _elbow(self, u: Array, Py: Array, eps: Array) -> tuple[Array, Array]:
@@ -120,6 +130,7 @@ class CArmD1(_CArmBase):
     """
 
     name = "carm-d1"
+    kernel_id = kernels.CARM_D1
     blind_spots = "d1 = Pz with Px = 0 (wrist on joint 2's axis): solved separately as a special slice"
 
     def __init__(self, robot: Robot) -> None:
@@ -176,11 +187,13 @@ class CArmD1(_CArmBase):
         Pz = poses[:, 2, 3]
         return np.stack([Pz - L, Pz + L], axis=-1)
 
-    def special_solutions(self, poses: Array) -> Array:
+    def special_solutions(self, poses: Array) -> Array | None:
         """Wrist on joint 2's axis (Px = 0, d1 = Pz): u = 0, theta34 from the elbow, theta2 from the
         orientation (``A cos theta2 + B sin theta2 = c``). 4 candidates per pose (NaN where none)."""
         Px, Py, Pz, z, R = _unpack(poses, 0)
         sel = np.abs(Px) <= 1e-9 * (self.L1 + self.L2)
+        if not sel.any():
+            return None
         out = []
         for eps in (1.0, -1.0):
             c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))
@@ -209,6 +222,7 @@ class CArmTheta2(_CArmBase):
     """
 
     name = "carm-theta2"
+    kernel_id = kernels.CARM_THETA2
     blind_spots = "cos(theta2) = 0 (d1 drops out): solved separately as a special slice; families need carm-d1"
 
     def __init__(self, robot: Robot) -> None:
@@ -256,7 +270,7 @@ class CArmTheta2(_CArmBase):
             cols += [a, -a, np.pi - a, a - np.pi]
         return np.stack(cols, axis=-1)
 
-    def special_solutions(self, poses: Array) -> Array:
+    def special_solutions(self, poses: Array) -> Array | None:
         """Solutions near the blind spot cos(theta2) = 0, found with the d1 reduction.
 
         Near theta2 = +-90 deg, d1 = Pz - Px tan(theta2) races through its range within a window of width
@@ -268,9 +282,8 @@ class CArmTheta2(_CArmBase):
 
         Px = poses[:, 0, 3]
         idx = np.nonzero(np.abs(Px) <= BLIND_PX_REL * (self.L1 + self.L2))[0]
-        out = np.full((poses.shape[0], 8, 6), np.nan)
         if idx.size == 0:
-            return out
+            return None
         d1red = CArmD1(self.robot)
         rng = d1red.search_range(poses[idx])
         cand, _ = find_candidates(d1red, poses[idx], rng[:, 0], rng[:, 1])
@@ -278,7 +291,7 @@ class CArmTheta2(_CArmBase):
         keep = np.all(np.isfinite(q), axis=-1) & (np.abs(np.cos(q[:, 1])) <= BLIND_COS)
         pose, q = cand.pose[keep], q[keep]
         if pose.size == 0:
-            return out
+            return None
         counts = np.bincount(pose, minlength=idx.size)
         width = max(8, int(counts.max()))
         out = np.full((poses.shape[0], width, 6), np.nan)

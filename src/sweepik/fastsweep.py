@@ -1,0 +1,413 @@
+"""Compiled (Numba) version of the precise sweep's candidate search, for reductions that supply a scalar
+residual kernel. Same algorithm and constants as :mod:`sweepik.sweep` (the reference, used for every other
+reduction): per pose and branch, sample theta*, bracket sign changes (Chandrupatla), locate extrema, keep
+domain-edge samples, resample bending or edge-adjacent intervals recursively, detect families and merge
+noise-level clusters. Poses run in parallel threads (``prange``).
+
+Why: the NumPy engine spends most of its time in Python-level bookkeeping of small arrays; per pose the
+search is a few hundred scalar residual evaluations, which compiled code does in microseconds.
+
+A kernel is ``residual(params, theta, branch) -> float`` compiled with ``numba.njit``, where ``params`` is
+one row of ``Reduction.kernel_params(poses)``. The kernel is selected by ``Reduction.kernel_id``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import sweep as _ref
+from .reductions.kernels import residual_by_id
+
+try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
+    from numba import njit, prange
+
+    AVAILABLE = True
+except ImportError:  # pragma: no cover - exercised only without numba
+    AVAILABLE = False
+
+Array = NDArray[np.float64]
+
+FAMILY_TOL = _ref.FAMILY_TOL
+FAMILY_MIN_RUN = _ref.FAMILY_MIN_RUN
+SUB = _ref.SUB_SAMPLES
+MAX_LEVELS = _ref.MAX_LEVELS
+BEND = _ref.BEND
+XTOL_REL = _ref.XTOL_REL
+DIFF_STEP_REL = _ref.DIFF_STEP_REL
+CLUSTER_FAMILY_REL = _ref.CLUSTER_FAMILY_REL
+#: Candidates and family spans kept per pose (the C-Arm has at most 8 solutions; edges and near misses add
+#: candidates). Overflow is reported and the pose is redone by the NumPy engine.
+MAX_CAND = 256
+MAX_FAM = 16
+#: Pending resampled intervals per pose and branch (depth-first, so a few dozen suffice).
+STACK = 512
+#: Batches at least this large are searched with parallel threads.
+PARALLEL_MIN = 64
+_U_UNIFORM = _ref._U_UNIFORM
+_U_EDGE = _ref._U_EDGE
+
+if AVAILABLE:
+
+    @njit(cache=True)
+    def _res(kid, p, x, b):
+        return residual_by_id(kid, p, x, b)
+
+    @njit(cache=True)
+    def _root(kid, p, b, a, c, fa, fc, xtol):
+        """Chandrupatla's bracketed root finder (scalar), as rootfind.find_roots."""
+        eps = 2.220446049250313e-16
+        x = a if abs(fa) < abs(fc) else c
+        if fa == 0.0:
+            return a
+        if fc == 0.0:
+            return c
+        bb, fb = c, fc
+        cc, fcc = a, fa
+        t = 0.5
+        for _ in range(100):
+            xt = a + t * (bb - a)
+            ft = _res(kid, p, xt, b)
+            if math.isnan(ft):
+                return x
+            if (ft > 0) == (fa > 0):
+                cc, fcc = a, fa
+            else:
+                cc, fcc = bb, fb
+                bb, fb = a, fa
+            a, fa = xt, ft
+            if abs(fa) < abs(fb):
+                xm, fm = a, fa
+            else:
+                xm, fm = bb, fb
+            x = xm
+            tol = 2.0 * eps * abs(xm) + 0.5 * xtol
+            width = abs(bb - cc)
+            if fm == 0.0 or width == 0.0:
+                return x
+            tlim = tol / width
+            if tlim > 0.5:
+                return x
+            xi = (a - bb) / (cc - bb) if cc != bb else 0.0
+            denom1 = fcc - fb
+            phi = (fa - fb) / denom1 if denom1 != 0.0 else 0.0
+            t = 0.5
+            if phi * phi < xi and (1.0 - phi) ** 2 < 1.0 - xi and fb != fa and fb != fcc and fcc != fa:
+                t = fa / (fb - fa) * fcc / (fb - fcc) + (cc - a) / (bb - a) * fa / (fcc - fa) * fb / (fcc - fb)
+            if t != t:
+                t = 0.5
+            t = min(max(t, tlim), 1.0 - tlim)
+        return x
+
+    @njit(cache=True)
+    def _push(out_t, out_b, cnt, x, b):
+        if cnt[0] < out_t.shape[0]:
+            out_t[cnt[0]] = x
+            out_b[cnt[0]] = b
+        cnt[0] += 1
+
+    @njit(cache=True)
+    def _extremum(kid, p, b, ta, tc, tb, fa, fc, fb, span, noise, xtol, out_t, out_b, cnt):
+        h = DIFF_STEP_REL * span
+        a, c = ta + h, tb - h
+        xe = tc
+        if a < c:
+            ga = _res(kid, p, a + h, b) - _res(kid, p, a - h, b)
+            gc = _res(kid, p, c + h, b) - _res(kid, p, c - h, b)
+            if ga * gc < 0:
+                # root of the central difference g(x) = f(x + h) - f(x - h), bisection-safe Chandrupatla
+                xe = _root_diff(kid, p, b, a, c, ga, gc, h)
+        fx = _res(kid, p, xe, b)
+        if math.isnan(fx):
+            return
+        s = 1.0 if fc > 0 else -1.0
+        if s * fx < -noise:
+            _push(out_t, out_b, cnt, _root(kid, p, b, ta, xe, fa, fx, xtol), b)
+            _push(out_t, out_b, cnt, _root(kid, p, b, xe, tb, fx, fb, xtol), b)
+        else:
+            _push(out_t, out_b, cnt, xe, b)
+
+    @njit(cache=True)
+    def _g(kid, p, x, b, h):
+        return _res(kid, p, x + h, b) - _res(kid, p, x - h, b)
+
+    @njit(cache=True)
+    def _root_diff(kid, p, b, a, c, ga, gc, h):
+        """Root of the central difference between a and c (Illinois-safeguarded bisection)."""
+        xtol = 1e-3 * h
+        fa, fc = ga, gc
+        side = 0
+        x = 0.5 * (a + c)
+        for _ in range(100):
+            if c - a <= xtol:
+                break
+            x = (a * fc - c * fa) / (fc - fa) if fc != fa else 0.5 * (a + c)
+            if not (a < x < c):
+                x = 0.5 * (a + c)
+            fx = _g(kid, p, x, b, h)
+            if fx != fx:
+                break
+            if fx == 0.0:
+                return x
+            if (fx > 0) == (fa > 0):
+                a, fa = x, fx
+                if side == -1:
+                    fc *= 0.5
+                side = -1
+            else:
+                c, fc = x, fx
+                if side == 1:
+                    fa *= 0.5
+                side = 1
+        return x
+
+    @njit(cache=True)
+    def _scan(kid, p, b, th, f, level, el, er, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, top):
+        """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
+        hold recursive functions)."""
+        M = th.shape[0]
+        valid = np.empty(M, dtype=np.bool_)
+        for j in range(M):
+            valid[j] = not math.isnan(f[j])
+        for j in range(M):  # exact zeros
+            if valid[j] and f[j] == 0.0:
+                _push(out_t, out_b, cnt, th[j], b)
+        for j in range(1, M - 1):  # interior extrema of |f| without a sign change
+            if valid[j - 1] and valid[j] and valid[j + 1] and th[j + 1] > th[j - 1]:
+                fm, fc, fp = f[j - 1], f[j], f[j + 1]
+                if abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0:
+                    _extremum(kid, p, b, th[j - 1], th[j], th[j + 1], fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
+        for j in range(M):  # samples next to a domain edge (or at the range ends, level 0)
+            if not valid[j]:
+                continue
+            lo_open = (j == 0 and level == 0) or (j > 0 and not valid[j - 1])
+            hi_open = (j == M - 1 and level == 0) or (j < M - 1 and not valid[j + 1])
+            nr = abs(f[j + 1]) if (j < M - 1 and valid[j + 1]) else np.inf
+            nl = abs(f[j - 1]) if (j > 0 and valid[j - 1]) else np.inf
+            if (lo_open and abs(f[j]) <= nr) or (hi_open and abs(f[j]) <= nl):
+                _push(out_t, out_b, cnt, th[j], b)
+        # second divided differences
+        dd = np.full(M, np.nan)
+        for j in range(1, M - 1):
+            if valid[j - 1] and valid[j] and valid[j + 1]:
+                hl = th[j] - th[j - 1]
+                hr = th[j + 1] - th[j]
+                if hl > 0 and hr > 0:
+                    dd[j] = 2.0 * ((f[j + 1] - f[j]) / hr - (f[j] - f[j - 1]) / hl) / (hl + hr)
+        for j in range(M - 1):
+            if not (valid[j] and valid[j + 1] and th[j + 1] > th[j]):
+                continue
+            prod = f[j] * f[j + 1]
+            refine = False
+            open_l = el if j == 0 else not valid[j - 1]
+            open_r = er if j + 1 == M - 1 else not valid[j + 2]
+            near_edge = open_l or open_r
+            if level < MAX_LEVELS and abs(f[j]) + abs(f[j + 1]) > 0:
+                c1, c2 = dd[j], dd[j + 1]
+                curv = np.nan
+                if not math.isnan(c1):
+                    curv = abs(c1)
+                if not math.isnan(c2) and (math.isnan(curv) or abs(c2) > curv):
+                    curv = abs(c2)
+                h = th[j + 1] - th[j]
+                lowest = min(abs(f[j]), abs(f[j + 1]))
+                bend = (not math.isnan(curv)) and lowest <= BEND * curv * h * h
+                refine = bend or near_edge
+            if refine:
+                if top[0] >= stk_t.shape[0]:
+                    cnt[0] += out_t.shape[0] + 1  # overflow: the caller redoes this pose with NumPy
+                    continue
+                us = _U_EDGE_ARR if near_edge else _U_UNIFORM_ARR
+                k0 = top[0]
+                for k in range(SUB + 2):
+                    stk_t[k0, k] = th[j] + (th[j + 1] - th[j]) * us[k]
+                stk_f[k0, 0] = f[j]
+                stk_f[k0, SUB + 1] = f[j + 1]
+                for k in range(1, SUB + 1):
+                    stk_f[k0, k] = _res(kid, p, stk_t[k0, k], b)
+                stk_i[k0, 0] = level + 1
+                stk_i[k0, 1] = 1 if open_l else 0
+                stk_i[k0, 2] = 1 if open_r else 0
+                top[0] += 1
+            elif prod < 0:
+                _push(out_t, out_b, cnt, _root(kid, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
+
+    _U_UNIFORM_ARR = _U_UNIFORM.copy()
+    _U_EDGE_ARR = _U_EDGE.copy()
+
+    @njit(cache=True)
+    def _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt, i):
+        M = grid.shape[1]
+        if True:
+            p = params[i]
+            th = grid[i]
+            xtol = XTOL_REL * span[i]
+            c = np.zeros(1, dtype=np.int64)
+            stk_t = np.empty((STACK, SUB + 2))
+            stk_f = np.empty((STACK, SUB + 2))
+            stk_i = np.empty((STACK, 3), dtype=np.int64)
+            for b in range(n_branches):
+                f = np.empty(M)
+                for j in range(M):
+                    f[j] = _res(kid, p, th[j], b)
+                # families: runs of vanishing samples
+                j = 0
+                while j < M:
+                    if not math.isnan(f[j]) and abs(f[j]) <= FAMILY_TOL:
+                        k = j
+                        while k + 1 < M and not math.isnan(f[k + 1]) and abs(f[k + 1]) <= FAMILY_TOL:
+                            k += 1
+                        if k - j + 1 >= FAMILY_MIN_RUN and th[k] > th[j]:
+                            if fcnt[i] < fam.shape[1]:
+                                fam[i, fcnt[i], 0] = th[j]
+                                fam[i, fcnt[i], 1] = th[k]
+                                fam[i, fcnt[i], 2] = b
+                            fcnt[i] += 1
+                            for m in range(j, k + 1):
+                                f[m] = np.nan
+                        j = k + 1
+                    else:
+                        j += 1
+                top = np.zeros(1, dtype=np.int64)
+                _scan(
+                    kid,
+                    p,
+                    b,
+                    th,
+                    f,
+                    0,
+                    False,
+                    False,
+                    span[i],
+                    noise,
+                    xtol,
+                    out_t[i],
+                    out_b[i],
+                    c,
+                    stk_t,
+                    stk_f,
+                    stk_i,
+                    top,
+                )
+                while top[0] > 0:
+                    top[0] -= 1
+                    k0 = top[0]
+                    sub_t = stk_t[k0].copy()
+                    sub_f = stk_f[k0].copy()
+                    _scan(
+                        kid,
+                        p,
+                        b,
+                        sub_t,
+                        sub_f,
+                        stk_i[k0, 0],
+                        stk_i[k0, 1] == 1,
+                        stk_i[k0, 2] == 1,
+                        span[i],
+                        noise,
+                        xtol,
+                        out_t[i],
+                        out_b[i],
+                        c,
+                        stk_t,
+                        stk_f,
+                        stk_i,
+                        top,
+                    )
+            cnt[i] = c[0]
+            # merge noise-level clusters per branch (candidates sorted by branch, then theta)
+            n = min(c[0], out_t.shape[1])
+            if n > 1:
+                order = np.argsort(out_t[i, :n])
+                ts = out_t[i, :n][order]
+                bs = out_b[i, :n][order]
+                order2 = np.argsort(bs, kind="mergesort")  # stable: by branch, then theta
+                ts = ts[order2]
+                bs = bs[order2]
+                w = 0
+                s = 0
+                while s < n:
+                    e = s
+                    while (
+                        e + 1 < n
+                        and bs[e + 1] == bs[s]
+                        and (ts[e + 1] == ts[e] or abs(_res(kid, p, 0.5 * (ts[e] + ts[e + 1]), bs[s])) <= noise)
+                    ):
+                        e += 1
+                    lo, hi = ts[s], ts[e]
+                    if hi - lo > CLUSTER_FAMILY_REL * span[i]:
+                        if fcnt[i] < fam.shape[1]:
+                            fam[i, fcnt[i], 0] = lo
+                            fam[i, fcnt[i], 1] = hi
+                            fam[i, fcnt[i], 2] = bs[s]
+                        fcnt[i] += 1
+                    else:
+                        out_t[i, w] = 0.5 * (lo + hi)
+                        out_b[i, w] = bs[s]
+                        w += 1
+                    s = e + 1
+                cnt[i] = w if c[0] <= out_t.shape[1] else c[0]
+
+    @njit(cache=True, parallel=True)
+    def _search_parallel(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt):
+        for i in prange(grid.shape[0]):
+            _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt, i)
+
+    @njit(cache=True)
+    def _search_serial(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt):
+        for i in range(grid.shape[0]):
+            _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt, i)
+
+
+def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int):
+    """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
+    Poses whose candidate or family buffers overflow are redone by the NumPy engine."""
+    theta = _ref.sample_grid(reduction, poses, lo, hi, n_samples)
+    params = np.ascontiguousarray(reduction.kernel_params(poses), dtype=np.float64)
+    N = poses.shape[0]
+    out_t = np.empty((N, MAX_CAND))
+    out_b = np.empty((N, MAX_CAND), dtype=np.int64)
+    cnt = np.zeros(N, dtype=np.int64)
+    fam = np.empty((N, MAX_FAM, 3))
+    fcnt = np.zeros(N, dtype=np.int64)
+    span = (hi - lo).astype(np.float64)
+    # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
+    run = _search_parallel if N >= PARALLEL_MIN else _search_serial
+    run(
+        reduction.kernel_id,
+        params,
+        np.ascontiguousarray(theta),
+        reduction.n_branches,
+        span,
+        float(reduction.residual_noise),
+        out_t,
+        out_b,
+        cnt,
+        fam,
+        fcnt,
+    )
+    over = (cnt > MAX_CAND) | (fcnt > MAX_FAM)
+    ok = ~over
+    take = np.arange(MAX_CAND)[None, :] < np.minimum(cnt, MAX_CAND)[:, None]
+    take &= ok[:, None]
+    pose_idx, slot = np.nonzero(take)
+    cand_p, cand_b, cand_t = [pose_idx], [out_b[pose_idx, slot]], [out_t[pose_idx, slot]]
+    spans: list[_ref.FamilySpan] = []
+    fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(fcnt, MAX_FAM)[:, None]) & ok[:, None])
+    for i, k in zip(fp, fs, strict=True):
+        spans.append(_ref.FamilySpan(int(i), int(fam[i, k, 2]), float(fam[i, k, 0]), float(fam[i, k, 1])))
+    if over.any():
+        idx = np.nonzero(over)[0]
+        c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples)
+        cand_p.append(idx[c2.pose])
+        cand_b.append(c2.branch)
+        cand_t.append(c2.theta)
+        spans += [_ref.FamilySpan(int(idx[s.pose]), s.branch, s.lo, s.hi) for s in s2]
+    cand = _ref.Candidates(
+        pose=np.concatenate(cand_p).astype(np.intp),
+        branch=np.concatenate(cand_b).astype(np.intp),
+        theta=np.concatenate(cand_t),
+    )
+    return cand, spans

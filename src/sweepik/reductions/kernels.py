@@ -1,0 +1,74 @@
+"""Scalar residual kernels of the bundled reductions, compiled with Numba for :mod:`sweepik.fastsweep`.
+
+Each kernel computes exactly what the reduction's vectorised ``residual`` computes, for one pose (its
+``kernel_params`` row), one theta* and one branch. ``residual_by_id`` dispatches on ``Reduction.kernel_id``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+_njit: Any
+try:
+    from numba import njit as _njit
+except ImportError:  # pragma: no cover - without numba the NumPy engine is used
+    _njit = None
+
+#: Same as carm.DISC_TOL (kept here so that this module has no import cycle with carm.py).
+DISC_TOL = 1e-12
+
+#: Kernel ids (Reduction.kernel_id).
+CARM_D1 = 0
+CARM_THETA2 = 1
+
+
+def _elbow_residual(
+    c2: float, s2: float, u: float, Py: float, zx: float, zy: float, zz: float, eps: float, L1: float, L2: float
+) -> float:
+    rho2 = u * u + Py * Py
+    k = (rho2 + L2 * L2 - L1 * L1) / (2.0 * L2)
+    disc = rho2 - k * k
+    if disc < -DISC_TOL * (L1 + L2) ** 2:
+        return math.nan
+    s = eps * math.sqrt(max(disc, 0.0))
+    c34 = (k * u - s * Py) / rho2
+    s34 = (k * Py + s * u) / rho2
+    return c34 * (c2 * zx + s2 * zz) + s34 * zy
+
+
+def _carm_d1(p, d1: float, b: int) -> float:
+    Px, Py, Pz, zx, zy, zz, L1, L2 = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    sigma = 1.0 if b < 2 else -1.0
+    eps = 1.0 if b % 2 == 0 else -1.0
+    t = Pz - d1
+    r = math.hypot(Px, t)
+    if r > 0.0:
+        c2, s2 = sigma * Px / r, sigma * t / r
+    else:
+        c2, s2 = sigma, 0.0
+    return _elbow_residual(c2, s2, sigma * r, Py, zx, zy, zz, eps, L1, L2)
+
+
+def _carm_theta2(p, th2: float, b: int) -> float:
+    Px, Py, zx, zy, zz, L1, L2 = p[0], p[1], p[3], p[4], p[5], p[6], p[7]
+    eps = 1.0 if b == 0 else -1.0
+    c2, s2 = math.cos(th2), math.sin(th2)
+    if abs(c2) <= 1e-300:
+        return math.nan
+    return _elbow_residual(c2, s2, Px / c2, Py, zx, zy, zz, eps, L1, L2)
+
+
+def _dispatch(kid: int, p, x: float, b: int) -> float:
+    if kid == CARM_D1:
+        return _carm_d1(p, x, b)
+    return _carm_theta2(p, x, b)
+
+
+if _njit is not None:
+    _elbow_residual = _njit(cache=True)(_elbow_residual)
+    _carm_d1 = _njit(cache=True)(_carm_d1)
+    _carm_theta2 = _njit(cache=True)(_carm_theta2)
+    residual_by_id = _njit(cache=True)(_dispatch)
+else:  # pragma: no cover
+    residual_by_id = _dispatch
