@@ -411,3 +411,51 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int):
         theta=np.concatenate(cand_t),
     )
     return cand, spans
+
+
+if AVAILABLE:
+
+    @njit(cache=True, parallel=True)
+    def _fk_modified(a, alpha, d, theta, rev, base, q, out):
+        """Flange poses (K, 4, 4) of a modified-DH chain (world frame, tool not applied)."""
+        n = a.shape[0]
+        for k in prange(q.shape[0]):
+            T = base.copy()
+            for i in range(n):
+                th = theta[i] + (q[k, i] if rev[i] else 0.0)
+                di = d[i] + (0.0 if rev[i] else q[k, i])
+                ct, st = math.cos(th), math.sin(th)
+                ca, sa = math.cos(alpha[i]), math.sin(alpha[i])
+                # link = [[ct, -st, 0, a], [st ca, ct ca, -sa, -sa d], [st sa, ct sa, ca, ca d], [0, 0, 0, 1]]
+                L = np.empty((3, 4))
+                L[0, 0], L[0, 1], L[0, 2], L[0, 3] = ct, -st, 0.0, a[i]
+                L[1, 0], L[1, 1], L[1, 2], L[1, 3] = st * ca, ct * ca, -sa, -sa * di
+                L[2, 0], L[2, 1], L[2, 2], L[2, 3] = st * sa, ct * sa, ca, ca * di
+                R = np.empty((3, 4))
+                for r in range(3):
+                    for c in range(4):
+                        R[r, c] = T[r, 0] * L[0, c] + T[r, 1] * L[1, c] + T[r, 2] * L[2, c]
+                    R[r, 3] += T[r, 3]
+                T[:3, :] = R
+            out[k] = T
+
+
+def flange_poses(robot, q: Array) -> Array:  # type: ignore[no-untyped-def]
+    """World poses of the last link frame ``(K, 4, 4)`` for configurations ``q (K, n)``: compiled for
+    modified-DH robots when Numba is available, else :func:`sweepik.kinematics.chain_frames`."""
+    from . import kinematics
+
+    if not AVAILABLE or robot.dh_convention != "modified" or q.ndim != 2 or q.shape[0] < 16:
+        return kinematics.chain_frames(robot, q)[..., -1, :, :]
+    out = np.empty((q.shape[0], 4, 4))
+    _fk_modified(
+        robot.dh_a,
+        robot.dh_alpha,
+        robot.dh_d,
+        robot.dh_theta,
+        robot.is_revolute,
+        np.ascontiguousarray(robot.T_world_base),
+        np.ascontiguousarray(q, dtype=np.float64),
+        out,
+    )
+    return out

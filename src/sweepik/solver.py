@@ -11,7 +11,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import fastsweep, kinematics
+from . import fastsweep
 from ._validate import check_poses
 from .errors import ShapeError, UnknownOptionError
 from .paper_sweep import paper_candidates
@@ -82,7 +82,12 @@ def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> N
     order = np.lexsort((*keys.T[::-1], pose_idx))
     ps, qs, es = pose_idx[order], q[order], err[order]
     drop = np.zeros(K, dtype=bool)
+    ks = keys[order, 0]
     for w in range(1, min(_DEDUPE_WINDOW, K - 1) + 1):
+        # sorted by (pose, rounded first joint, ...): once no pair w apart shares pose and first key
+        # (within one rounding step), no pair further apart does
+        if not np.any((ps[w:] == ps[:-w]) & (ks[w:] - ks[:-w] <= 1)):
+            break
         d = qs[w:] - qs[:-w]
         d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
         same = (ps[w:] == ps[:-w]) & np.all(d <= tol, axis=-1)
@@ -113,7 +118,10 @@ def _families(
     q = red.solve_rest(chain[pose], grid, np.broadcast_to(branch[:, None], grid.shape))
     ok = np.all(np.isfinite(q), axis=-1)
     qz = np.nan_to_num(q)
-    T = np.linalg.inv(robot.T_world_base) @ kinematics.chain_frames(robot, qz)[..., -1, :, :]
+    shape = qz.shape
+    T = np.linalg.inv(robot.T_world_base) @ fastsweep.flange_poses(robot, qz.reshape(-1, shape[-1])).reshape(
+        *shape[:-1], 4, 4
+    )
     ok &= pose_error_geodesic(T, chain[pose][:, None], weight) <= ACCEPT_TOL_REL * robot.length_scale
     if limits:
         ok &= robot.within_limits(qz)
@@ -159,7 +167,7 @@ def _solve_chunk(
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
     finite = np.all(np.isfinite(q), axis=-1)
     pose_idx, q = pose_idx[finite], q[finite]
-    T = kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool
+    T = fastsweep.flange_poses(robot, q) @ robot.T_flange_tool
     target = poses[pose_idx]
     err_geo = pose_error_geodesic(T, target, weight)
     if strategy == "precise":
@@ -168,7 +176,7 @@ def _solve_chunk(
         )[0]
         if near.size:
             q[near] = polish(robot, q[near], target[near], weight)
-            T[near] = kinematics.chain_frames(robot, q[near])[:, -1] @ robot.T_flange_tool
+            T[near] = fastsweep.flange_poses(robot, q[near]) @ robot.T_flange_tool
             err_geo[near] = pose_error_geodesic(T[near], target[near], weight)
     err_paper = pose_error_paper(T, target, weight)
     if strategy == "precise":
