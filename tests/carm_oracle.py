@@ -105,12 +105,20 @@ ROT_TOL_RAD = 1e-8
 IMAG_TOL = 1e-3
 #: Leading coefficients of Q below this fraction of the largest are dropped (their roots have |t| >> 1).
 LEAD_TRIM = 1e-13
-#: Polished roots closer than this (scaled t) form a cluster, i.e. a (numerically) multiple root:
-#: ~100x the sqrt(machine eps) scatter that Newton leaves at a double root.
-CLUSTER_TOL = 1e-7
+#: Roots of one branch F_e, polished to rounding level, that lie closer than this (scaled t) are tested
+#: for being one double root (``_Pose.double_root``: F_e touches zero without a sign change). Newton leaves
+#: a double root scattered by ~1e-8; distinct roots inside a cluster are recognised by the sign test.
+CLUSTER_TOL = 1e-5
+#: A polished t counts as a root of F_e when |F_e| <= CONVERGED * (its rounding-noise estimate).
+CONVERGED = 4.0
+#: Polished roots of one branch that agree to this relative precision are one simple root.
+SAME_ROOT_TOL = 1e-12
+#: Raw roots of Q closer than this (scaled t) are tested as one multiple root (a root of multiplicity m
+#: is scattered by ~eps^(1/m): 1e-8 for m = 2, 1e-4 for m = 4).
+RAW_CLUSTER_TOL = 1e-3
 #: Verified solutions closer than this are one solution (d1 in mm, angles in rad modulo 2 pi). Larger than
 #: the scatter of a double root polished by Newton (~1e-8 * 752 mm in d1).
-DEDUP_D1_MM = 1e-4
+DEDUP_D1_MM = 1e-5
 DEDUP_ANGLE = 1e-6
 #: Below this |Px| (scaled) the r = 0 solutions are added as Newton seeds (see module docstring).
 PX_SEED = 1e-3
@@ -126,12 +134,9 @@ NEWTON_ITERS = 40
 #: Newton on F_e never moves farther than this (scaled t) from its start: a raw root of Q is far closer
 #: than that to its true value (a quadruple root is off by ~eps^(1/4) ~ 1e-4).
 NEWTON_MAX_MOVE = 1e-2
-#: F_e is "zero to rounding" below F_NOISE times the size of its terms.
-F_NOISE = 8.0 * np.finfo(float).eps
-#: A derivative root t* is a multiple root of Q if |Q(t*)| <= Q_NOISE * (|T1| + |T2|)(|t*|), where
-#: Q = T1 - T2 and |T| has the absolute values of T's coefficients: a generous multiple of the machine eps
-#: times the size of what cancels in Q.
-Q_NOISE = 1e-13
+#: F_e is "zero to rounding" below F_NOISE times the size of its terms (see ``_Pose.F``); calibrated against
+#: long-double evaluation: the actual error stayed below 0.5 of this bound over 9,600 test evaluations.
+F_NOISE = 2.0 * np.finfo(float).eps
 
 
 def _wrap(x: ArrayLike) -> Array:
@@ -211,7 +216,12 @@ class _Pose:
         B = px * self.zx + t * self.zz
         G = self.w * B + r * r * self.zy
         F = r * k * A - e * h * G
-        noise = F_NOISE * (abs(r * k) * (abs(px) + abs(t) + abs(py)) + h * (abs(self.w) * (abs(px) + abs(t)) + r * r))
+        # Rounding-error bound: A and G from their summands, h from the cancellation in rho^2 - k^2
+        # (absolute error ~eps (rho^2 + k^2), i.e. ~eps (rho^2 + k^2) / (2 h) in h), the products relative.
+        sA = abs(px * self.zx) + abs(t * self.zz) + abs(py * self.zy)
+        sG = abs(self.w) * (abs(px * self.zx) + abs(t * self.zz)) + r * r * abs(self.zy)
+        dh_err = (rho2 + k * k) / (2.0 * h) if h > 0.0 else np.sqrt(rho2 + k * k)
+        noise = F_NOISE * (abs(r * k) * sA + h * sG + abs(G) * dh_err + abs(r * k * A) + abs(h * G))
         if r == 0.0 or h == 0.0:
             return F, np.nan, noise
         dr, dk, dh = t / r, t / l2, t * (1.0 - k / l2) / h
@@ -220,30 +230,34 @@ class _Pose:
         return F, dF, noise
 
     def newton_F(self, t0: float, e: float) -> tuple[float, float]:
-        """Newton on F_e from t0; returns (t, |F_e| / noise level) at convergence or at the best iterate.
+        """Newton on F_e from t0; returns (t, |F_e(t)| / its noise level) at the best iterate.
 
-        Stops as soon as F_e is zero to rounding (so a double root, where F_e' ~ 0, is not left by a huge
-        step) and never moves farther than NEWTON_MAX_MOVE from t0 (near r = 0, F_e is trivially small
-        when Px ~ 0, which must not attract the iteration).
+        Iterates until the step is at rounding level, or until F_e is zero to rounding and the steps
+        stopped shrinking (at a double root, where F_e' ~ 0, further steps would be erratic and large);
+        never moves farther than NEWTON_MAX_MOVE from t0 (near r = 0, F_e is trivially small when
+        Px ~ 0, which must not attract the iteration).
         """
         t = t0
         F, dF, noise = self.F(t, e)
-        best_t, best_ratio = t, abs(F) / max(noise, 1e-300)
+        best_t, best_F, best_noise = t, abs(F), noise
+        prev = np.inf
         for _ in range(NEWTON_ITERS):
-            if abs(F) <= noise or not np.isfinite(dF) or dF == 0.0:
+            if F == 0.0 or not np.isfinite(dF) or dF == 0.0:
                 break
             step = F / dF
+            if abs(F) <= noise and abs(step) > 2.0 * prev:
+                break
             t_new = t - step
             if not np.isfinite(t_new) or abs(t_new - t0) > NEWTON_MAX_MOVE:
                 break
             t = t_new
             F, dF, noise = self.F(t, e)
-            ratio = abs(F) / max(noise, 1e-300)
-            if ratio < best_ratio:
-                best_t, best_ratio = t, ratio
-            if abs(step) <= 1e-16 * (abs(t) + 1e-3):
+            if abs(F) < best_F:
+                best_t, best_F, best_noise = t, abs(F), noise
+            if abs(step) <= 1e-16 * (abs(t) + 1e-3) or (abs(F) <= noise and abs(step) > 0.5 * prev):
                 break
-        return best_t, best_ratio
+            prev = abs(step)
+        return best_t, best_F / max(best_noise, 1e-300)
 
     # ---------------------------------------------------------------- configurations
     def _arm(self, C2: float, S2: float, u: float, eps: float, d1: float) -> Array | None:
@@ -274,20 +288,40 @@ class _Pose:
         th6 = np.arctan2(N[1, 0], N[1, 1])
         return np.array([d1, th2, th3, th4, th5, th6])
 
-    def configs_at(self, t: float) -> tuple[list[Array], bool]:
-        """All branch configurations at scaled t (unverified) and whether a theta2-continuum was met."""
+    def configs_at(self, t: float, e: float | None = None) -> tuple[list[Array], bool]:
+        """Configurations at scaled t (unverified) and whether a theta2-continuum was met.
+
+        With ``e`` only the two branches of F_e, (sigma, eps) = (+1, e) and (-1, -e), are built; at r = 0
+        the theta2 solutions of the r = 0 case are returned whatever ``e``.
+        """
         d1 = self.Pz - t * self.s
         r = float(np.hypot(self.px, t))
         out: list[Array] = []
         if r > R_ZERO:
             for sigma in (1.0, -1.0):
                 C2, S2 = sigma * self.px / r, sigma * t / r
-                for eps in (1.0, -1.0):
+                for eps in (1.0, -1.0) if e is None else (e * sigma,):
                     q = self._arm(C2, S2, sigma * r, eps, d1)
                     if q is not None:
                         out.append(q)
             return out, False
         return self.configs_r0(d1)
+
+    def root_of_derivative(self, ta: float, tb: float, e: float) -> float | None:
+        """The root of F_e' near [ta, tb] (secant method): where a double root of F_e sits."""
+        t0, t1 = ta, tb if tb > ta else ta + 1e-9
+        d0, d1 = self.F(t0, e)[1], self.F(t1, e)[1]
+        for _ in range(NEWTON_ITERS):
+            if not (np.isfinite(d0) and np.isfinite(d1)) or d1 == d0:
+                break
+            t2 = t1 - d1 * (t1 - t0) / (d1 - d0)
+            if not np.isfinite(t2) or abs(t2 - 0.5 * (ta + tb)) > 1e-4:
+                return None
+            t0, d0, t1 = t1, d1, t2
+            d1 = self.F(t1, e)[1]
+            if abs(t1 - t0) <= 1e-16 * (abs(t1) + 1e-3):
+                break
+        return float(t1)
 
     def theta2_r0(self) -> tuple[list[tuple[float, float, float, float]], bool]:
         """r = 0: (theta2, eps, C34, S34) solving C34 (C2 zx + S2 zz) + S34 zy = 0 with u = 0."""
@@ -383,59 +417,52 @@ def carm_ik_oracle_ex(T: ArrayLike, L1: float = 350.0, L2: float = 402.0) -> tup
     if abs(T[0, 3]) < DEGEN_PX_MM and np.hypot(P.zy, P.zz) < DEGEN_ANGLE:
         return empty, True
 
-    Q, T1, T2 = P.polynomial()
-    n = max(T1.coef.size, T2.coef.size)  # Q = T1 - T2: rounding error ~ eps * (|T1| + |T2|)
-    noise_poly = Polynomial(np.abs(np.pad(T1.coef, (0, n - T1.coef.size))) + np.abs(np.pad(T2.coef, (0, n - T2.coef.size))))
+    Q = P.polynomial()[0]
     c = Q.coef.copy()
     big = np.max(np.abs(c)) if c.size else 0.0
+    if big == 0.0:  # Q == 0 exactly but not caught above (zy = zz = 0 and Px = 0 to the bit)
+        return empty, True
     degenerate = False
-    cands: list[tuple[int, float, Array]] = []  # (priority, error, q)
+    cands: list[tuple[int, float, Array]] = []  # (priority, error, q); lower priority wins in dedupe
 
-    def add_t(t: float, priority: int) -> None:
+    def add_t(t: float, e: float | None, priority: int) -> None:
         nonlocal degenerate
-        qs, deg = P.configs_at(t)
+        qs, deg = P.configs_at(t, e)
         degenerate |= deg
         for q in qs:
             err = P.verify(q)
             if err is not None:
                 cands.append((priority, err, q))
 
-    if big > 0.0:
-        keep = np.nonzero(np.abs(c) > LEAD_TRIM * big)[0]
-        c = c[: keep[-1] + 1]
-        raw = np.roots(c[::-1]) if c.size > 1 else np.zeros(0, dtype=complex)
-        raw = raw[(np.abs(raw.imag) < IMAG_TOL) & (np.abs(raw.real) < 1.0 + 1e-6)]
-        best_polished: list[float] = []  # per raw root: the polished t of the branch that vanishes
-        for t0 in raw.real:
-            best = (np.inf, float(t0))
-            for e in (1.0, -1.0):
-                t1, f1 = P.newton_F(float(t0), e)
-                best = min(best, (f1, t1))
-                add_t(t1, 1)
-            best_polished.append(best[1])
-        # Multiple roots: distinct raw roots polish to (nearly) the same t. The simple root of the (m-1)-th
-        # derivative of Q locates such a root to full precision; it is accepted only where Q itself vanishes
-        # to rounding level (two close but distinct roots have a clearly non-zero Q between them).
-        for tc, m in _clusters(sorted(best_polished)):
-            for order in range(1, m):
-                ts = _newton_poly(Q.deriv(order), tc)
-                if ts is not None and abs(Q(ts)) <= Q_NOISE * noise_poly(abs(ts)):
-                    # A higher order is the simple root when the multiplicity is m: most accurate first.
-                    add_t(ts, -order)
-    else:  # Q == 0 exactly but not caught above (e.g. zy = zz = 0 and Px = 0 to the bit)
-        return empty, True
+    keep = np.nonzero(np.abs(c) > LEAD_TRIM * big)[0]
+    c = c[: keep[-1] + 1]
+    raw = np.roots(c[::-1]) if c.size > 1 else np.zeros(0, dtype=complex)
+    raw = raw[(np.abs(raw.imag) < IMAG_TOL) & (np.abs(raw.real) < 1.0 + 1e-6)]
+
+    # Every near-real root of Q is polished on both branches (a root of Q is a root of F_+ or of F_-). It
+    # belongs to each branch where F_e then vanishes to rounding, and at least to the better one (at the
+    # elbow boundary h = 0, where F_+ = F_-, the noise bound of F_e is pessimistic).
+    members: dict[float, list[float]] = {1.0: [], -1.0: []}
+    for t0 in raw.real:
+        pol = {e: P.newton_F(float(t0), e) for e in (1.0, -1.0)}
+        best_e = min(pol, key=lambda e: pol[e][1])
+        for e, (t1, ratio) in pol.items():
+            if ratio <= CONVERGED or e == best_e:
+                members[e].append(t1)
+    for e in (1.0, -1.0):
+        for t, priority in _branch_roots(P, e, np.sort(members[e]), raw.real, Q):
+            add_t(t, e, priority)
 
     # r = 0 family (wrist centre on the joint-2 axis).
     if abs(P.px) < PX_SEED:
         if P.px == 0.0:
-            add_t(0.0, 0)
+            add_t(0.0, None, 0)
         else:
             for t0 in P.r0_seeds():
-                sigma = 1.0  # F_e with e = eps * sigma; try both, the FK check decides
                 for e in (1.0, -1.0):
-                    t1, _ = P.newton_F(t0, e * sigma)
-                    add_t(t1, 1)
-            add_t(0.0, 3)
+                    t1, _ = P.newton_F(t0, e)
+                    add_t(t1, e, 1)
+            add_t(0.0, None, 2)
 
     sols = _dedupe(cands)
     if not sols:
@@ -451,21 +478,124 @@ def carm_ik_oracle(T: ArrayLike, L1: float = 350.0, L2: float = 402.0) -> Array:
     return carm_ik_oracle_ex(T, L1, L2)[0]
 
 
-def _clusters(ts: list[float]) -> list[tuple[float, int]]:
-    """(centre, size) of groups (>= 2 members) of sorted values closer than CLUSTER_TOL to a neighbour."""
+def _branch_roots(
+    P: _Pose, e: float, members: Array, raw: Array, Q: Polynomial
+) -> list[tuple[float, int]]:
+    """Distinct roots (t, priority) of F_e from its sorted polished roots ``members``.
+
+    Members closer than CLUSTER_TOL form a group. A group whose members agree to rounding is one simple
+    root. Otherwise the signs of F_e at the members, at the midpoints between them and just outside the
+    group (only values beyond rounding noise count) decide: two or more sign changes are distinct roots,
+    each refined by bisection; no sign change is one multiple root (a singular pose), located by
+    ``_multiple_root``; one sign change is an odd-multiplicity root (``_multiple_root``, else bisection).
+    """
     out: list[tuple[float, int]] = []
+    for ta, tb, _ in _clusters(members, CLUSTER_TOL, singletons=True):
+        group = members[(members >= ta) & (members <= tb)]
+        if tb - ta <= SAME_ROOT_TOL * (1.0 + abs(ta)):
+            out.append((float(min(group, key=lambda t: abs(P.F(t, e)[0]))), 0))
+            continue
+        D = max(tb - ta, 0.5 * CLUSTER_TOL)
+        pts = [ta - D]
+        for i, t in enumerate(group):
+            if i:
+                pts.append(0.5 * (group[i - 1] + t))
+            pts.append(float(t))
+        pts.append(tb + D)
+        sig = []
+        for t in pts:
+            F, _, noise = P.F(t, e)
+            if abs(F) > noise:
+                sig.append((t, float(np.sign(F))))
+        changes = [(a[0], b[0]) for a, b in zip(sig[:-1], sig[1:], strict=True) if a[1] != b[1]]
+        if len(changes) >= 2:
+            out.extend((_bisect(P, e, lo, hi), 0) for lo, hi in changes)
+            continue
+        outside = (P.F(pts[0], e)[0], P.F(pts[-1], e)[0])
+        ts = _multiple_root(P, e, group, outside, len(changes) == 1, raw, Q)
+        if ts is not None:
+            out.append((ts, -1))
+        elif changes:
+            out.append((_bisect(P, e, *changes[0]), 0))
+        else:
+            out.append((float(min(group, key=lambda t: abs(P.F(t, e)[0]))), 0))
+    return out
+
+
+def _multiple_root(
+    P: _Pose,
+    e: float,
+    group: Array,
+    outside: tuple[float, float],
+    odd: bool,
+    raw: Array,
+    Q: Polynomial,
+) -> float | None:
+    """A multiple root of F_e at the group of polished roots ``group``, to full precision, or None.
+
+    np.roots returns a root of multiplicity m as m roots scattered by ~eps^(1/m), and the root of Q^(m-1)
+    is simple: it is tried for m = (raw roots nearby) down to 2, then the root of F_e'. A candidate must lie
+    at the group and make F_e vanish to the rounding level seen across the group; for an even multiplicity (``odd`` False) it is also accepted if
+    F_e there has the sign F_e has on both sides (``outside``: F_e just left and right of the group), i.e.
+    touches zero without crossing (a near-double root).
+    """
+    ta, tb = float(group[0]), float(group[-1])
+    at_members = [P.F(float(t), e) for t in group]
+    # The rounding level across the group (the noise bound is relative to F's terms, which may all be
+    # tiny at a single point, e.g. at t = 0).
+    level = max(max(abs(F) for F, _, _ in at_members), CONVERGED * max(n for _, _, n in at_members))
+
+    def acceptable(ts: float | None) -> bool:
+        if ts is None or not (ta - CLUSTER_TOL <= ts <= tb + CLUSTER_TOL):
+            return False
+        Fs, _, noise = P.F(ts, e)
+        if abs(Fs) <= max(CONVERGED * noise, level):
+            return True
+        return not odd and bool(np.sign(Fs) == np.sign(outside[0]) == np.sign(outside[1]))
+
+    m = int(np.sum((raw >= ta - RAW_CLUSTER_TOL) & (raw <= tb + RAW_CLUSTER_TOL)))
+    for order in range(m - 1, 0, -1):
+        ts = _newton_poly(Q.deriv(order), 0.5 * (ta + tb), tb - ta)
+        if acceptable(ts):
+            return ts
+    ts = P.root_of_derivative(ta, tb, e)
+    return ts if acceptable(ts) else None
+
+
+def _bisect(P: _Pose, e: float, lo: float, hi: float) -> float:
+    """Bisection for the sign change of F_e in [lo, hi]."""
+    flo = np.sign(P.F(lo, e)[0])
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid in (lo, hi):
+            break
+        fm = np.sign(P.F(mid, e)[0])
+        if fm == 0.0:
+            return mid
+        if fm == flo:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def _clusters(ts: Array, tol: float, singletons: bool = False) -> list[tuple[float, float, int]]:
+    """(first, last, size) of groups of sorted values closer than tol to a neighbour (size >= 2 unless
+    ``singletons``)."""
+    out: list[tuple[float, float, int]] = []
     i = 0
     while i < len(ts):
         j = i
-        while j + 1 < len(ts) and ts[j + 1] - ts[j] < CLUSTER_TOL:
+        while j + 1 < len(ts) and ts[j + 1] - ts[j] < tol:
             j += 1
-        if j > i:
-            out.append((float(np.mean(ts[i : j + 1])), j - i + 1))
+        if j > i or singletons:
+            out.append((float(ts[i]), float(ts[j]), j - i + 1))
         i = j + 1
     return out
 
 
-def _newton_poly(p: Polynomial, t0: float) -> float | None:
+def _newton_poly(p: Polynomial, t0: float, span: float) -> float | None:
+    """Newton on polynomial p from t0; None if it leaves t0 +- span (+ 1e-4) or does not settle."""
     dp = p.deriv()
     t = t0
     for _ in range(NEWTON_ITERS):
@@ -474,7 +604,7 @@ def _newton_poly(p: Polynomial, t0: float) -> float | None:
             break
         step = p(t) / d
         t -= step
-        if not np.isfinite(t) or abs(t - t0) > 1e-3:
+        if not np.isfinite(t) or abs(t - t0) > span + 1e-4:
             return None
         if abs(step) <= 1e-16 * (abs(t) + 1e-3):
             break

@@ -61,7 +61,8 @@ def assert_certified(sol: sweepik.Solutions, T: np.ndarray) -> None:
     if len(sol):
         J = pose_error_paper(CARM.fk(sol.q), T)
         assert J.max() <= J_TOL
-        np.testing.assert_allclose(sol.error, J, rtol=0, atol=1e-12)
+        # near a ZYZ gimbal (small sin beta) rounding of FK is amplified in J: compare loosely
+        np.testing.assert_allclose(sol.error, J, rtol=0, atol=1e-10)
         assert np.all(CARM.within_limits(sol.q))
 
 

@@ -57,7 +57,8 @@ from .cli_common import (
     _subparser,
     _SubParsers,
 )
-from .cli_solve import add_solve_parser, cmd_solve
+from .cli_solve import add_path_parser, add_solve_parser, cmd_path, cmd_solve
+from .cli_verify import add_bench_parser, add_verify_parser, cmd_bench, cmd_verify
 
 
 def _add_fk_parser(sub: _SubParsers) -> None:
@@ -221,6 +222,9 @@ _COMMANDS: dict[str, tuple[_AddParser, _Run]] = {
     "fk": (_add_fk_parser, _cmd_fk),
     "robots": (_add_robots_parser, _cmd_robots),
     "solve": (add_solve_parser, cmd_solve),
+    "path": (add_path_parser, cmd_path),
+    "verify": (add_verify_parser, cmd_verify),
+    "bench": (add_bench_parser, cmd_bench),
 }
 
 

@@ -143,3 +143,62 @@ def cmd_solve(args: argparse.Namespace) -> int:
             qn = sol.nearest(nearest)
             print("  nearest: " + "  ".join(f"{v:.{dec}f}" for v in _display(robot, qn, args.rad)))
     return 0
+
+
+def add_path_parser(sub: _SubParsers) -> None:
+    p = _subparser(
+        sub,
+        "path",
+        help="follow a Cartesian path: one configuration per pose, staying on one IK branch",
+        description=(
+            "Solve every pose of POSES_FILE (CSV, NPY or JSON) and pick, at each step, the solution nearest the "
+            "previous configuration (the first: nearest --start, else the first solution). Writes the joint path "
+            "as CSV or JSON (by the output file's extension; default: CSV on standard output)."
+        ),
+    )
+    p.add_argument("args", nargs="+", metavar="[ROBOT] POSES_FILE", help="robot (optional), then the pose file")
+    p.add_argument("--start", nargs="+", metavar="Q", help="start configuration (degrees / length unit)")
+    p.add_argument("-o", "--output", metavar="FILE", help="write the joint path here (.csv or .json)")
+    _add_ik_options(p)
+    _add_json(p, ": summary (points, max joint step, branch switches, errors) and the path")
+
+
+def cmd_path(args: argparse.Namespace) -> int:
+    from .trajectory import follow_path, load_poses, write_joint_path
+
+    if len(args.args) > 2:
+        raise CliInputError(f"expected [ROBOT] POSES_FILE, got {len(args.args)} arguments")
+    robot_name, path = (DEFAULT_ROBOT, args.args[0]) if len(args.args) == 1 else args.args
+    robot = load_robot(robot_name)
+    poses = load_poses(path)
+    start = None if args.start is None else _config_from_cli(robot, args.start, args.rad)
+    res = follow_path(robot, poses, start, reduction=args.reduction, strategy=args.strategy, limits=not args.no_limits)
+    if args.output:
+        write_joint_path(args.output, res.q, robot)
+    summary = {
+        "robot": robot.name,
+        "points": int(len(res.q)),
+        "found": int(np.sum(res.found)),
+        "J_max": float(np.nanmax(res.error)) if np.any(res.found) else None,
+        "max_joint_step": res.max_joint_step.tolist(),
+        "branch_switches": res.branch_switches,
+        "switch_steps": list(res.switch_steps),
+    }
+    if args.json:
+        q_rows = [[float(v) if np.isfinite(v) else None for v in row] for row in res.q]
+        _print_json({**summary, "q": q_rows})
+    elif args.output:
+        print(
+            f"{summary['found']}/{summary['points']} poses solved, J_max = {summary['J_max']}, "
+            f"branch switches: {res.branch_switches}; joint path written to {args.output}"
+        )
+    else:
+        units = _joint_units(robot, args.rad)
+        header = ["#", *(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True)), "J"]
+        rows = [
+            [str(k + 1), *(f"{v:.6f}" for v in _display(robot, q, args.rad)), f"{e:.2e}"]
+            for k, (q, e) in enumerate(zip(res.q, res.error, strict=True))
+        ]
+        print(_format_table(header, rows))
+        print(f"{summary['found']}/{summary['points']} poses solved, branch switches: {res.branch_switches}")
+    return 0

@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from . import sweep as _ref
 from .reductions.kernels import residual_by_id
+from .robot import Robot
 
 try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
     from numba import njit, prange
@@ -32,12 +33,17 @@ Array = NDArray[np.float64]
 
 FAMILY_TOL = _ref.FAMILY_TOL
 FAMILY_MIN_RUN = _ref.FAMILY_MIN_RUN
+FAMILY_BISECT = _ref.FAMILY_BISECT
 SUB = _ref.SUB_SAMPLES
 MAX_LEVELS = _ref.MAX_LEVELS
 BEND = _ref.BEND
 XTOL_REL = _ref.XTOL_REL
 DIFF_STEP_REL = _ref.DIFF_STEP_REL
 CLUSTER_FAMILY_REL = _ref.CLUSTER_FAMILY_REL
+CLUSTER_REACH = _ref.CLUSTER_REACH
+FLAT_PROBE_REL = _ref.FLAT_PROBE_REL
+FLAT_MAX_REL = _ref.FLAT_MAX_REL
+FLAT_BISECT = _ref.FLAT_BISECT
 #: Candidates and family spans kept per pose (the C-Arm has at most 8 solutions; edges and near misses add
 #: candidates). Overflow is reported and the pose is redone by the NumPy engine.
 MAX_CAND = 256
@@ -100,6 +106,50 @@ if AVAILABLE:
                 t = 0.5
             t = min(max(t, tlim), 1.0 - tlim)
         return x
+
+    @njit(cache=True)
+    def _small(kid, p, x, b, noise):
+        f = _res(kid, p, x, b)
+        return (not math.isnan(f)) and abs(f) <= noise
+
+    @njit(cache=True)
+    def _center_flat(kid, p, x, b, noise, span):
+        """As sweep._Search._center_flat, for one root."""
+        d0 = FLAT_PROBE_REL * span
+        if not (_small(kid, p, x - d0, b, noise) or _small(kid, p, x + d0, b, noise)):
+            return x
+        limit = FLAT_MAX_REL * span
+        reach = np.zeros(2)
+        for side in range(2):
+            sgn = -1.0 if side == 0 else 1.0
+            inner, outer = 0.0, d0
+            if _small(kid, p, x + sgn * outer, b, noise):
+                for _ in range(64):
+                    inner = outer
+                    if inner >= limit:
+                        break
+                    outer = min(2.0 * outer, limit)
+                    if not _small(kid, p, x + sgn * outer, b, noise):
+                        break
+            for _ in range(FLAT_BISECT):
+                mid = 0.5 * (inner + outer)
+                if _small(kid, p, x + sgn * mid, b, noise):
+                    inner = mid
+                else:
+                    outer = mid
+            reach[side] = inner
+        return x + 0.5 * (reach[1] - reach[0])
+
+    @njit(cache=True)
+    def _extend(kid, p, b, inside, outside):
+        for _ in range(FAMILY_BISECT):
+            mid = 0.5 * (inside + outside)
+            f = _res(kid, p, mid, b)
+            if (not math.isnan(f)) and abs(f) <= FAMILY_TOL:
+                inside = mid
+            else:
+                outside = mid
+        return inside
 
     @njit(cache=True)
     def _push(out_t, out_b, cnt, x, b):
@@ -261,8 +311,13 @@ if AVAILABLE:
                             k += 1
                         if k - j + 1 >= FAMILY_MIN_RUN and th[k] > th[j]:
                             if fcnt[i] < fam.shape[1]:
-                                fam[i, fcnt[i], 0] = th[j]
-                                fam[i, fcnt[i], 1] = th[k]
+                                lo, hi = th[j], th[k]
+                                if j > 0:
+                                    lo = _extend(kid, p, b, lo, th[j - 1])
+                                if k + 1 < M:
+                                    hi = _extend(kid, p, b, hi, th[k + 1])
+                                fam[i, fcnt[i], 0] = lo
+                                fam[i, fcnt[i], 1] = hi
                                 fam[i, fcnt[i], 2] = b
                             fcnt[i] += 1
                             for m in range(j, k + 1):
@@ -317,6 +372,8 @@ if AVAILABLE:
                         top,
                     )
             cnt[i] = c[0]
+            for k in range(min(c[0], out_t.shape[1])):
+                out_t[i, k] = _center_flat(kid, p, out_t[i, k], out_b[i, k], noise, span[i])
             # merge noise-level clusters per branch (candidates sorted by branch, then theta)
             n = min(c[0], out_t.shape[1])
             if n > 1:
@@ -344,7 +401,15 @@ if AVAILABLE:
                             fam[i, fcnt[i], 2] = bs[s]
                         fcnt[i] += 1
                     else:
-                        out_t[i, w] = 0.5 * (lo + hi)
+                        x = 0.5 * (lo + hi)
+                        if e > s:  # a root of even multiplicity: locate the extremum outside the noise
+                            H = max(CLUSTER_REACH * (hi - lo), DIFF_STEP_REL * span[i])
+                            a, cc, hh = lo - H, hi + H, 0.5 * H
+                            ga = _g(kid, p, a, bs[s], hh)
+                            gc = _g(kid, p, cc, bs[s], hh)
+                            if ga * gc < 0:
+                                x = _root_diff(kid, p, bs[s], a, cc, ga, gc, hh)
+                        out_t[i, w] = x
                         out_b[i, w] = bs[s]
                         w += 1
                     s = e + 1
@@ -440,12 +505,12 @@ if AVAILABLE:
             out[k] = T
 
 
-def flange_poses(robot, q: Array) -> Array:  # type: ignore[no-untyped-def]
+def flange_poses(robot: Robot, q: Array) -> Array:
     """World poses of the last link frame ``(K, 4, 4)`` for configurations ``q (K, n)``: compiled for
     modified-DH robots when Numba is available, else :func:`sweepik.kinematics.chain_frames`."""
     from . import kinematics
 
-    if not AVAILABLE or robot.dh_convention != "modified" or q.ndim != 2 or q.shape[0] < 16:
+    if not AVAILABLE or robot.dh_convention != "modified" or q.ndim != 2:
         return kinematics.chain_frames(robot, q)[..., -1, :, :]
     out = np.empty((q.shape[0], 4, 4))
     _fk_modified(

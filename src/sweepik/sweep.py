@@ -50,6 +50,17 @@ FAMILY_TOL = 1e-10
 #: every point of it solves the pose to rounding precision), a shorter one as its midpoint. A double root
 #: (f ~ c x^2) is flat at noise level over ~2 sqrt(1e-16 / c), about 1e-8 of the range: far shorter.
 CLUSTER_FAMILY_REL = 1e-6
+#: Probe distance (relative to the range) deciding whether a root sits in a flat stretch of the residual,
+#: the largest half-width searched for such a stretch, and bisection steps locating its ends.
+FLAT_PROBE_REL = 1e-9
+FLAT_MAX_REL = 1e-2
+FLAT_BISECT = 30
+#: A cluster of several roots (an even-multiplicity root under noise) is located as the extremum of the
+#: residual, from a central difference with half-step CLUSTER_REACH / 2 times the cluster's width (where the
+#: residual rises ~CLUSTER_REACH^2 times above the noise).
+CLUSTER_REACH = 100.0
+#: Bisection steps locating where a family ends between its last sample and the next one.
+FAMILY_BISECT = 40
 #: Minimum number of consecutive vanishing samples that make a family.
 FAMILY_MIN_RUN = 3
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
@@ -252,11 +263,51 @@ class _Search:
             xtol = float(XTOL_REL * self.span.min())
             x = find_roots(lambda x, s: self.residual(p[s], b[s], x[:, None])[:, 0], a, c, fa, fc, xtol)
             self._root(p, b, x)
-        return self._merge_clusters(
-            np.concatenate(self.roots_p).astype(np.intp),
-            np.concatenate(self.roots_b).astype(np.intp),
-            np.concatenate(self.roots_t),
-        )
+        p = np.concatenate(self.roots_p).astype(np.intp)
+        b = np.concatenate(self.roots_b).astype(np.intp)
+        t = self._center_flat(p, b, np.concatenate(self.roots_t))
+        return self._merge_clusters(p, b, t)
+
+    def _center_flat(self, p: IntArray, b: IntArray, t: Array) -> Array:
+        """Move each root to the middle of the stretch around it where |residual| stays within the noise.
+
+        A simple root's stretch is ~noise / |f'| wide: nothing moves. At a root of high multiplicity (the
+        residual ~ c x^k, k >= 3) the residual crosses zero at places decided by rounding anywhere in a
+        stretch of width ~(noise / c)^(1/k); its middle is the root."""
+        if t.size == 0:
+            return t
+        noise = self.red.residual_noise
+        d0 = FLAT_PROBE_REL * self.span[p]
+
+        def small(x: Array, sel: IntArray) -> NDArray[np.bool_]:
+            f = self.residual(p[sel], b[sel], x[:, None])[:, 0]
+            return np.abs(f) <= noise  # NaN (outside the branch's domain) counts as not small
+
+        idx = np.arange(t.size)
+        flat = np.nonzero(small(t - d0, idx) | small(t + d0, idx))[0]
+        if flat.size == 0:
+            return t
+        reach = np.empty((flat.size, 2))
+        for side, sgn in enumerate((-1.0, 1.0)):
+            inner = np.zeros(flat.size)
+            outer = d0[flat].copy()
+            grow = small(t[flat] + sgn * outer, flat)
+            limit = FLAT_MAX_REL * self.span[p[flat]]
+            for _ in range(64):  # double until the residual leaves the noise (or the reach limit)
+                if not grow.any():
+                    break
+                inner = np.where(grow, outer, inner)
+                outer = np.where(grow, np.minimum(2.0 * outer, limit), outer)
+                grow = grow & (inner < limit) & small(t[flat] + sgn * outer, flat)
+            for _ in range(FLAT_BISECT):  # boundary between inner (small) and outer (not small)
+                mid = 0.5 * (inner + outer)
+                sm = small(t[flat] + sgn * mid, flat)
+                inner = np.where(sm, mid, inner)
+                outer = np.where(sm, outer, mid)
+            reach[:, side] = inner
+        t = t.copy()
+        t[flat] += 0.5 * (reach[:, 1] - reach[:, 0])
+        return t
 
     def _merge_clusters(self, p: IntArray, b: IntArray, t: Array) -> Candidates:
         """Merge neighbouring roots of one branch between which the residual stays within its rounding
@@ -283,11 +334,50 @@ class _Search:
         for i in np.nonzero(wide)[0]:
             self.spans.append(FamilySpan(int(p[first[i]]), int(b[first[i]]), float(lo[i]), float(hi[i])))
         keep = first[~wide]
-        return Candidates(pose=p[keep], branch=b[keep], theta=0.5 * (lo + hi)[~wide])
+        x = 0.5 * (lo + hi)[~wide]
+        # clusters of several roots: a root of even multiplicity; locate the extremum outside the noise as
+        # the root of a central difference reaching beyond the cluster
+        several = np.nonzero(np.diff(np.append(first, t.size))[~wide] > 1)[0]
+        if several.size:
+            pp, bb = p[keep][several], b[keep][several]
+            lo_s, hi_s = lo[~wide][several], hi[~wide][several]
+            H = np.maximum(CLUSTER_REACH * (hi_s - lo_s), DIFF_STEP_REL * self.span[pp])
+
+            def g(xx: Array, sel: IntArray) -> Array:
+                h = 0.5 * H[sel]
+                return (
+                    self.residual(pp[sel], bb[sel], (xx + h)[:, None])[:, 0]
+                    - self.residual(pp[sel], bb[sel], (xx - h)[:, None])[:, 0]
+                )
+
+            idx = np.arange(several.size)
+            a, c = lo_s - H, hi_s + H
+            ga, gc = g(a, idx), g(c, idx)
+            ok = np.nonzero(ga * gc < 0)[0]
+            if ok.size:
+                x[several[ok]] = find_roots(
+                    lambda xx, sel: g(xx, ok[sel]), a[ok], c[ok], ga[ok], gc[ok], 1e-3 * float(H[ok].min())
+                )
+        return Candidates(pose=p[keep], branch=b[keep], theta=x)
 
 
-def _families(theta: Array, f: Array, valid: NDArray[np.bool_]) -> tuple[list[FamilySpan], NDArray[np.bool_]]:
-    """Runs of vanishing samples ``(N, M, B)`` -> family spans, and the mask of samples they cover."""
+def _extend(reduction: Reduction, pose: Array, branch: int, inside: float, outside: float) -> float:
+    """Bisect between a sample on a family (``inside``) and one off it for where the family ends."""
+    for _ in range(FAMILY_BISECT):
+        mid = 0.5 * (inside + outside)
+        r = reduction.residual(pose[None], np.array([[mid]]), np.array([[branch]]))
+        if r is not None and np.isfinite(r[0, 0]) and abs(r[0, 0]) <= FAMILY_TOL:
+            inside = mid
+        else:
+            outside = mid
+    return inside
+
+
+def _families(
+    reduction: Reduction, poses: Array, theta: Array, f: Array, valid: NDArray[np.bool_]
+) -> tuple[list[FamilySpan], NDArray[np.bool_]]:
+    """Runs of vanishing samples ``(N, M, B)`` -> family spans (ends located by bisection towards the
+    neighbouring samples), and the mask of samples they cover."""
     flat = valid & (np.abs(f) <= FAMILY_TOL)
     in_family = np.zeros_like(flat)
     spans: list[FamilySpan] = []
@@ -298,7 +388,12 @@ def _families(theta: Array, f: Array, valid: NDArray[np.bool_]) -> tuple[list[Fa
         edges = np.diff(np.concatenate([[0], col.astype(np.int8), [0]]))
         for s0, e0 in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0], strict=True):
             if e0 - s0 >= FAMILY_MIN_RUN and theta[p, e0 - 1] > theta[p, s0]:
-                spans.append(FamilySpan(int(p), int(b), float(theta[p, s0]), float(theta[p, e0 - 1])))
+                lo, hi = float(theta[p, s0]), float(theta[p, e0 - 1])
+                if s0 > 0:
+                    lo = _extend(reduction, poses[p], int(b), lo, float(theta[p, s0 - 1]))
+                if e0 < theta.shape[1]:
+                    hi = _extend(reduction, poses[p], int(b), hi, float(theta[p, e0]))
+                spans.append(FamilySpan(int(p), int(b), lo, hi))
                 in_family[p, s0:e0, b] = True
     return spans, in_family
 
@@ -345,7 +440,7 @@ def find_candidates(
         f = reduction.residual(poses, theta)
     N, M, B = f.shape
     valid = np.isfinite(f)
-    spans, in_family = _families(theta, f, valid)
+    spans, in_family = _families(reduction, poses, theta, f, valid)
     valid &= ~in_family
     search = _Search(reduction, poses, hi - lo)
     p = np.repeat(np.arange(N), B)

@@ -1,0 +1,131 @@
+"""Benchmarks (``sweepik bench``): speed and memory of the solver on the bundled C-Arm.
+
+(a) ``solve_many`` on the paper's 15,900 grid poses, precise strategy: wall time and us per pose;
+(b) single-pose ``solve`` latency, median and 95th percentile over random in-limit poses;
+(c) the paper strategy, seconds per pose (on a subset of the grid);
+(d) peak memory (resident set) of ``solve_many`` on 100,000 random poses, measured in a child process.
+
+Benchmarks are not tests: nothing here asserts a speed.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from typing import Any
+
+import numpy as np
+
+from .robot_file import load_robot
+from .solver import solve, solve_many
+from .verify import grid_configurations, random_configurations
+
+#: The paper's figure: 0.098 s per pose in Matlab.
+PAPER_SECONDS_PER_POSE = 0.098
+
+_MEMORY_SCRIPT = """
+import resource, sys, json
+import numpy as np
+import sweepik
+from sweepik.verify import random_configurations
+robot = sweepik.load_robot("carm")
+poses = robot.fk(random_configurations(robot, {n}, np.random.default_rng(0)))
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+sols = sweepik.solve_many(robot, poses)
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(json.dumps({{"peak_rss_mib": peak / 1024, "before_solve_mib": base / 1024, "poses": len(sols)}}))
+"""
+
+
+def bench_grid(repeats: int = 3) -> dict[str, Any]:
+    """(a) Best of ``repeats`` wall times of ``solve_many`` on the 15,900 grid poses (precise)."""
+    robot = load_robot("carm")
+    poses = robot.fk(grid_configurations(include_singular=False))
+    solve_many(robot, poses[:64])  # warm-up (imports, caches)
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        solve_many(robot, poses)
+        times.append(time.perf_counter() - t0)
+    best = min(times)
+    return {
+        "poses": len(poses),
+        "seconds": best,
+        "us_per_pose": best / len(poses) * 1e6,
+        "speedup_vs_paper": PAPER_SECONDS_PER_POSE * len(poses) / best,
+    }
+
+
+def bench_single(count: int = 1000, seed: int = 0) -> dict[str, Any]:
+    """(b) Latency of ``solve`` on ``count`` random in-limit poses: median and 95th percentile."""
+    robot = load_robot("carm")
+    poses = robot.fk(random_configurations(robot, count, np.random.default_rng(seed)))
+    solve(robot, poses[0])
+    lat = np.empty(count)
+    for i, T in enumerate(poses):
+        t0 = time.perf_counter()
+        solve(robot, T)
+        lat[i] = time.perf_counter() - t0
+    return {"poses": count, "median_us": float(np.median(lat) * 1e6), "p95_us": float(np.percentile(lat, 95) * 1e6)}
+
+
+def bench_paper(count: int = 500) -> dict[str, Any]:
+    """(c) The paper strategy on ``count`` grid poses (every 31st): seconds per pose."""
+    robot = load_robot("carm")
+    q = grid_configurations(include_singular=False)
+    poses = robot.fk(q[:: max(1, len(q) // count)][:count])
+    t0 = time.perf_counter()
+    solve_many(robot, poses, strategy="paper")
+    dt = time.perf_counter() - t0
+    return {"poses": len(poses), "seconds_per_pose": dt / len(poses), "paper_seconds_per_pose": PAPER_SECONDS_PER_POSE}
+
+
+def bench_memory(count: int = 100_000) -> dict[str, Any]:
+    """(d) Peak resident memory of a child process running ``solve_many`` on ``count`` random poses."""
+    out = subprocess.run(
+        [sys.executable, "-c", _MEMORY_SCRIPT.format(n=count)], capture_output=True, text=True, check=True
+    )
+    return dict(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def run_bench(single: int = 1000, paper: int = 500, memory: int = 100_000, repeats: int = 3) -> dict[str, Any]:
+    """All four benchmarks; sizes can be reduced for a quick look (0 skips a benchmark)."""
+    result: dict[str, Any] = {"grid_precise": bench_grid(repeats)}
+    if single:
+        result["single_pose"] = bench_single(single)
+    if paper:
+        result["paper_strategy"] = bench_paper(paper)
+    if memory:
+        result["memory"] = bench_memory(memory)
+    return result
+
+
+def format_bench(result: dict[str, Any]) -> str:
+    """Human-readable table of ``run_bench``'s result, with the issue's targets."""
+    rows = []
+    g = result["grid_precise"]
+    rows.append(
+        (
+            "(a) 15,900 grid poses, precise",
+            f"{g['seconds']:.3f} s ({g['us_per_pose']:.0f} us/pose, {g['speedup_vs_paper']:.0f}x the paper)",
+            "<= 1.0 s",
+        )
+    )
+    if "single_pose" in result:
+        s = result["single_pose"]
+        rows.append(
+            ("(b) single-pose solve", f"median {s['median_us']:.0f} us, p95 {s['p95_us']:.0f} us", "median <= 300 us")
+        )
+    if "paper_strategy" in result:
+        p = result["paper_strategy"]
+        rows.append(("(c) paper strategy", f"{p['seconds_per_pose'] * 1e3:.2f} ms/pose (paper: 98 ms in Matlab)", ""))
+    if "memory" in result:
+        m = result["memory"]
+        rows.append((f"(d) peak memory, {m['poses']:,} poses", f"{m['peak_rss_mib']:.0f} MiB resident", "<= 1024 MiB"))
+    w0 = max(len(r[0]) for r in rows)
+    w1 = max(len(r[1]) for r in rows)
+    lines = [f"{'benchmark':<{w0}}  {'measured':<{w1}}  target", "-" * (w0 + w1 + 20)]
+    lines += [f"{a:<{w0}}  {b:<{w1}}  {c}" for a, b, c in rows]
+    return "\n".join(lines)

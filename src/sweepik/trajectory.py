@@ -1,0 +1,387 @@
+"""Following a Cartesian path with branch continuity, and reading/writing path files.
+
+* :func:`follow_path` solves every pose of a path (all solutions, :func:`sweepik.solver.solve_many`) and
+  picks, pose after pose, the solution nearest the previous configuration.
+* :func:`load_poses` reads poses from CSV, NPY or JSON; :func:`write_joint_path` writes the joint path as
+  CSV or JSON (degrees for revolute joints, the robot's length unit for prismatic ones).
+
+Distances between configurations mix lengths and angles. The paper's own exchange rate is used (eq. 6c:
+100 mm of length weigh as much as 1 rad of angle), so a prismatic difference is divided by that weight
+(``sweepik.units.orientation_weight``) before the Euclidean norm; angles are compared modulo 2 pi.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._validate import check_configuration, check_poses
+from .errors import ShapeError, SweepikError, UnknownOptionError
+from .pose import pose_error_paper, pose_from_xyz_zyz
+from .reductions import Reduction
+from .robot import Robot
+from .solutions import Family, Solutions, joint_distance
+from .solver import solve_many
+from .units import orientation_weight
+
+__all__ = [
+    "BRANCH_SWITCH_ANGLE_RAD",
+    "BRANCH_SWITCH_LENGTH_REL",
+    "PathResult",
+    "PoseFileError",
+    "follow_path",
+    "weighted_joint_distance",
+    "branch_switch_thresholds",
+    "load_poses",
+    "write_joint_path",
+]
+
+Array = NDArray[np.float64]
+
+#: A step between consecutive path points is a *branch switch* when a revolute joint moves more than this
+#: (30 degrees). Consecutive points of a sensibly sampled path move each joint by a few degrees; a switch
+#: to another IK branch (elbow flip, theta2 + 180 deg, ...) moves some joint by tens of degrees at once.
+BRANCH_SWITCH_ANGLE_RAD = math.radians(30.0)
+#: ... or when a prismatic joint moves more than this share of its range (C-Arm rail: 10 % of 2000 mm).
+#: Joints without a finite range use the robot's ``length_scale`` instead of the range.
+BRANCH_SWITCH_LENGTH_REL = 0.1
+#: Members sampled along a self-motion family before the nearest one is refined (golden section).
+_FAMILY_SAMPLES = 721
+_GOLDEN_ITERS = 60
+
+
+class PoseFileError(SweepikError):
+    """A pose file cannot be read: missing, unknown extension, or content not in a supported layout."""
+
+
+def weighted_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
+    """Distance ``(...)`` between configurations ``q (..., n)`` and ``q_ref (n,)``, dimensionless.
+
+    Angles are compared modulo 2 pi (radians); prismatic differences are divided by the paper's weight
+    (100 mm per radian, in the robot's length unit), then the Euclidean norm is taken.
+    """
+    d = joint_distance(robot, q, q_ref)
+    scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
+    return np.asarray(np.linalg.norm(d * scale, axis=-1))
+
+
+def branch_switch_thresholds(robot: Robot) -> Array:
+    """Per-joint step ``(n,)`` above which a step counts as a branch switch (radians / length unit)."""
+    span = robot.upper - robot.lower
+    span = np.where(np.isfinite(span), span, robot.length_scale)
+    return np.where(robot.is_revolute, BRANCH_SWITCH_ANGLE_RAD, BRANCH_SWITCH_LENGTH_REL * span)
+
+
+@dataclass(frozen=True, eq=False)
+class PathResult:
+    """A joint path along a Cartesian path of ``N`` poses for an ``n``-joint robot.
+
+    Attributes:
+        q: ``(N, n)`` chosen configurations (radians / length unit); NaN rows where a pose has no solution.
+        error: ``(N,)`` the paper's error J (eq. 6, length unit) of each chosen configuration; NaN where
+            there is none.
+        found: ``(N,)`` bool, the pose has at least one solution.
+        n_solutions: ``(N,)`` isolated solutions of each pose (self-motion families not counted).
+        steps: ``(N - 1, n)`` absolute joint change between consecutive points (angles modulo 2 pi); a row is
+            NaN when either point has no solution.
+        max_joint_step: ``(n,)`` largest change of each joint over the path (radians / length unit), over
+            the steps between points that both have a solution (0 if there is none).
+        branch_switches: number of steps with some joint change above :func:`branch_switch_thresholds`.
+        switch_steps: indices ``k`` of those steps (between point ``k`` and ``k + 1``).
+    """
+
+    q: Array
+    error: Array
+    found: NDArray[np.bool_]
+    n_solutions: NDArray[np.intp]
+    steps: Array
+    max_joint_step: Array
+    branch_switches: int
+    switch_steps: tuple[int, ...]
+
+    @property
+    def recall(self) -> float:
+        """Share of path points with a solution."""
+        return float(np.mean(self.found)) if self.found.size else 0.0
+
+
+def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, float]:
+    """Member of ``fam`` nearest ``ref`` (weighted distance): dense sampling, then golden-section search."""
+    lo, hi = fam.interval
+    grid = np.linspace(lo, hi, _FAMILY_SAMPLES)
+    members = fam.at(grid)
+    d = weighted_joint_distance(robot, members, ref)
+    d = np.where(np.all(np.isfinite(members), axis=-1), d, np.inf)
+    i = int(np.argmin(d))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+
+    def dist(t: float) -> float:
+        return float(weighted_joint_distance(robot, fam.at(t), ref))
+
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    c, e = b - g * (b - a), a + g * (b - a)
+    fc, fe = dist(c), dist(e)
+    for _ in range(_GOLDEN_ITERS):
+        if fc <= fe:
+            b, e, fe = e, c, fc
+            c = b - g * (b - a)
+            fc = dist(c)
+        else:
+            a, c, fc = c, e, fe
+            e = a + g * (b - a)
+            fe = dist(e)
+    t = c if fc <= fe else e
+    best = fam.at(t)
+    bd = dist(t)
+    if not bd <= float(d[i]):
+        best, bd = members[i], float(d[i])
+    return np.asarray(best, dtype=np.float64), bd
+
+
+def _choose(robot: Robot, sols: Solutions, ref: Array | None, weight: float) -> tuple[Array, float] | None:
+    """The solution of ``sols`` nearest ``ref`` (the first one when ``ref`` is None) and its error J."""
+    best: Array | None = None
+    best_err = math.nan
+    best_d = math.inf
+    if len(sols):
+        if ref is None:
+            return sols.q[0].copy(), float(sols.error[0])
+        d = weighted_joint_distance(robot, sols.q, ref)
+        i = int(np.argmin(d))
+        best, best_err, best_d = sols.q[i].copy(), float(sols.error[i]), float(d[i])
+    for fam in sols.families:
+        if ref is None:
+            member, dm = fam.at(fam.interval[0]), 0.0
+        else:
+            member, dm = _nearest_on_family(robot, fam, ref)
+        if dm < best_d:
+            err = float(pose_error_paper(robot.fk(member), sols.pose, weight))
+            best, best_err, best_d = member, err, dm
+            if ref is None:
+                break
+    if best is None:
+        return None
+    return best, best_err
+
+
+def follow_path(
+    robot: Robot,
+    poses: ArrayLike,
+    q_start: ArrayLike | None = None,
+    *,
+    reduction: str | Reduction | None = None,
+    strategy: Literal["precise", "paper"] = "precise",
+    limits: bool = True,
+) -> PathResult:
+    """Joint path along ``poses (N, 4, 4)`` (world frame, robot's length unit), keeping to one IK branch.
+
+    Every pose is solved for all its solutions; the first point takes the solution nearest ``q_start``
+    (``(n,)``, radians / length unit), or the first solution reported when ``q_start`` is None; every later
+    point takes the solution nearest the previous chosen configuration (see :func:`weighted_joint_distance`;
+    members of self-motion families count). A pose without solution gets a NaN row and the next point is
+    compared with the last configuration found.
+
+    >>> import numpy as np
+    >>> from sweepik import load_robot
+    >>> arm = load_robot("carm")
+    >>> q = np.array([800.0, 0.3, 0.2, -0.4, 0.5, 0.1]) + np.linspace(0, 0.05, 5)[:, None]
+    >>> res = follow_path(arm, arm.fk(q), q_start=q[0])
+    >>> bool(np.allclose(res.q, q, atol=1e-8)), res.branch_switches
+    (True, 0)
+    """
+    P = check_poses(poses, "poses")
+    if P.ndim != 3 or P.shape[0] == 0:
+        raise ShapeError(f"poses must have shape (N, 4, 4) with N >= 1, got {P.shape}")
+    ref = None if q_start is None else check_configuration(q_start, robot.n_joints, "q_start")
+    if ref is not None and ref.ndim != 1:
+        raise ShapeError(f"q_start must have shape ({robot.n_joints},), got {ref.shape}")
+    sols = solve_many(robot, P, reduction=reduction, strategy=strategy, limits=limits)
+    weight = orientation_weight(robot.length_unit)
+    N, n = P.shape[0], robot.n_joints
+    q = np.full((N, n), np.nan)
+    err = np.full(N, np.nan)
+    for k, s in enumerate(sols):
+        pick = _choose(robot, s, ref, weight)
+        if pick is not None:
+            q[k], err[k] = pick
+            ref = q[k]
+    found = np.all(np.isfinite(q), axis=-1)
+    n_solutions = np.array([len(s) for s in sols], dtype=np.intp)
+    steps = joint_distance(robot, q[1:], q[:-1]) if N > 1 else np.zeros((0, n))
+    valid = np.all(np.isfinite(steps), axis=-1)
+    max_step = steps[valid].max(axis=0) if np.any(valid) else np.zeros(n)
+    over = valid & np.any(np.where(np.isfinite(steps), steps, 0.0) > branch_switch_thresholds(robot), axis=-1)
+    switch = tuple(int(i) for i in np.nonzero(over)[0])
+    return PathResult(q, err, found, n_solutions, steps, max_step, len(switch), switch)
+
+
+# ---------------------------------------------------------------------------------------------- files
+
+_POSE_LAYOUTS = (
+    "CSV: one pose per row, 16 numbers (row-major 4x4) or 6 numbers x y z alpha beta gamma "
+    "(Z-Y-Z Euler angles in degrees); NPY: array (N, 4, 4); JSON: a list of 4x4 nested lists or of "
+    '{"xyz": [x, y, z], "zyz_deg": [alpha, beta, gamma]} objects'
+)
+
+
+def _poses_from_rows(rows: Array, where: str) -> Array:
+    if rows.ndim != 2 or rows.shape[1] not in (6, 16):
+        width = rows.shape[1] if rows.ndim == 2 else rows.shape
+        raise PoseFileError(f"{where}: expected 16 or 6 numbers per row, got {width}. Layouts: {_POSE_LAYOUTS}")
+    if rows.shape[1] == 16:
+        return rows.reshape(-1, 4, 4)
+    return pose_from_xyz_zyz(rows[:, :3], np.radians(rows[:, 3:]))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _read_csv(path: Path) -> Array:
+    rows: list[list[float]] = []
+    with path.open(newline="") as fh:
+        lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    dialect_delim = "," if any("," in ln for ln in lines) else None
+    for lineno, line in enumerate(lines, start=1):
+        fields = [f.strip() for f in (line.split(dialect_delim) if dialect_delim else line.split())]
+        fields = [f for f in fields if f != ""]
+        if lineno == 1 and fields and not all(_is_number(f) for f in fields):
+            continue  # a header row of column names
+        try:
+            rows.append([float(f) for f in fields])
+        except ValueError:
+            raise PoseFileError(f"{path}: data row {lineno} holds a non-numeric field: {line.strip()!r}") from None
+    if not rows:
+        raise PoseFileError(f"{path}: no poses found. Layouts: {_POSE_LAYOUTS}")
+    widths = {len(r) for r in rows}
+    if len(widths) != 1:
+        raise PoseFileError(f"{path}: rows have different numbers of fields {sorted(widths)}; expected all 16 or all 6")
+    return _poses_from_rows(np.array(rows, dtype=np.float64), str(path))
+
+
+def _read_npy(path: Path) -> Array:
+    try:
+        arr = np.load(path, allow_pickle=False)
+    except (ValueError, OSError) as exc:
+        raise PoseFileError(f"{path}: not a readable .npy array ({exc})") from None
+    if not isinstance(arr, np.ndarray) or not np.issubdtype(arr.dtype, np.number):
+        raise PoseFileError(f"{path}: expected a numeric array, got dtype {getattr(arr, 'dtype', type(arr))}")
+    arr = arr.astype(np.float64)
+    if arr.shape == (4, 4):
+        arr = arr[None]
+    if arr.ndim != 3 or arr.shape[1:] != (4, 4):
+        raise PoseFileError(f"{path}: expected an array of shape (N, 4, 4), got {arr.shape}")
+    return arr
+
+
+def _json_item(item: Any, i: int, where: str) -> Array:
+    if isinstance(item, dict):
+        if "xyz" not in item or "zyz_deg" not in item:
+            raise PoseFileError(f"{where}: pose {i} is an object without 'xyz' and 'zyz_deg' keys: {sorted(item)}")
+        try:
+            xyz = np.array(item["xyz"], dtype=np.float64)
+            zyz = np.array(item["zyz_deg"], dtype=np.float64)
+        except (TypeError, ValueError):
+            raise PoseFileError(f"{where}: pose {i}: 'xyz' and 'zyz_deg' must be lists of 3 numbers") from None
+        if xyz.shape != (3,) or zyz.shape != (3,):
+            raise PoseFileError(f"{where}: pose {i}: 'xyz' and 'zyz_deg' must be lists of 3 numbers")
+        return pose_from_xyz_zyz(xyz, np.radians(zyz))
+    try:
+        T = np.array(item, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise PoseFileError(f"{where}: pose {i} is neither a 4x4 list of numbers nor an xyz/zyz_deg object") from None
+    if T.shape != (4, 4):
+        raise PoseFileError(f"{where}: pose {i} must be a 4x4 nested list, got shape {T.shape}")
+    return T
+
+
+def _read_json(path: Path) -> Array:
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise PoseFileError(f"{path}: invalid JSON ({exc})") from None
+    if isinstance(data, dict) and "poses" in data:
+        data = data["poses"]
+    if not isinstance(data, list) or not data:
+        raise PoseFileError(f"{path}: expected a non-empty JSON list of poses. Layouts: {_POSE_LAYOUTS}")
+    return np.stack([_json_item(item, i, str(path)) for i, item in enumerate(data)])
+
+
+_READERS = {".csv": _read_csv, ".txt": _read_csv, ".npy": _read_npy, ".json": _read_json}
+
+
+def load_poses(path: str | PathLike[str]) -> Array:
+    """Poses ``(N, 4, 4)`` read from a CSV, NPY or JSON file (chosen by extension).
+
+    * CSV (``.csv``, ``.txt``): one pose per row; 16 numbers (a row-major 4x4 matrix) or 6 numbers
+      ``x y z alpha beta gamma`` (position in the robot's length unit, Z-Y-Z Euler angles in **degrees**).
+      Separated by commas or whitespace; ``#`` comment lines and one header row of names are skipped.
+    * NPY: an array ``(N, 4, 4)`` (or a single ``(4, 4)``).
+    * JSON: a list (or ``{"poses": [...]}``) of 4x4 nested lists or of
+      ``{"xyz": [x, y, z], "zyz_deg": [alpha, beta, gamma]}`` objects.
+
+    Raises:
+        PoseFileError: missing file, unknown extension, malformed content.
+        InvalidPoseError / NonFiniteError: a matrix that is not a rigid transform, NaN or inf values
+            (messages name the file).
+    """
+    p = Path(path)
+    reader = _READERS.get(p.suffix.lower())
+    if reader is None:
+        raise PoseFileError(f"{p}: unknown pose file extension {p.suffix!r}; use one of {', '.join(_READERS)}")
+    if not p.is_file():
+        raise PoseFileError(f"{p}: no such file")
+    return check_poses(reader(p), f"{p}: poses")
+
+
+def _display_units(robot: Robot) -> list[str]:
+    return ["deg" if rev else robot.length_unit for rev in robot.is_revolute]
+
+
+def write_joint_path(path: str | PathLike[str], q: ArrayLike, robot: Robot) -> Path:
+    """Write a joint path ``q (N, n)`` (radians / length unit) to ``path`` as CSV or JSON (by extension).
+
+    Revolute joints are written in **degrees**, prismatic ones in the robot's length unit; rows of a pose
+    without solution are ``nan`` (CSV) or ``null`` (JSON).
+
+    * CSV: a ``#`` comment line stating robot and units, a header row ``<joint>_<unit>``, one row per point.
+    * JSON: ``{"robot": ..., "joints": [...], "units": [...], "q": [[...], ...]}``.
+
+    Returns the path written. Raises UnknownOptionError for another extension, ShapeError for a bad ``q``.
+    """
+    p = Path(path)
+    qa = np.asarray(q, dtype=np.float64)
+    if qa.ndim != 2 or qa.shape[1] != robot.n_joints:
+        raise ShapeError(f"q must have shape (N, {robot.n_joints}), got {qa.shape}")
+    shown = np.where(robot.is_revolute, np.degrees(qa), qa)
+    units = _display_units(robot)
+    names = robot.joint_names
+    ext = p.suffix.lower()
+    if ext == ".csv":
+        with p.open("w", newline="") as fh:
+            unit_text = ", ".join(f"{nm} in {u}" for nm, u in zip(names, units, strict=True))
+            fh.write(f"# sweepik joint path, robot {robot.name}: {unit_text}\n")
+            w = csv.writer(fh)
+            w.writerow([f"{nm}_{u}" for nm, u in zip(names, units, strict=True)])
+            for row in shown:
+                w.writerow([repr(float(v)) if np.isfinite(v) else "nan" for v in row])
+    elif ext == ".json":
+        rows: Sequence[list[float | None]] = [[float(v) if np.isfinite(v) else None for v in row] for row in shown]
+        doc = {"robot": robot.name, "joints": names, "units": units, "q": rows}
+        p.write_text(json.dumps(doc, indent=1) + "\n")
+    else:
+        raise UnknownOptionError(f"{p}: unknown joint-path file extension {p.suffix!r}; use .csv or .json")
+    return p
