@@ -124,10 +124,11 @@ DEDUP_ANGLE = 1e-6
 PX_SEED = 1e-3
 #: r (scaled) below which theta2 is taken from the r = 0 formula instead of atan2(sigma t, sigma Px).
 R_ZERO = 1e-13
-#: Pose within these of a self-motion pose is reported as degenerate: Px (mm), angle of z from +-x_B (rad).
-#: Both far below POS_TOL_MM / ROT_TOL_RAD, so the neighbouring continuum passes verification.
-DEGEN_PX_MM = 1e-8
-DEGEN_ANGLE = 1e-10
+#: A pose this close to a self-motion pose (|Px| in mm, angle of the tool z axis from +-x_B in rad) is
+#: reported as degenerate: every configuration of the neighbouring continuum then reproduces it within
+#: half the verification tolerance, so no finite list of solutions is meaningful.
+DEGEN_PX_MM = 0.5 * POS_TOL_MM
+DEGEN_ANGLE = 0.5 * ROT_TOL_RAD
 #: h^2 (scaled) slightly negative from rounding is clamped to 0 above this.
 H2_CLAMP = 1e-10
 NEWTON_ITERS = 40
@@ -425,14 +426,18 @@ def carm_ik_oracle_ex(T: ArrayLike, L1: float = 350.0, L2: float = 402.0) -> tup
     degenerate = False
     cands: list[tuple[int, float, Array]] = []  # (priority, error, q); lower priority wins in dedupe
 
-    def add_t(t: float, e: float | None, priority: int) -> None:
+    def add_t(t: float, e: float | None, priority: int) -> int:
+        """Verify the configurations at t (branch e) and keep those that pass; returns how many did."""
         nonlocal degenerate
         qs, deg = P.configs_at(t, e)
         degenerate |= deg
+        n_ok = 0
         for q in qs:
             err = P.verify(q)
             if err is not None:
                 cands.append((priority, err, q))
+                n_ok += 1
+        return n_ok
 
     keep = np.nonzero(np.abs(c) > LEAD_TRIM * big)[0]
     c = c[: keep[-1] + 1]
@@ -450,8 +455,10 @@ def carm_ik_oracle_ex(T: ArrayLike, L1: float = 350.0, L2: float = 402.0) -> tup
             if ratio <= CONVERGED or e == best_e:
                 members[e].append(t1)
     for e in (1.0, -1.0):
-        for t, priority in _branch_roots(P, e, np.sort(members[e]), raw.real, Q):
-            add_t(t, e, priority)
+        for alternatives in _branch_roots(P, e, np.sort(members[e]), raw.real, Q):
+            for t in alternatives:
+                if add_t(t, e, 0):
+                    break
 
     # r = 0 family (wrist centre on the joint-2 axis).
     if abs(P.px) < PX_SEED:
@@ -478,22 +485,23 @@ def carm_ik_oracle(T: ArrayLike, L1: float = 350.0, L2: float = 402.0) -> Array:
     return carm_ik_oracle_ex(T, L1, L2)[0]
 
 
-def _branch_roots(
-    P: _Pose, e: float, members: Array, raw: Array, Q: Polynomial
-) -> list[tuple[float, int]]:
-    """Distinct roots (t, priority) of F_e from its sorted polished roots ``members``.
+def _branch_roots(P: _Pose, e: float, members: Array, raw: Array, Q: Polynomial) -> list[list[float]]:
+    """The distinct roots of F_e, from its sorted polished roots ``members``, each as a list of
+    alternatives (best first; the caller keeps the first that passes the FK check).
 
     Members closer than CLUSTER_TOL form a group. A group whose members agree to rounding is one simple
     root. Otherwise the signs of F_e at the members, at the midpoints between them and just outside the
     group (only values beyond rounding noise count) decide: two or more sign changes are distinct roots,
     each refined by bisection; no sign change is one multiple root (a singular pose), located by
     ``_multiple_root``; one sign change is an odd-multiplicity root (``_multiple_root``, else bisection).
+    The group member with the smallest |F_e| is always the last alternative.
     """
-    out: list[tuple[float, int]] = []
+    out: list[list[float]] = []
     for ta, tb, _ in _clusters(members, CLUSTER_TOL, singletons=True):
         group = members[(members >= ta) & (members <= tb)]
+        best = float(min(group, key=lambda t: abs(P.F(float(t), e)[0])))
         if tb - ta <= SAME_ROOT_TOL * (1.0 + abs(ta)):
-            out.append((float(min(group, key=lambda t: abs(P.F(t, e)[0]))), 0))
+            out.append([best])
             continue
         D = max(tb - ta, 0.5 * CLUSTER_TOL)
         pts = [ta - D]
@@ -509,16 +517,19 @@ def _branch_roots(
                 sig.append((t, float(np.sign(F))))
         changes = [(a[0], b[0]) for a, b in zip(sig[:-1], sig[1:], strict=True) if a[1] != b[1]]
         if len(changes) >= 2:
-            out.extend((_bisect(P, e, lo, hi), 0) for lo, hi in changes)
+            for lo, hi in changes:
+                inside = group[(group >= lo) & (group <= hi)]
+                near = [float(min(inside, key=lambda t: abs(P.F(float(t), e)[0])))] if inside.size else []
+                out.append([_bisect(P, e, lo, hi), *near])
             continue
         outside = (P.F(pts[0], e)[0], P.F(pts[-1], e)[0])
+        alternatives = []
         ts = _multiple_root(P, e, group, outside, len(changes) == 1, raw, Q)
         if ts is not None:
-            out.append((ts, -1))
-        elif changes:
-            out.append((_bisect(P, e, *changes[0]), 0))
-        else:
-            out.append((float(min(group, key=lambda t: abs(P.F(t, e)[0]))), 0))
+            alternatives.append(ts)
+        if changes:
+            alternatives.append(_bisect(P, e, *changes[0]))
+        out.append([*alternatives, best])
     return out
 
 
@@ -546,7 +557,7 @@ def _multiple_root(
     level = max(max(abs(F) for F, _, _ in at_members), CONVERGED * max(n for _, _, n in at_members))
 
     def acceptable(ts: float | None) -> bool:
-        if ts is None or not (ta - CLUSTER_TOL <= ts <= tb + CLUSTER_TOL):
+        if ts is None or not (2.0 * ta - tb - 1e-9 <= ts <= 2.0 * tb - ta + 1e-9):
             return False
         Fs, _, noise = P.F(ts, e)
         if abs(Fs) <= max(CONVERGED * noise, level):

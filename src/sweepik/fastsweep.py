@@ -480,29 +480,39 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int):
 
 if AVAILABLE:
 
-    @njit(cache=True, parallel=True)
-    def _fk_modified(a, alpha, d, theta, rev, base, q, out):
-        """Flange poses (K, 4, 4) of a modified-DH chain (world frame, tool not applied)."""
+    @njit(cache=True)
+    def _fk_one(a, alpha, d, theta, rev, base, q, out, k):
+        """Flange pose of configuration ``q[k]`` of a modified-DH chain (world frame, tool not applied)."""
         n = a.shape[0]
+        T = base.copy()
+        R = np.empty((3, 4))
+        for i in range(n):
+            th = theta[i] + (q[k, i] if rev[i] else 0.0)
+            di = d[i] + (0.0 if rev[i] else q[k, i])
+            ct, st = math.cos(th), math.sin(th)
+            ca, sa = math.cos(alpha[i]), math.sin(alpha[i])
+            # link = [[ct, -st, 0, a], [st ca, ct ca, -sa, -sa d], [st sa, ct sa, ca, ca d], [0, 0, 0, 1]]
+            l00, l01, l02, l03 = ct, -st, 0.0, a[i]
+            l10, l11, l12, l13 = st * ca, ct * ca, -sa, -sa * di
+            l20, l21, l22, l23 = st * sa, ct * sa, ca, ca * di
+            for r in range(3):
+                t0, t1, t2 = T[r, 0], T[r, 1], T[r, 2]
+                R[r, 0] = t0 * l00 + t1 * l10 + t2 * l20
+                R[r, 1] = t0 * l01 + t1 * l11 + t2 * l21
+                R[r, 2] = t0 * l02 + t1 * l12 + t2 * l22
+                R[r, 3] = t0 * l03 + t1 * l13 + t2 * l23 + T[r, 3]
+            T[:3, :] = R
+        out[k] = T
+
+    @njit(cache=True, parallel=True)
+    def _fk_parallel(a, alpha, d, theta, rev, base, q, out):
         for k in prange(q.shape[0]):
-            T = base.copy()
-            for i in range(n):
-                th = theta[i] + (q[k, i] if rev[i] else 0.0)
-                di = d[i] + (0.0 if rev[i] else q[k, i])
-                ct, st = math.cos(th), math.sin(th)
-                ca, sa = math.cos(alpha[i]), math.sin(alpha[i])
-                # link = [[ct, -st, 0, a], [st ca, ct ca, -sa, -sa d], [st sa, ct sa, ca, ca d], [0, 0, 0, 1]]
-                L = np.empty((3, 4))
-                L[0, 0], L[0, 1], L[0, 2], L[0, 3] = ct, -st, 0.0, a[i]
-                L[1, 0], L[1, 1], L[1, 2], L[1, 3] = st * ca, ct * ca, -sa, -sa * di
-                L[2, 0], L[2, 1], L[2, 2], L[2, 3] = st * sa, ct * sa, ca, ca * di
-                R = np.empty((3, 4))
-                for r in range(3):
-                    for c in range(4):
-                        R[r, c] = T[r, 0] * L[0, c] + T[r, 1] * L[1, c] + T[r, 2] * L[2, c]
-                    R[r, 3] += T[r, 3]
-                T[:3, :] = R
-            out[k] = T
+            _fk_one(a, alpha, d, theta, rev, base, q, out, k)
+
+    @njit(cache=True)
+    def _fk_serial(a, alpha, d, theta, rev, base, q, out):
+        for k in range(q.shape[0]):
+            _fk_one(a, alpha, d, theta, rev, base, q, out, k)
 
 
 def flange_poses(robot: Robot, q: Array) -> Array:
@@ -513,7 +523,8 @@ def flange_poses(robot: Robot, q: Array) -> Array:
     if not AVAILABLE or robot.dh_convention != "modified" or q.ndim != 2:
         return kinematics.chain_frames(robot, q)[..., -1, :, :]
     out = np.empty((q.shape[0], 4, 4))
-    _fk_modified(
+    run = _fk_parallel if q.shape[0] >= PARALLEL_MIN * 16 else _fk_serial
+    run(
         robot.dh_a,
         robot.dh_alpha,
         robot.dh_d,

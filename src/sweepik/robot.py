@@ -198,8 +198,30 @@ class Robot:
 
     def within_limits(self, q: ArrayLike) -> NDArray[np.bool_]:
         """``(...)`` bool: all joint values inside their limits (revolute ones after ``wrap``), with ``LIMIT_TOL``."""
+        return self.wrapped_within_limits(q)[1]
+
+    def wrapped_within_limits(self, q: ArrayLike) -> tuple[Array, NDArray[np.bool_]]:
+        """``wrap(q)`` and ``within_limits(q)`` in one pass."""
         w = self.wrap(q)
-        return np.all((w >= self.lower - LIMIT_TOL) & (w <= self.upper + LIMIT_TOL), axis=-1)
+        return w, np.all((w >= self.lower - LIMIT_TOL) & (w <= self.upper + LIMIT_TOL), axis=-1)
+
+    @cached_property
+    def base_is_identity(self) -> bool:
+        return bool(np.array_equal(self.T_world_base, np.eye(4)))
+
+    @cached_property
+    def tool_is_identity(self) -> bool:
+        return bool(np.array_equal(self.T_flange_tool, np.eye(4)))
+
+    @cached_property
+    def T_base_world(self) -> Array:
+        """Inverse of ``T_world_base`` (cached)."""
+        return np.asarray(np.linalg.inv(self.T_world_base), dtype=np.float64)
+
+    @cached_property
+    def T_tool_flange(self) -> Array:
+        """Inverse of ``T_flange_tool`` (cached)."""
+        return np.asarray(np.linalg.inv(self.T_flange_tool), dtype=np.float64)
 
     def dh_table(self) -> list[dict[str, float | str]]:
         """The DH table as rows of plain values (angles in degrees), for display."""

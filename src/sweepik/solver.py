@@ -11,7 +11,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import fastsweep
+from . import fastcertify, fastsweep
 from ._validate import check_poses
 from .errors import ShapeError, UnknownOptionError
 from .paper_sweep import paper_candidates
@@ -49,7 +49,12 @@ CHUNK = 2048
 
 
 def _chain_poses(robot: Robot, poses: Array) -> Array:
-    return np.linalg.inv(robot.T_world_base) @ poses @ np.linalg.inv(robot.T_flange_tool)
+    out = poses
+    if not robot.base_is_identity:
+        out = robot.T_base_world @ out
+    if not robot.tool_is_identity:
+        out = out @ robot.T_tool_flange
+    return out
 
 
 def _theta_range(robot: Robot, red: Reduction, chain: Array, limits: bool) -> tuple[Array, Array]:
@@ -150,42 +155,47 @@ def _solve_chunk(
     lo, hi = _theta_range(robot, red, chain, limits)
     weight = orientation_weight(robot.length_unit)
     spans: list[FamilySpan] = []
+    compiled = red.kernel_id is not None and fastsweep.AVAILABLE
+    err_geo = err_paper = None
     if strategy == "precise":
-        if red.kernel_id is not None and fastsweep.AVAILABLE:
+        if compiled:
             cand, spans = fastsweep.search(red, chain, lo, hi, n_samples)
+            q, err_geo, err_paper = fastcertify.certify(robot, red, chain, poses, cand.pose, cand.theta, cand.branch)
         else:
             cand, spans = find_candidates(red, chain, lo, hi, n_samples)
-        q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+            q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         pose_idx = cand.pose
         special = red.special_solutions(chain)
         if special is not None:
-            sp_ok = np.all(np.isfinite(special), axis=-1)
-            sp_p, sp_k = np.nonzero(sp_ok)
-            q = np.concatenate([q, special[sp_p, sp_k]])
+            sp_p, sp_k = np.nonzero(np.all(np.isfinite(special), axis=-1))
+            q_sp = special[sp_p, sp_k]
+            if err_geo is not None and err_paper is not None:
+                eg_sp, ep_sp = _errors(robot, q_sp, poses[sp_p], weight)
+                err_geo, err_paper = np.concatenate([err_geo, eg_sp]), np.concatenate([err_paper, ep_sp])
+            q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
     else:
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
     finite = np.all(np.isfinite(q), axis=-1)
     pose_idx, q = pose_idx[finite], q[finite]
-    T = fastsweep.flange_poses(robot, q) @ robot.T_flange_tool
     target = poses[pose_idx]
-    err_geo = pose_error_geodesic(T, target, weight)
+    if err_geo is None or err_paper is None:
+        err_geo, err_paper = _errors(robot, q, target, weight)
+    else:
+        err_geo, err_paper = err_geo[finite], err_paper[finite]
     if strategy == "precise":
         near = np.nonzero(
             (err_geo <= POLISH_BELOW_REL * robot.length_scale) & (err_geo > POLISH_ABOVE_REL * robot.length_scale)
         )[0]
         if near.size:
             q[near] = polish(robot, q[near], target[near], weight)
-            T[near] = fastsweep.flange_poses(robot, q[near]) @ robot.T_flange_tool
-            err_geo[near] = pose_error_geodesic(T[near], target[near], weight)
-    err_paper = pose_error_paper(T, target, weight)
+            err_geo[near], err_paper[near] = _errors(robot, q[near], target[near], weight)
     if strategy == "precise":
         certified = err_geo <= ACCEPT_TOL_REL * robot.length_scale
     else:
         certified = err_paper < PAPER_ACCEPT_MM / mm_per_unit(robot.length_unit)
     pose_idx, q, err_paper, err_geo = pose_idx[certified], q[certified], err_paper[certified], err_geo[certified]
-    q = robot.wrap(q)
-    inside = robot.within_limits(q)
+    q, inside = robot.wrapped_within_limits(q)
     n_reachable = np.bincount(pose_idx, minlength=len(poses))
     if limits:
         pose_idx, q, err_paper, err_geo, inside = (
@@ -252,6 +262,12 @@ def _solve_chunk(
             )
         )
     return results
+
+
+def _errors(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array, Array]:
+    """Geodesic error and the paper's J ``(K,)`` of configurations ``q (K, n)`` against ``target (K, 4, 4)``."""
+    T = fastsweep.flange_poses(robot, q) @ robot.T_flange_tool
+    return pose_error_geodesic(T, target, weight), pose_error_paper(T, target, weight)
 
 
 def _check_strategy(strategy: str) -> None:

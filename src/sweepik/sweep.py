@@ -20,6 +20,7 @@ configurations, certifies each by forward kinematics and applies limits.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -89,9 +90,14 @@ class FamilySpan:
     hi: float
 
 
+@lru_cache(maxsize=8)
+def _unit_grid(n: int) -> Array:
+    return np.linspace(0.0, 1.0, n)
+
+
 def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
     """Sorted theta* samples ``(N, M)``: a uniform grid on [lo, hi] plus the reduction's hints inside it."""
-    s = np.linspace(0.0, 1.0, n_samples)
+    s = _unit_grid(n_samples)
     grid = lo[:, None] + (hi - lo)[:, None] * s[None, :]
     hints = reduction.sample_hints(poses)
     if hints is not None and hints.size:

@@ -35,6 +35,7 @@ BLIND_PX_REL = 1e-2
 BLIND_COS = 2e-2
 #: Number of extra samples placed across the narrow window |Pz - d1| ~ |Px| where theta2 swings by pi.
 _SWING_SAMPLES = 16
+_TAN_SWING = np.tan(np.linspace(-np.pi / 2, np.pi / 2, _SWING_SAMPLES + 2)[1:-1])
 
 
 def carm_lengths(robot: Robot) -> tuple[float, float]:
@@ -177,8 +178,7 @@ class CArmD1(_CArmBase):
             t_out = np.sqrt((L1 + L2) ** 2 - q2)  # NaN where no d1 reaches the wrist
             t_in = np.sqrt((L1 - L2) ** 2 - q2)
         # theta2 swings by pi across |t| ~ |Px| around d1 = Pz: sample that window densely in angle.
-        phi = np.linspace(-np.pi / 2, np.pi / 2, _SWING_SAMPLES + 2)[1:-1]
-        swing = Pz[:, None] - np.abs(Px)[:, None] * np.tan(phi)[None, :]
+        swing = Pz[:, None] - np.abs(Px)[:, None] * _TAN_SWING[None, :]
         cols = [Pz - t_out, Pz + t_out, Pz - t_in, Pz + t_in, Pz]
         return np.concatenate([np.stack(cols, axis=-1), swing], axis=-1)
 
@@ -190,10 +190,10 @@ class CArmD1(_CArmBase):
     def special_solutions(self, poses: Array) -> Array | None:
         """Wrist on joint 2's axis (Px = 0, d1 = Pz): u = 0, theta34 from the elbow, theta2 from the
         orientation (``A cos theta2 + B sin theta2 = c``). 4 candidates per pose (NaN where none)."""
-        Px, Py, Pz, z, R = _unpack(poses, 0)
-        sel = np.abs(Px) <= 1e-9 * (self.L1 + self.L2)
+        sel = np.abs(poses[:, 0, 3]) <= 1e-9 * (self.L1 + self.L2)
         if not sel.any():
             return None
+        Px, Py, Pz, z, R = _unpack(poses, 0)
         out = []
         for eps in (1.0, -1.0):
             c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))

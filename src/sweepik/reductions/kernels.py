@@ -72,3 +72,61 @@ if _njit is not None:
     residual_by_id = _njit(cache=True)(_dispatch)
 else:  # pragma: no cover
     residual_by_id = _dispatch
+
+
+def _carm_configuration(kid: int, p, R, x: float, b: int, out) -> None:
+    """Full configuration of branch ``b`` at theta* = ``x`` into ``out (6,)`` (NaN where the branch does not
+    exist), as CArmD1/CArmTheta2.solve_rest; ``R`` is the chain pose's rotation (3, 3)."""
+    Px, Py, Pz, L1, L2 = p[0], p[1], p[2], p[6], p[7]
+    if kid == CARM_D1:
+        sigma = 1.0 if b < 2 else -1.0
+        eps = 1.0 if b % 2 == 0 else -1.0
+        d1 = x
+        t = Pz - d1
+        r = math.hypot(Px, t)
+        if r > 0.0:
+            c2, s2 = sigma * Px / r, sigma * t / r
+        else:
+            c2, s2 = sigma, 0.0
+        u = sigma * r
+    else:
+        eps = 1.0 if b == 0 else -1.0
+        c2, s2 = math.cos(x), math.sin(x)
+        if abs(c2) <= 1e-300:
+            for i in range(6):
+                out[i] = math.nan
+            return
+        u = Px / c2
+        d1 = Pz - s2 * u
+    rho2 = u * u + Py * Py
+    k = (rho2 + L2 * L2 - L1 * L1) / (2.0 * L2)
+    disc = rho2 - k * k
+    if disc < -DISC_TOL * (L1 + L2) ** 2:
+        for i in range(6):
+            out[i] = math.nan
+        return
+    s = eps * math.sqrt(max(disc, 0.0))
+    c34 = (k * u - s * Py) / rho2
+    s34 = (k * Py + s * u) / rho2
+    th3 = math.atan2(u - L2 * c34, L2 * s34 - Py)
+    th4 = math.atan2(s34, c34) - th3
+    th4 = math.pi - ((math.pi - th4) % (2.0 * math.pi))
+    # V = R_B2^T R_D rows, N = R_24^T V
+    v0 = (c2 * R[0, 0] + s2 * R[2, 0], c2 * R[0, 1] + s2 * R[2, 1], c2 * R[0, 2] + s2 * R[2, 2])
+    v1z = -s2 * R[0, 2] + c2 * R[2, 2]
+    v2 = (-R[1, 0], -R[1, 1], -R[1, 2])
+    n0z = s34 * v0[2] + c34 * v2[2]
+    n1x = c34 * v0[0] - s34 * v2[0]
+    n1y = c34 * v0[1] - s34 * v2[1]
+    out[0] = d1
+    out[1] = math.atan2(s2, c2)
+    out[2] = th3
+    out[3] = th4
+    out[4] = math.atan2(n0z, v1z)
+    out[5] = math.atan2(n1x, n1y)
+
+
+if _njit is not None:
+    configuration_by_id = _njit(cache=True)(_carm_configuration)
+else:  # pragma: no cover
+    configuration_by_id = _carm_configuration
