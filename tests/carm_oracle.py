@@ -44,40 +44,63 @@ Write the desired pose as R_D (tool z axis ``z = R_D[:, 2]``) and P = (Px, Py, P
   (zy^2 + zz^2) / (4 L2^2), so **Q has degree 8** unless the tool z axis is parallel to the base x axis
   (then degree <= 6, and Q vanishes identically if in addition Px = 0: see "Degenerate poses").
 
-What the roots mean: each real root t of Q with h^2 >= 0 and r > 0 is a rail position d1 = Pz - t at
-which F_e = 0 for e = +1 or -1, and then *two* configurations exist, (sigma, eps) = (+1, e) and (-1, -e)
-(theta2 differs by pi between them: the "alternate solution 180 deg off" of the paper's Figure 4). Hence
-at most 8 rail positions and at most 16 configurations per pose; generic poses have 0, 2, 4, ... Real
-roots with h^2 < 0 are spurious (only possible where both sides of Q vanish) and are removed by the FK
-check. Complex roots are not solutions.
+What the roots mean: each real root t of Q (with r > 0) is a rail position d1 = Pz - t at which
+F_e = 0 for e = +1 or -1, and then *two* configurations exist, (sigma, eps) = (+1, e) and (-1, -e):
+theta2 differs by pi between them (the "alternate solution 180 deg off" of the paper's Figure 4), and
+theta3, theta5 change sign. Where both F_+ and F_- vanish at the same t there are four. Hence at most 8 rail
+positions and 16 configurations per pose. Measured over 40,000 random reachable poses: 2, 4 or 6 rail
+positions (4, 8 or 12 configurations; 71 %, 29 %, 0.75 %), always exactly 2 x (number of real roots of
+Q); within the paper's joint limits up to 6 distinct d1 values occur (about 1 pose in 900), although the
+paper reports at most four. Every real root of Q is a solution: where h^2 < 0, Q = r^2 k^2 A^2 - h^2 G^2
+is a sum of squares and vanishes only if both terms do (those rare points fail the FK check). Complex
+roots are not solutions.
 
 Numerics
 --------
-Lengths are scaled by L1 + L2 so that Q's coefficients are O(1) and every valid root has |t| <= 1. Q is
-built with ``numpy.polynomial.Polynomial`` arithmetic (exact coefficient algebra), leading coefficients
-negligible relative to the largest are trimmed (they only carry roots at |t| >> 1, which cannot be
-reached), and the roots come from ``np.roots`` (companion-matrix eigenvalues). Roots with a small
-imaginary part are kept (a double root is returned by the eigensolver as two roots split by
-~sqrt(eps), often as a complex pair), then each is polished by Newton's method on the unsquared F_e of
-whichever branch vanishes. Roots that cluster after polishing are a multiple root; the root of the
-(m-1)-th derivative of Q (a simple root) is then used as well, which locates a double root to full
-precision. Every candidate is expanded into its branches, verified by FK (position < 1e-6 mm, rotation
-< 1e-8 rad), and duplicates are merged (d1 within ``DEDUP_D1_MM``, angles within ``DEDUP_ANGLE``
-modulo 2 pi). A double root of Q is therefore returned once.
+* Lengths are scaled by L1 + L2, so Q's coefficients are O(1) and every valid root has |t| <= 1. Q is
+  built with ``numpy.polynomial.Polynomial`` arithmetic (exact coefficient algebra, no fitting); leading
+  coefficients negligible next to the largest are trimmed (they only carry roots at |t| >> 1, which cannot
+  be reached: the t^8 coefficient vanishes when the tool z axis is +-x_B), and the roots come from
+  ``np.roots`` (companion-matrix eigenvalues). Roots with |imag| < ``IMAG_TOL`` are candidates: a root of
+  multiplicity m comes back as m roots scattered by ~eps^(1/m), often as a complex pair.
+* Each candidate is polished by Newton's method on the unsquared F_+ and on F_- (F is evaluated with a
+  rounding-error bound, calibrated against long-double evaluation). It becomes a root of each branch
+  where F_e then vanishes to rounding (and of the better branch at least).
+* Per branch, polished roots closer than ``CLUSTER_TOL`` form a group. A group that agrees to rounding is
+  one simple root. Otherwise the signs of F_e at and between the members and just outside the group
+  decide: two or more sign changes are distinct close roots (each refined by bisection); none is a
+  multiple root (a singular pose, where Newton stalls ~1e-8 away), located to full precision as the simple
+  root of Q^(m-1) (m = raw roots in the cluster) or of F_e'; one is an odd-multiplicity root. A multiple
+  root is returned once.
+* Every root is expanded into its two configurations and verified by FK (paper eqs. 1b, 1c): position
+  < ``POS_TOL_MM`` = 1e-6 mm and rotation < ``ROT_TOL_RAD`` = 1e-8 rad; if a root's best estimate fails,
+  the next alternative of its group is tried. Solutions equal within ``DEDUP_D1_MM`` and ``DEDUP_ANGLE``
+  (angles modulo 2 pi) are merged.
 
 Special case r = 0 (Px = 0 and d1 = Pz): the wrist centre lies on the joint-2 axis and theta2 is not
-fixed by the {2,4} entry. Then u = 0 and theta2 solves C34 (C2 zx + S2 zz) = -S34 zy directly. For tiny
-but non-zero |Px| these solutions sit at t = Px tan(theta2); they are used as Newton seeds, because the
-eigenvalue roots of Q near t = 0 are too inaccurate there.
+fixed by the {2,4} entry (Q has a spurious double root at t = 0 from the r^2 factors). Then u = 0 and
+theta2 solves C34 (C2 zx + S2 zz) = -S34 zy directly (up to 2 per elbow branch). For tiny non-zero |Px|
+these solutions sit at t = Px tan(theta2) and are used as Newton seeds, because the eigenvalue roots of Q
+near t = 0 are too inaccurate there.
+
+Accuracy limits (inherent, not of the method): at and near singular poses (e.g. theta2 = +-90 deg with
+theta3 = 0, where F_e has a double root) two solutions merge; a pose computed by FK in double precision
+then has, exactly, two real solutions about 1e-5 mm from the generating q or none (a complex pair),
+which was confirmed with long-double arithmetic. The oracle returns what the rounded pose admits, so a
+"contains the generating q within 1e-6 mm" test can fail there by ~1e-5 mm.
 
 Degenerate poses (continua of solutions)
 ----------------------------------------
 * Tool z axis = +-x_B and Px = 0 (e.g. theta2 = +-90 deg with theta5 = 0): joints 3, 4 and 6 are parallel
-  and the rail moves in their common normal plane, so there is a one-parameter self-motion: every d1 with
-  |L1 - L2| <= rho <= L1 + L2 works. Here Q vanishes identically (A = B = G = 0). The oracle returns no
-  solutions and ``degenerate=True``.
-* r = 0 with C34 = 0 and zy = 0 (wrist on the joint-2 axis at the workspace boundary): joints 2 and 5 are
-  coaxial and theta2 is free at that d1. Isolated solutions are still returned; ``degenerate=True``.
+  to x_B and the rail (z_B) lies in their common normal plane, so there is a one-parameter self-motion:
+  every d1 with |L1 - L2| <= rho <= L1 + L2 works. Here Q vanishes identically (A = B = G = 0). The
+  oracle returns no solutions and ``degenerate=True``, also for poses within half the verification
+  tolerance of such a pose (|Px| < 5e-7 mm, angle(z, +-x_B) < 5e-9 rad), where a whole continuum of
+  configurations passes the FK check. Slightly farther away (up to ~1e-6 rad) the pose is near-continuum:
+  many verified near-solutions (up to ~28) are returned.
+* r = 0 with C34 = 0 and zy = 0 (wrist centre on the joint-2 axis at the workspace boundary): joints 2
+  and 5 are coaxial and theta2 is free at that d1. Isolated solutions are still returned, with
+  ``degenerate=True``.
 """
 
 from __future__ import annotations
@@ -105,9 +128,9 @@ ROT_TOL_RAD = 1e-8
 IMAG_TOL = 1e-3
 #: Leading coefficients of Q below this fraction of the largest are dropped (their roots have |t| >> 1).
 LEAD_TRIM = 1e-13
-#: Roots of one branch F_e, polished to rounding level, that lie closer than this (scaled t) are tested
-#: for being one double root (``_Pose.double_root``: F_e touches zero without a sign change). Newton leaves
-#: a double root scattered by ~1e-8; distinct roots inside a cluster are recognised by the sign test.
+#: Roots of one branch F_e, polished to rounding level, closer than this (scaled t) form a group that is
+#: tested for being one multiple root (``_branch_roots``). Newton leaves a double root scattered by ~1e-8;
+#: distinct roots inside a group are recognised by the sign test.
 CLUSTER_TOL = 1e-5
 #: A polished t counts as a root of F_e when |F_e| <= CONVERGED * (its rounding-noise estimate).
 CONVERGED = 4.0
@@ -116,8 +139,9 @@ SAME_ROOT_TOL = 1e-12
 #: Raw roots of Q closer than this (scaled t) are tested as one multiple root (a root of multiplicity m
 #: is scattered by ~eps^(1/m): 1e-8 for m = 2, 1e-4 for m = 4).
 RAW_CLUSTER_TOL = 1e-3
-#: Verified solutions closer than this are one solution (d1 in mm, angles in rad modulo 2 pi). Larger than
-#: the scatter of a double root polished by Newton (~1e-8 * 752 mm in d1).
+#: Verified solutions closer than this are one solution (d1 in mm, angles in rad modulo 2 pi): e.g. the
+#: two elbow branches at h = 0 (angles there are only good to ~sqrt(eps)), or an r = 0 solution found both
+#: from a seed and from Q. Distinct solutions are far apart except within ~1e-8 of a singular pose.
 DEDUP_D1_MM = 1e-5
 DEDUP_ANGLE = 1e-6
 #: Below this |Px| (scaled) the r = 0 solutions are added as Newton seeds (see module docstring).
@@ -401,10 +425,18 @@ def _dedupe(cands: list[tuple[int, float, Array]]) -> list[Array]:
 def carm_ik_oracle_ex(T: ArrayLike, L1: float = 350.0, L2: float = 402.0) -> tuple[Array, bool]:
     """All real IK solutions of one pose, and whether the pose has a continuum of solutions.
 
-    Parameters: ``T (4, 4)`` desired tool pose in the base frame (mm). Returns ``(q (k, 6), degenerate)``
-    with rows [d1 mm, theta2..theta6 rad], angles in (-pi, pi], sorted by d1 then theta2; no joint limits.
-    Every row reproduces T by FK within 1e-6 mm and 1e-8 rad. ``degenerate`` is True when the solution set
-    contains a continuum (self-motion); then only isolated solutions are listed (none when Q == 0).
+    Parameters: ``T (4, 4)`` desired tool pose in the base frame (mm); ``L1``, ``L2`` in mm. Returns
+    ``(q (k, 6), degenerate)`` with rows [d1 mm, theta2..theta6 rad], angles wrapped to (-pi, pi], sorted
+    by d1 then theta2, no joint limits, duplicates removed. Every row reproduces T by FK within
+    ``POS_TOL_MM`` and ``ROT_TOL_RAD``. ``degenerate`` is True when the solutions form a continuum
+    (self-motion): at (or within half the tolerance of) a pose with tool z = +-x_B and Px = 0, ``q`` is
+    empty; in the rare coaxial r = 0 case the isolated solutions are still listed. Unreachable poses give
+    ``(empty, False)``.
+
+    >>> q = [500.0, 0.3, 0.2, -0.4, 1.0, 0.5]
+    >>> sols = carm_ik_oracle(carm_fk(q))
+    >>> sols.shape[1], bool(np.any(np.all(np.abs(sols - q) < 1e-9, axis=1)))
+    (6, True)
     """
     T = np.asarray(T, dtype=np.float64)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
@@ -546,9 +578,10 @@ def _multiple_root(
 
     np.roots returns a root of multiplicity m as m roots scattered by ~eps^(1/m), and the root of Q^(m-1)
     is simple: it is tried for m = (raw roots nearby) down to 2, then the root of F_e'. A candidate must lie
-    at the group and make F_e vanish to the rounding level seen across the group; for an even multiplicity (``odd`` False) it is also accepted if
-    F_e there has the sign F_e has on both sides (``outside``: F_e just left and right of the group), i.e.
-    touches zero without crossing (a near-double root).
+    at the group and make F_e vanish to the rounding level seen across the group; for an even
+    multiplicity (``odd`` False) it is also accepted if F_e there has the sign F_e has on both sides
+    (``outside``: F_e just left and right of the group), i.e. touches zero without crossing (a near-double
+    root).
     """
     ta, tb = float(group[0]), float(group[-1])
     at_members = [P.F(float(t), e) for t in group]

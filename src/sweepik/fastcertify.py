@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from .fastsweep import AVAILABLE, _fk_one
+from .fastsweep import AVAILABLE, PARALLEL_MIN, _fk_one
 from .pose import GIMBAL_TOL
 from .reductions.kernels import configuration_by_id
 
@@ -20,7 +20,7 @@ Array = NDArray[np.float64]
 _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
 
 if AVAILABLE:
-    from numba import njit
+    from numba import njit, prange
 
     @njit(cache=True)
     def _wrap(x):
@@ -67,31 +67,39 @@ if AVAILABLE:
         return geo, math.sqrt(dp * dp + (weight * jo) ** 2)
 
     @njit(cache=True)
-    def _certify(
+    def _certify_one(kid, params, chain, world, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, i, k):
+        """Configuration of candidate k (pose i) into q[k]; returns (geodesic error, paper J)."""
+        configuration_by_id(kid, params[i], chain[i], theta[k], branch[k], q[k])
+        if not np.all(np.isfinite(q[k])):
+            return np.inf, np.inf
+        F = np.empty((1, 4, 4))
+        qq = np.empty((1, a.shape[0]))
+        qq[0] = q[k]
+        _fk_one(a, alpha, d, th0, rev, base, qq, F, 0)
+        T = np.zeros((4, 4))  # flange @ tool, without BLAS
+        for r in range(4):
+            for c in range(4):
+                T[r, c] = F[0, r, 0] * tool[0, c] + F[0, r, 1] * tool[1, c] + F[0, r, 2] * tool[2, c]
+                T[r, c] += F[0, r, 3] * tool[3, c]
+        return _errors(T, world[i], weight)
+
+    @njit(cache=True, parallel=True)
+    def _certify_parallel(
         kid, params, chain, world, pose, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, err_geo, err_paper
     ):
-        n = a.shape[0]
-        F = np.empty((1, 4, 4))
-        qq = np.empty((1, n))
+        for k in prange(pose.shape[0]):
+            err_geo[k], err_paper[k] = _certify_one(
+                kid, params, chain, world, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, pose[k], k
+            )
+
+    @njit(cache=True)
+    def _certify_serial(
+        kid, params, chain, world, pose, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, err_geo, err_paper
+    ):
         for k in range(pose.shape[0]):
-            i = pose[k]
-            configuration_by_id(kid, params[i], chain[i], theta[k], branch[k], q[k])
-            if not np.all(np.isfinite(q[k])):
-                err_geo[k] = np.inf
-                err_paper[k] = np.inf
-                continue
-            qq[0] = q[k]
-            _fk_one(a, alpha, d, th0, rev, base, qq, F, 0)
-            T = np.zeros((4, 4))  # flange @ tool, without BLAS
-            for r in range(4):
-                for c in range(4):
-                    T[r, c] = (
-                        F[0, r, 0] * tool[0, c]
-                        + F[0, r, 1] * tool[1, c]
-                        + F[0, r, 2] * tool[2, c]
-                        + F[0, r, 3] * tool[3, c]
-                    )
-            err_geo[k], err_paper[k] = _errors(T, world[i], weight)
+            err_geo[k], err_paper[k] = _certify_one(
+                kid, params, chain, world, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, pose[k], k
+            )
 
 
 def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch):
@@ -101,7 +109,8 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch):
     q = np.empty((K, robot.n_joints))
     eg = np.empty(K)
     ep = np.empty(K)
-    _certify(
+    run = _certify_parallel if K >= 16 * PARALLEL_MIN else _certify_serial
+    run(
         red.kernel_id,
         np.ascontiguousarray(red.kernel_params(chain)),
         np.ascontiguousarray(chain),

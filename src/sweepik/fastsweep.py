@@ -39,6 +39,7 @@ MAX_LEVELS = _ref.MAX_LEVELS
 BEND = _ref.BEND
 XTOL_REL = _ref.XTOL_REL
 DIFF_STEP_REL = _ref.DIFF_STEP_REL
+EXTREMUM_REACH = _ref.EXTREMUM_REACH
 CLUSTER_FAMILY_REL = _ref.CLUSTER_FAMILY_REL
 CLUSTER_REACH = _ref.CLUSTER_REACH
 FLAT_PROBE_REL = _ref.FLAT_PROBE_REL
@@ -227,7 +228,10 @@ if AVAILABLE:
         for j in range(1, M - 1):  # interior extrema of |f| without a sign change
             if valid[j - 1] and valid[j] and valid[j + 1] and th[j + 1] > th[j - 1]:
                 fm, fc, fp = f[j - 1], f[j], f[j + 1]
-                if abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0:
+                hl, hr = th[j] - th[j - 1], th[j + 1] - th[j]
+                ddj = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr) if hl > 0 and hr > 0 else np.inf
+                may_touch = abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2
+                if abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0 and may_touch:
                     _extremum(kid, p, b, th[j - 1], th[j], th[j + 1], fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
         for j in range(M):  # samples next to a domain edge (or at the range ends, level 0)
             if not valid[j]:
@@ -454,15 +458,15 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int):
         fcnt,
     )
     over = (cnt > MAX_CAND) | (fcnt > MAX_FAM)
-    ok = ~over
-    take = np.arange(MAX_CAND)[None, :] < np.minimum(cnt, MAX_CAND)[:, None]
-    take &= ok[:, None]
-    pose_idx, slot = np.nonzero(take)
+    counts = np.where(over, 0, cnt)
+    pose_idx = np.repeat(np.arange(N), counts)
+    slot = np.arange(pose_idx.size) - np.repeat(np.cumsum(counts) - counts, counts)
     cand_p, cand_b, cand_t = [pose_idx], [out_b[pose_idx, slot]], [out_t[pose_idx, slot]]
     spans: list[_ref.FamilySpan] = []
-    fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(fcnt, MAX_FAM)[:, None]) & ok[:, None])
-    for i, k in zip(fp, fs, strict=True):
-        spans.append(_ref.FamilySpan(int(i), int(fam[i, k, 2]), float(fam[i, k, 0]), float(fam[i, k, 1])))
+    if fcnt.any():
+        fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(fcnt, MAX_FAM)[:, None]) & ~over[:, None])
+        for i, k in zip(fp, fs, strict=True):
+            spans.append(_ref.FamilySpan(int(i), int(fam[i, k, 2]), float(fam[i, k, 0]), float(fam[i, k, 1])))
     if over.any():
         idx = np.nonzero(over)[0]
         c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples)

@@ -82,6 +82,14 @@ def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> N
     keep = np.ones(K, dtype=bool)
     if K == 0:
         return keep
+    if K <= _DEDUPE_PAIRWISE:  # small sets (a single pose): all pairs at once, fewer array operations
+        tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
+        d = q[:, None, :] - q[None, :, :]
+        d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
+        same = np.all(d <= tol, axis=-1) & (pose_idx[:, None] == pose_idx[None, :])
+        idx = np.arange(K)
+        better = (err[None, :] < err[:, None]) | ((err[None, :] == err[:, None]) & (idx[None, :] < idx[:, None]))
+        return ~np.any(same & better, axis=1)
     tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
     keys = np.round(q / (10.0 * tol))
     order = np.lexsort((*keys.T[::-1], pose_idx))
@@ -105,6 +113,8 @@ def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> N
 
 #: Candidates compared by ``_dedupe`` on each side in sorted order (duplicates of one solution are few).
 _DEDUPE_WINDOW = 16
+#: Up to this many candidates, ``_dedupe`` compares all pairs directly.
+_DEDUPE_PAIRWISE = 48
 
 
 def _families(

@@ -41,6 +41,9 @@ MAX_LEVELS = 4
 #: below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step), and always next to
 #: a domain edge or range end (no curvature estimate there; square-root behaviour at a domain edge).
 BEND = 1.0
+#: An interior extremum of |residual| is examined only if its sample is within EXTREMUM_REACH |f''| h^2 of
+#: zero: 8 times the deepest dip a parabola through the three samples can have (|f''| h^2 / 2).
+EXTREMUM_REACH = 4.0
 _U_UNIFORM = np.linspace(0.0, 1.0, SUB_SAMPLES + 2)
 _U_EDGE = 0.5 * (1.0 - np.cos(np.pi * _U_UNIFORM))
 #: |residual| at or below which a sample counts as lying on a self-motion family (residuals are computed to
@@ -162,12 +165,18 @@ class _Search:
         # 3) interior extrema of |f| with no sign change around them
         if M >= 3:
             fm, fc, fp = fin[:, :-2], fin[:, 1:-1], fin[:, 2:]
+            hl, hr = th[:, 1:-1] - th[:, :-2], th[:, 2:] - th[:, 1:-1]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                dd = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr)
+                # a parabola through the samples dips at most |f''| h^2 / 2 below the middle one
+                may_touch = np.abs(fc) <= EXTREMUM_REACH * np.abs(dd) * np.maximum(hl, hr) ** 2
             ext = (
                 (absf[:, 1:-1] <= absf[:, :-2])
                 & (absf[:, 1:-1] <= absf[:, 2:])
                 & (fm * fc > 0)
                 & (fc * fp > 0)
                 & (th[:, 2:] > th[:, :-2])
+                & may_touch
             )
             e_i, e_j = np.nonzero(ext)
             if e_i.size:
