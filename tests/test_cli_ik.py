@@ -1,0 +1,119 @@
+"""CLI: solve, path, verify, bench (small sizes); errors are one line with exit status 2."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sweepik import load_robot
+from sweepik.cli import main
+from sweepik.pose import xyz_zyz_from_pose
+
+CARM = load_robot("carm")
+
+
+def _xyz_zyz_args(q: np.ndarray) -> list[str]:
+    xyz, zyz = xyz_zyz_from_pose(CARM.fk(q))
+    return ["--xyz", *map(repr, xyz.tolist()), "--zyz", *map(repr, np.degrees(zyz).tolist())]
+
+
+def test_solve_xyz_zyz_json_contains_generating_configuration(capsys: pytest.CaptureFixture[str]) -> None:
+    q = np.array([700.0, 0.4, 0.3, -0.5, 0.6, -0.2])
+    assert main(["solve", "carm", *_xyz_zyz_args(q), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    sols = np.array(out["poses"][0]["q"])
+    d = np.abs(np.pi - np.mod(np.pi - (sols - q), 2 * np.pi))
+    d[:, 0] = np.abs(sols[:, 0] - q[0])
+    assert d.max(axis=1).min() < 1e-6
+    assert max(out["poses"][0]["error_J"]) <= 1e-9
+
+
+def test_solve_matrix_table_and_nearest(capsys: pytest.CaptureFixture[str]) -> None:
+    q = np.array([900.0, -0.7, 0.5, -0.9, 1.1, 0.3])
+    matrix = [repr(float(v)) for v in CARM.fk(q).ravel()]
+    nearest = [repr(float(v)) for v in np.where(CARM.is_revolute, np.degrees(q), q)]
+    assert main(["solve", "--matrix", *matrix, "--nearest", *nearest]) == 0
+    out = capsys.readouterr().out
+    assert "solution(s)" in out and "nearest:" in out
+    near = [float(v) for v in out.strip().splitlines()[-1].split(":")[1].split()]
+    np.testing.assert_allclose(near, np.where(CARM.is_revolute, np.degrees(q), q), atol=1e-6)
+
+
+def test_solve_poses_file_and_unreachable(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    T = CARM.fk(np.array([[500.0, 0.1, 0.2, 0.3, 0.4, 0.5], [1200.0, -0.1, 0.2, -0.3, 0.4, -0.5]]))
+    far = np.eye(4)
+    far[:3, 3] = [9000.0, 0.0, 0.0]
+    np.save(tmp_path / "poses.npy", np.concatenate([T, far[None]]))
+    assert main(["solve", "--poses", str(tmp_path / "poses.npy"), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [len(p["q"]) > 0 for p in out["poses"]] == [True, True, False]
+    assert "unreachable" in out["poses"][2]["reason"]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["solve"],  # no pose
+        ["solve", "--xyz", "1", "2", "3", "--matrix", *["0"] * 16],  # two poses
+        ["solve", "--xyz", "1", "2", "nan"],
+        ["solve", "--matrix", *["1"] * 16],  # not a rigid transform
+        ["solve", "--xyz", "1", "2", "3", "--reduction", "nope"],
+        ["solve", "nosuchrobot", "--xyz", "1", "2", "3"],
+        ["solve", "--poses", "/no/such/file.csv"],
+    ],
+)
+def test_solve_bad_input_is_one_line_exit_2(capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) >= 1 and err[-1].startswith("sweepik")
+    assert "Traceback" not in "\n".join(err)
+
+
+def test_path_writes_joint_csv(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    q = np.array([800.0, 0.3, 0.2, -0.4, 0.5, 0.1]) + np.linspace(0, 0.05, 6)[:, None]
+    np.save(tmp_path / "path.npy", CARM.fk(q))
+    start = [repr(float(v)) for v in np.where(CARM.is_revolute, np.degrees(q[0]), q[0])]
+    out_file = tmp_path / "joints.csv"
+    assert main(["path", "carm", str(tmp_path / "path.npy"), "--start", *start, "-o", str(out_file)]) == 0
+    assert "branch switches: 0" in capsys.readouterr().out
+    rows = np.loadtxt(out_file, delimiter=",", comments="#", skiprows=2)
+    np.testing.assert_allclose(rows, np.where(CARM.is_revolute, np.degrees(q), q), atol=1e-6)
+
+
+def test_verify_json_contract(monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    import sweepik.verify as verify
+
+    full = verify.grid_configurations
+
+    def small(include_singular: bool = False) -> np.ndarray:
+        return full(include_singular)[::97]
+
+    monkeypatch.setattr(verify, "grid_configurations", small)
+    assert main(["verify", "--strategy", "precise", "--offgrid", "50", "--json", str(tmp_path / "out.json")]) == 0
+    res = json.loads((tmp_path / "out.json").read_text())
+    for key in ("grid", "grid_all", "offgrid", "trajectory"):
+        for metric in ("points", "recall", "J_max", "J_mean", "J_99_6", "seconds_per_point"):
+            assert metric in res[key]
+        assert res[key]["recall"] == 1.0
+        assert res[key]["J_max"] <= 1e-9
+    assert "max_joint_step" in res["trajectory"] and res["trajectory"]["points"] >= 40
+    assert "paper" in capsys.readouterr().out
+
+
+def test_bench_runs_small(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    import sweepik.bench as bench
+
+    monkeypatch.setattr(bench, "grid_configurations", lambda include_singular=False: bench_grid_small())
+    assert main(["bench", "--single", "20", "--paper", "5", "--memory", "0", "--repeats", "1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["grid_precise"]["poses"] == 100 and out["single_pose"]["poses"] == 20
+    assert out["grid_precise"]["us_per_pose"] > 0
+
+
+def bench_grid_small() -> np.ndarray:
+    from sweepik.verify import grid_configurations
+
+    return grid_configurations(False)[::159][:100]
