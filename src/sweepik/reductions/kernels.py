@@ -23,17 +23,21 @@ CARM_D1 = 0
 CARM_THETA2 = 1
 
 
-def _elbow_residual(
-    c2: float, s2: float, u: float, Py: float, zx: float, zy: float, zz: float, eps: float, L1: float, L2: float
-) -> float:
+def _elbow(u: float, Py: float, eps: float, L1: float, L2: float) -> tuple[float, float]:
+    """(C34, S34) of the planar two-link problem (NaN outside its domain), as carm._CArmBase._elbow."""
     rho2 = u * u + Py * Py
     k = (rho2 + L2 * L2 - L1 * L1) / (2.0 * L2)
     disc = rho2 - k * k
     if disc < -DISC_TOL * (L1 + L2) ** 2:
-        return math.nan
+        return math.nan, math.nan
     s = eps * math.sqrt(max(disc, 0.0))
-    c34 = (k * u - s * Py) / rho2
-    s34 = (k * Py + s * u) / rho2
+    return (k * u - s * Py) / rho2, (k * Py + s * u) / rho2
+
+
+def _elbow_residual(
+    c2: float, s2: float, u: float, Py: float, zx: float, zy: float, zz: float, eps: float, L1: float, L2: float
+) -> float:
+    c34, s34 = _elbow(u, Py, eps, L1, L2)
     return c34 * (c2 * zx + s2 * zz) + s34 * zy
 
 
@@ -66,6 +70,7 @@ def _dispatch(kid: int, p, x: float, b: int) -> float:
 
 
 if _njit is not None:
+    _elbow = _njit(cache=True)(_elbow)
     _elbow_residual = _njit(cache=True)(_elbow_residual)
     _carm_d1 = _njit(cache=True)(_carm_d1)
     _carm_theta2 = _njit(cache=True)(_carm_theta2)
@@ -98,16 +103,11 @@ def _carm_configuration(kid: int, p, R, x: float, b: int, out) -> None:
             return
         u = Px / c2
         d1 = Pz - s2 * u
-    rho2 = u * u + Py * Py
-    k = (rho2 + L2 * L2 - L1 * L1) / (2.0 * L2)
-    disc = rho2 - k * k
-    if disc < -DISC_TOL * (L1 + L2) ** 2:
+    c34, s34 = _elbow(u, Py, eps, L1, L2)
+    if math.isnan(c34):
         for i in range(6):
             out[i] = math.nan
         return
-    s = eps * math.sqrt(max(disc, 0.0))
-    c34 = (k * u - s * Py) / rho2
-    s34 = (k * Py + s * u) / rho2
     th3 = math.atan2(u - L2 * c34, L2 * s34 - Py)
     th4 = math.atan2(s34, c34) - th3
     th4 = math.pi - ((math.pi - th4) % (2.0 * math.pi))
