@@ -134,6 +134,8 @@ LEAD_TRIM = 1e-13
 CLUSTER_TOL = 1e-5
 #: A polished t counts as a root of F_e when |F_e| <= CONVERGED * (its rounding-noise estimate).
 CONVERGED = 4.0
+#: A multiple-root estimate must lie within this (scaled t) of its group of polished roots.
+MULTIPLE_WINDOW = 1e-6
 #: Polished roots of one branch that agree to this relative precision are one simple root.
 SAME_ROOT_TOL = 1e-12
 #: Raw roots of Q closer than this (scaled t) are tested as one multiple root (a root of multiplicity m
@@ -590,7 +592,9 @@ def _multiple_root(
     level = max(max(abs(F) for F, _, _ in at_members), CONVERGED * max(n for _, _, n in at_members))
 
     def acceptable(ts: float | None) -> bool:
-        if ts is None or not (2.0 * ta - tb - 1e-9 <= ts <= 2.0 * tb - ta + 1e-9):
+        # Newton leaves the members of a double root up to ~sqrt(noise / F'') ~ 1e-8 away, possibly all
+        # on one side; the |F_e| test below is what rejects a wrong derivative root.
+        if ts is None or not (ta - MULTIPLE_WINDOW <= ts <= tb + MULTIPLE_WINDOW):
             return False
         Fs, _, noise = P.F(ts, e)
         if abs(Fs) <= max(CONVERGED * noise, level):

@@ -796,7 +796,8 @@ def _explanations(result: dict[str, Any]) -> list[str]:
     times = ", ".join(f"{_fmt(r['grid']['seconds_per_point'], 'time')} ({n} strategy)" for n, r in runs.items())
     out.append(
         f"**Time per point.** The paper reports {ref['grid']['seconds_per_point']} s per point in Matlab on "
-        f"2008 hardware; sweepik (NumPy, poses solved in vectorised batches) takes {times} on the grid."
+        f"2008 hardware; sweepik (vectorised batches, the search compiled with Numba when installed) takes "
+        f"{times} on the grid."
     )
     tr_run = runs.get("precise") or runs.get("paper")
     if tr_run:
