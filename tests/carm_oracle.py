@@ -46,14 +46,14 @@ Write the desired pose as R_D (tool z axis ``z = R_D[:, 2]``) and P = (Px, Py, P
 
 What the roots mean: each real root t of Q (with r > 0) is a rail position d1 = Pz - t at which
 F_e = 0 for e = +1 or -1, and then *two* configurations exist, (sigma, eps) = (+1, e) and (-1, -e):
-theta2 differs by pi between them (the "alternate solution 180 deg off" of the paper's Figure 4), and
-theta3, theta5 change sign. Where both F_+ and F_- vanish at the same t there are four. Hence at most 8 rail
-positions and 16 configurations per pose. Measured over 40,000 random reachable poses: 2, 4 or 6 rail
-positions (4, 8 or 12 configurations; 71 %, 29 %, 0.75 %), always exactly 2 x (number of real roots of
-Q); within the paper's joint limits up to 6 distinct d1 values occur (about 1 pose in 900), although the
-paper reports at most four. Every real root of Q is a solution: where h^2 < 0, Q = r^2 k^2 A^2 - h^2 G^2
-is a sum of squares and vanishes only if both terms do (those rare points fail the FK check). Complex
-roots are not solutions.
+(theta2 + pi, -theta3, -pi - theta4, theta5 + pi, theta6) is the partner of (theta2, ..., theta6), the
+"alternate solution 180 deg off" of the paper's Figure 4. Where both F_+ and F_- vanish at the same t
+there are four. Hence at most 8 rail positions and 16 configurations per pose. Measured over 40,000
+random reachable poses: 2, 4 or 6 rail positions (4, 8 or 12 configurations; 71 %, 29 %, 0.75 %),
+always exactly 2 x (number of real roots of Q). Within the paper's joint limits 5 or 6 distinct d1
+values occur for about 1 pose in 750, although the paper reports at most four. Every real root of Q is
+a solution: where h^2 < 0, Q = r^2 k^2 A^2 - h^2 G^2 is a sum of squares and vanishes only if both terms
+do (those rare points fail the FK check). Complex roots are not solutions.
 
 Numerics
 --------

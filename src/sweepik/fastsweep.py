@@ -39,9 +39,10 @@ MAX_LEVELS = _ref.MAX_LEVELS
 BEND = _ref.BEND
 XTOL_REL = _ref.XTOL_REL
 DIFF_STEP_REL = _ref.DIFF_STEP_REL
+DIFF_SHRINK = _ref.DIFF_SHRINK
+DIFF_LEVELS = _ref.DIFF_LEVELS
 EXTREMUM_REACH = _ref.EXTREMUM_REACH
 CLUSTER_FAMILY_REL = _ref.CLUSTER_FAMILY_REL
-CLUSTER_REACH = _ref.CLUSTER_REACH
 FLAT_PROBE_REL = _ref.FLAT_PROBE_REL
 FLAT_MAX_REL = _ref.FLAT_MAX_REL
 FLAT_BISECT = _ref.FLAT_BISECT
@@ -161,15 +162,21 @@ if AVAILABLE:
 
     @njit(cache=True)
     def _extremum(kid, p, b, ta, tc, tb, fa, fc, fb, span, noise, xtol, out_t, out_b, cnt):
-        h = DIFF_STEP_REL * span
-        a, c = ta + h, tb - h
         xe = tc
-        if a < c:
+        lo, hi = ta, tb
+        for level in range(DIFF_LEVELS):  # as sweep._Search._extrema
+            h = DIFF_STEP_REL * span / DIFF_SHRINK**level
+            if level > 0:
+                lo, hi = xe - 2.0 * DIFF_SHRINK * h, xe + 2.0 * DIFF_SHRINK * h
+            a, c = lo + h, hi - h
+            if not a < c:
+                break
             ga = _res(kid, p, a + h, b) - _res(kid, p, a - h, b)
             gc = _res(kid, p, c + h, b) - _res(kid, p, c - h, b)
-            if ga * gc < 0:
-                # root of the central difference g(x) = f(x + h) - f(x - h), bisection-safe Chandrupatla
-                xe = _root_diff(kid, p, b, a, c, ga, gc, h)
+            if not ga * gc < 0:
+                break
+            # root of the central difference g(x) = f(x + h) - f(x - h)
+            xe = _root_diff(kid, p, b, a, c, ga, gc, h)
         fx = _res(kid, p, xe, b)
         if math.isnan(fx):
             return
@@ -406,13 +413,6 @@ if AVAILABLE:
                         fcnt[i] += 1
                     else:
                         x = 0.5 * (lo + hi)
-                        if e > s:  # a root of even multiplicity: locate the extremum outside the noise
-                            H = max(CLUSTER_REACH * (hi - lo), DIFF_STEP_REL * span[i])
-                            a, cc, hh = lo - H, hi + H, 0.5 * H
-                            ga = _g(kid, p, a, bs[s], hh)
-                            gc = _g(kid, p, cc, bs[s], hh)
-                            if ga * gc < 0:
-                                x = _root_diff(kid, p, bs[s], a, cc, ga, gc, hh)
                         out_t[i, w] = x
                         out_b[i, w] = bs[s]
                         w += 1

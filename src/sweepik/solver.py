@@ -36,8 +36,11 @@ ACCEPT_TOL_REL = 2e-13
 #: Candidates with a pose error below this times the length scale get a Newton polish on the full pose
 #: (removes the ill-conditioning of a reduction; spurious candidates are far above it).
 POLISH_BELOW_REL = 1e-6
-#: ... and above this (already at rounding level: nothing to gain).
+#: ... and above this (already at rounding level: nothing to gain), ...
 POLISH_ABOVE_REL = 1e-14
+#: ... or with the paper's J above this: near a Z-Y-Z gimbal J magnifies a tiny rotation error by 1/sin(beta),
+#: so there the pose is polished down to rounding level.
+POLISH_PAPER_ABOVE_REL = 5e-14
 #: Paper strategy: the paper's acceptance threshold J < 1e-5 mm (section 4).
 PAPER_ACCEPT_MM = 1e-5
 #: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
@@ -194,8 +197,10 @@ def _solve_chunk(
     else:
         err_geo, err_paper = err_geo[finite], err_paper[finite]
     if strategy == "precise":
+        scale = robot.length_scale
         near = np.nonzero(
-            (err_geo <= POLISH_BELOW_REL * robot.length_scale) & (err_geo > POLISH_ABOVE_REL * robot.length_scale)
+            (err_geo <= POLISH_BELOW_REL * scale)
+            & ((err_geo > POLISH_ABOVE_REL * scale) | (err_paper > POLISH_PAPER_ABOVE_REL * scale))
         )[0]
         if near.size:
             q[near] = polish(robot, q[near], target[near], weight)

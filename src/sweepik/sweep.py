@@ -59,10 +59,6 @@ CLUSTER_FAMILY_REL = 1e-6
 FLAT_PROBE_REL = 1e-9
 FLAT_MAX_REL = 1e-2
 FLAT_BISECT = 30
-#: A cluster of several roots (an even-multiplicity root under noise) is located as the extremum of the
-#: residual, from a central difference with half-step CLUSTER_REACH / 2 times the cluster's width (where the
-#: residual rises ~CLUSTER_REACH^2 times above the noise).
-CLUSTER_REACH = 100.0
 #: Bisection steps locating where a family ends between its last sample and the next one.
 FAMILY_BISECT = 40
 #: Minimum number of consecutive vanishing samples that make a family.
@@ -72,6 +68,9 @@ XTOL_REL = 1e-16
 #: Half-step of the central difference used to locate extrema, relative to the theta* range.
 #: Balances rounding (1e-16 / h) against truncation (h^2): the extremum lands within ~1e-8 of the range.
 DIFF_STEP_REL = 1e-7
+#: The extremum is then relocated with steps DIFF_SHRINK and DIFF_SHRINK^2 times smaller (DIFF_LEVELS in all).
+DIFF_SHRINK = 16.0
+DIFF_LEVELS = 3
 
 
 @dataclass(frozen=True)
@@ -245,22 +244,33 @@ class _Search:
     ) -> None:
         """Locate the extremum between ta and tb, then classify (two roots / touching / nothing)."""
         span = self.span[p]
-        h = DIFF_STEP_REL * span
-        a, c = ta + h, tb - h
         idx = np.arange(p.size)
 
         def fe(x: Array, sel: IntArray) -> Array:
             return self.residual(p[sel], b[sel], x[:, None])[:, 0]
 
-        def g(x: Array, sel: IntArray) -> Array:
-            return fe(x + h[sel], sel) - fe(x - h[sel], sel)
-
-        ga, gc = g(a, idx), g(c, idx)
-        ok = (ga * gc < 0) & (a < c)
         xe = tc.copy()
-        if ok.any():
+        a, c = ta, tb
+        # root of the central difference g(x) = f(x + h) - f(x - h), then again with h / DIFF_SHRINK around it:
+        # the first step's truncation error (next to a domain edge f''' is large) shrinks by DIFF_SHRINK^2
+        for level in range(DIFF_LEVELS):
+            h = DIFF_STEP_REL * span / DIFF_SHRINK**level
+
+            if level:
+                a, c = xe - 2.0 * DIFF_SHRINK * h, xe + 2.0 * DIFF_SHRINK * h
+            lo_, hi_ = a + h, c - h
+            ga = fe(lo_ + h, idx) - fe(lo_ - h, idx)
+            gc = fe(hi_ + h, idx) - fe(hi_ - h, idx)
+            ok = (ga * gc < 0) & (lo_ < hi_)
+            if not ok.any():
+                break
             k = np.nonzero(ok)[0]
-            xe[k] = find_roots(lambda x, s: g(x, k[s]), a[k], c[k], ga[k], gc[k], 1e-3 * float(h[k].min()))
+            hk = h[k]
+
+            def g(x: Array, s: IntArray, k: IntArray = k, hk: Array = hk) -> Array:
+                return fe(x + hk[s], k[s]) - fe(x - hk[s], k[s])
+
+            xe[k] = find_roots(g, lo_[k], hi_[k], ga[k], gc[k], 1e-3 * float(hk.min()))
         fx = fe(xe, idx)
         # a dip below zero within the residual's rounding noise is a double root, not two roots: bracketing
         # it would return arbitrary points of the flat bottom (where |f| < noise) instead of the extremum
@@ -350,29 +360,6 @@ class _Search:
             self.spans.append(FamilySpan(int(p[first[i]]), int(b[first[i]]), float(lo[i]), float(hi[i])))
         keep = first[~wide]
         x = 0.5 * (lo + hi)[~wide]
-        # clusters of several roots: a root of even multiplicity; locate the extremum outside the noise as
-        # the root of a central difference reaching beyond the cluster
-        several = np.nonzero(np.diff(np.append(first, t.size))[~wide] > 1)[0]
-        if several.size:
-            pp, bb = p[keep][several], b[keep][several]
-            lo_s, hi_s = lo[~wide][several], hi[~wide][several]
-            H = np.maximum(CLUSTER_REACH * (hi_s - lo_s), DIFF_STEP_REL * self.span[pp])
-
-            def g(xx: Array, sel: IntArray) -> Array:
-                h = 0.5 * H[sel]
-                return (
-                    self.residual(pp[sel], bb[sel], (xx + h)[:, None])[:, 0]
-                    - self.residual(pp[sel], bb[sel], (xx - h)[:, None])[:, 0]
-                )
-
-            idx = np.arange(several.size)
-            a, c = lo_s - H, hi_s + H
-            ga, gc = g(a, idx), g(c, idx)
-            ok = np.nonzero(ga * gc < 0)[0]
-            if ok.size:
-                x[several[ok]] = find_roots(
-                    lambda xx, sel: g(xx, ok[sel]), a[ok], c[ok], ga[ok], gc[ok], 1e-3 * float(H[ok].min())
-                )
         return Candidates(pose=p[keep], branch=b[keep], theta=x)
 
 
