@@ -62,7 +62,7 @@ def assert_certified(sol: sweepik.Solutions, T: np.ndarray) -> None:
         J = pose_error_paper(CARM.fk(sol.q), T)
         assert J.max() <= J_TOL
         # near a ZYZ gimbal (small sin beta) rounding of FK is amplified in J: compare loosely
-        np.testing.assert_allclose(sol.error, J, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(sol.error, J, rtol=0, atol=J_TOL)
         assert np.all(CARM.within_limits(sol.q))
 
 

@@ -32,13 +32,11 @@ if AVAILABLE:
         sb = math.hypot(r31, r32)
         beta = math.atan2(sb, r33)
         alpha = math.atan2(r23, r13)
-        if sb <= _EXACT_GIMBAL:
+        if sb <= _EXACT_GIMBAL:  # as pose.zyz_from_matrix: alpha = 0, beta keeps its value
             alpha = 0.0
             if r33 > 0:
-                beta = 0.0
                 gamma = math.atan2(-R[0, 1], R[0, 0])
             else:
-                beta = math.pi
                 gamma = math.atan2(R[0, 1], -R[0, 0])
         else:
             ca, sa = math.cos(alpha), math.sin(alpha)

@@ -6,7 +6,8 @@ Conventions
 * ``R = Rz(alpha) @ Ry(beta) @ Rz(gamma)`` (Craig 2005, Z-Y-Z Euler angles), radians,
   ``beta`` in [0, pi], ``alpha`` and ``gamma`` in (-pi, pi].
 * At the gimbal cases ``beta = 0`` (only ``alpha + gamma`` is defined) and ``beta = pi`` (only
-  ``alpha - gamma``), Craig's choice ``alpha = 0`` is made.
+  ``alpha - gamma``), Craig's choice ``alpha = 0`` is made (for sin(beta) <= 1e-12, where alpha would be
+  rounding noise).
 * Errors are in the robot's length unit; the orientation part is weighted by a length (default
   100 mm, the paper's choice) that turns radians into that unit.
 """
@@ -69,8 +70,7 @@ def zyz_from_matrix(R: ArrayLike) -> Array:
     zero = sb <= _EXACT_GIMBAL
     up = zero & (r33 > 0)
     down = zero & (r33 <= 0)
-    alpha = np.where(zero, 0.0, alpha)
-    beta = np.where(up, 0.0, np.where(down, np.pi, beta))
+    alpha = np.where(zero, 0.0, alpha)  # beta keeps its value (continuous across the threshold)
     gamma = np.where(up, np.arctan2(-R[..., 0, 1], R[..., 0, 0]), gamma)
     gamma = np.where(down, np.arctan2(R[..., 0, 1], -R[..., 0, 0]), gamma)
     return np.stack([wrap_angle(alpha), beta, wrap_angle(gamma)], axis=-1)
