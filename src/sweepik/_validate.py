@@ -53,8 +53,7 @@ def check_poses(T: ArrayLike, what: str = "pose") -> NDArray[np.float64]:
         raise InvalidPoseError(f"{what} bottom row must be (0, 0, 0, 1){where}, got {arr[..., 3, :].reshape(-1, 4)[0]}")
     R = arr[..., :3, :3]
     dev = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-1, -2))
-    # det of a 3x3 as the triple product (cheaper than np.linalg.det for single poses)
-    det = np.einsum("...i,...i->...", np.cross(R[..., 0, :], R[..., 1, :]), R[..., 2, :])
+    det = np.linalg.det(R)
     bad = (dev > ORTHONORMAL_TOL) | (np.abs(det - 1.0) > ORTHONORMAL_TOL)
     if np.any(bad):
         idx = np.argwhere(np.atleast_1d(bad))[0]

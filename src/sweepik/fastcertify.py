@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 from .fastsweep import AVAILABLE, PARALLEL_MIN, _fk_one
 from .pose import GIMBAL_TOL
 from .reductions.kernels import configuration_by_id
+from .units import orientation_weight
 
 Array = NDArray[np.float64]
 _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
@@ -100,7 +101,7 @@ if AVAILABLE:
             )
 
 
-def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch):
+def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, params: Array | None = None):
     """Configurations ``(K, n)``, geodesic errors and paper errors ``(K,)`` of the candidates
     (inf errors where the branch does not exist)."""
     K = pose.shape[0]
@@ -110,7 +111,7 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch):
     run = _certify_parallel if K >= 16 * PARALLEL_MIN else _certify_serial
     run(
         red.kernel_id,
-        np.ascontiguousarray(red.kernel_params(chain)),
+        np.ascontiguousarray(red.kernel_params(chain) if params is None else params),
         np.ascontiguousarray(chain),
         np.ascontiguousarray(world),
         pose.astype(np.int64),
@@ -123,15 +124,9 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch):
         robot.is_revolute,
         np.ascontiguousarray(robot.T_world_base),
         np.ascontiguousarray(robot.T_flange_tool),
-        float(weight_of(robot)),
+        orientation_weight(robot.length_unit),
         q,
         eg,
         ep,
     )
     return q, eg, ep
-
-
-def weight_of(robot) -> float:
-    from .units import orientation_weight
-
-    return orientation_weight(robot.length_unit)
