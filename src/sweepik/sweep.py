@@ -363,15 +363,15 @@ class _Search:
         return Candidates(pose=p[keep], branch=b[keep], theta=x)
 
 
-def _extend(reduction: Reduction, pose: Array, branch: int, inside: float, outside: float) -> float:
-    """Bisect between a sample on a family (``inside``) and one off it for where the family ends."""
+def _extend(reduction: Reduction, poses: Array, branch: IntArray, inside: Array, outside: Array) -> Array:
+    """Bisect, for every family end at once, between a sample on the family (``inside``) and the next sample
+    off it (``outside``) for where the family ends. ``poses (K, 4, 4)``, the rest ``(K,)``."""
     for _ in range(FAMILY_BISECT):
         mid = 0.5 * (inside + outside)
-        r = reduction.residual(pose[None], np.array([[mid]]), np.array([[branch]]))
-        if r is not None and np.isfinite(r[0, 0]) and abs(r[0, 0]) <= FAMILY_TOL:
-            inside = mid
-        else:
-            outside = mid
+        r = reduction.residual(poses, mid[:, None], branch[:, None])
+        on = np.isfinite(r[:, 0]) & (np.abs(r[:, 0]) <= FAMILY_TOL) if r is not None else np.zeros(mid.size, bool)
+        inside = np.where(on, mid, inside)
+        outside = np.where(on, outside, mid)
     return inside
 
 
@@ -382,21 +382,24 @@ def _families(
     neighbouring samples), and the mask of samples they cover."""
     flat = valid & (np.abs(f) <= FAMILY_TOL)
     in_family = np.zeros_like(flat)
-    spans: list[FamilySpan] = []
     if not flat.any():
-        return spans, in_family
+        return [], in_family
+    runs = []  # (pose, branch, first sample, last sample)
     for p, b in zip(*np.nonzero(flat.sum(axis=1) >= FAMILY_MIN_RUN), strict=True):
         col = flat[p, :, b]
         edges = np.diff(np.concatenate([[0], col.astype(np.int8), [0]]))
         for s0, e0 in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0], strict=True):
             if e0 - s0 >= FAMILY_MIN_RUN and theta[p, e0 - 1] > theta[p, s0]:
-                lo, hi = float(theta[p, s0]), float(theta[p, e0 - 1])
-                if s0 > 0:
-                    lo = _extend(reduction, poses[p], int(b), lo, float(theta[p, s0 - 1]))
-                if e0 < theta.shape[1]:
-                    hi = _extend(reduction, poses[p], int(b), hi, float(theta[p, e0]))
-                spans.append(FamilySpan(int(p), int(b), lo, hi))
+                runs.append((int(p), int(b), int(s0), int(e0 - 1)))
                 in_family[p, s0:e0, b] = True
+    if not runs:
+        return [], in_family
+    P, Bb, S0, S1 = (np.array(x) for x in zip(*runs, strict=True))
+    M = theta.shape[1]
+    lo, hi = theta[P, S0], theta[P, S1]
+    lo = np.where(S0 > 0, _extend(reduction, poses[P], Bb, lo, theta[P, np.maximum(S0 - 1, 0)]), lo)
+    hi = np.where(S1 < M - 1, _extend(reduction, poses[P], Bb, hi, theta[P, np.minimum(S1 + 1, M - 1)]), hi)
+    spans = [FamilySpan(int(p), int(b), float(x), float(y)) for p, b, x, y in zip(P, Bb, lo, hi, strict=True)]
     return spans, in_family
 
 
