@@ -235,8 +235,10 @@ def test_within_limits_carm(carm: Robot) -> None:
         (500.0, 0, 0, 0, 0, 0): True,
         (0.0, 0, 0, 0, 0, 0): True,  # at the rail's end
         (-1e-3, 0, 0, 0, 0, 0): False,
-        (-0.1 * LIMIT_TOL, 0, 0, 0, 0, 0): True,  # rounding-size excursions still count as inside
-        (2000.0 + 10 * LIMIT_TOL, 0, 0, 0, 0, 0): False,
+        (-0.1 * carm.limit_tol[0], 0, 0, 0, 0, 0): True,  # rounding-size excursions still count as inside
+        (2000.0 + 10 * carm.limit_tol[0], 0, 0, 0, 0, 0): False,
+        (500.0, 0, deg(116.0) + 0.5 * LIMIT_TOL, 0, 0, 0): True,
+        (500.0, 0, deg(116.0) + 10 * LIMIT_TOL, 0, 0, 0): False,
         (500.0, 0, deg(116.0), 0, 0, 0): True,  # at theta3's upper limit
         (500.0, 0, deg(117.0), 0, 0, 0): False,
         (500.0, 0, deg(116.0 + 360.0), 0, 0, 0): True,  # revolute values count modulo 2 pi

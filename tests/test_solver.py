@@ -112,6 +112,30 @@ def test_property_ik_of_fk_contains_q(qt: tuple[float, ...]) -> None:
     assert_certified(sol, T)
 
 
+def _joint(lo_deg: float, hi_deg: float, extra: tuple[float, ...] = ()) -> st.SearchStrategy[float]:
+    lo, hi = np.radians(lo_deg), np.radians(hi_deg)
+    return st.one_of(st.sampled_from([float(lo), float(hi), *extra]), st.floats(float(lo), float(hi)))
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    st.tuples(
+        st.one_of(st.sampled_from([0.0, 2000.0]), st.floats(0.0, 2000.0)),  # rail ends
+        _joint(-180, 180, (np.pi / 2, -np.pi / 2)),
+        _joint(-84, 116, (0.0,)),  # theta3 limits
+        _joint(-178, 66, (-np.pi / 2,)),  # theta4 limits, stretched elbow
+        st.one_of(st.floats(-1e-3, 1e-3), _joint(-180, 180)),  # near theta5 = 0
+        _joint(-180, 180),
+    )
+)
+def test_property_at_limits_and_near_singularities(qt: tuple[float, ...]) -> None:
+    q = np.array(qt)
+    T = CARM.fk(q)
+    sol = solve(CARM, T)
+    assert found(sol, q)
+    assert_certified(sol, T)
+
+
 def test_agrees_with_independent_polynomial_oracle() -> None:
     from carm_oracle import carm_ik_oracle_ex
 

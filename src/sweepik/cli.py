@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from . import __version__
 from .errors import SweepikError
 from .pose import GIMBAL_TOL, zyz_from_matrix
-from .robot import LIMIT_TOL, Robot
+from .robot import Robot
 from .robot_file import bundled_robots, load_robot
 
 __all__ = ["main", "build_parser"]
@@ -136,7 +136,9 @@ def _cmd_fk(args: argparse.Namespace) -> int:
 def _joints_inside(robot: Robot, q: NDArray[np.float64]) -> list[bool]:
     """Per joint: inside its limits (revolute values after ``Robot.wrap``), as ``Robot.within_limits``."""
     w = robot.wrap(q)
-    return [bool(lo - LIMIT_TOL <= v <= hi + LIMIT_TOL) for v, lo, hi in zip(w, robot.lower, robot.upper, strict=True)]
+    return [
+        bool(lo - t <= v <= hi + t) for v, lo, hi, t in zip(w, robot.lower, robot.upper, robot.limit_tol, strict=True)
+    ]
 
 
 # --------------------------------------------------------------------------------------------------

@@ -119,7 +119,7 @@ if AVAILABLE:
         """As sweep._Search._center_flat, for one root."""
         d0 = FLAT_PROBE_REL * span
         if not (_small(kid, p, x - d0, b, noise) or _small(kid, p, x + d0, b, noise)):
-            return x
+            return x, x, x
         limit = FLAT_MAX_REL * span
         reach = np.zeros(2)
         for side in range(2):
@@ -140,7 +140,8 @@ if AVAILABLE:
                 else:
                     outer = mid
             reach[side] = inner
-        return x + 0.5 * (reach[1] - reach[0])
+        lo, hi = x - reach[0], x + reach[1]
+        return 0.5 * (lo + hi), lo, hi
 
     @njit(cache=True)
     def _extend(kid, p, b, inside, outside):
@@ -320,7 +321,7 @@ if AVAILABLE:
                         k = j
                         while k + 1 < M and not math.isnan(f[k + 1]) and abs(f[k + 1]) <= FAMILY_TOL:
                             k += 1
-                        if k - j + 1 >= FAMILY_MIN_RUN and th[k] > th[j]:
+                        if k - j + 1 >= FAMILY_MIN_RUN and th[k] - th[j] > CLUSTER_FAMILY_REL * span[i]:
                             if fcnt[i] < fam.shape[1]:
                                 lo, hi = th[j], th[k]
                                 if j > 0:
@@ -333,6 +334,7 @@ if AVAILABLE:
                             fcnt[i] += 1
                             for m in range(j, k + 1):
                                 f[m] = np.nan
+                        # (a short run of coinciding samples is left to the scan: one root)
                         j = k + 1
                     else:
                         j += 1
@@ -383,8 +385,23 @@ if AVAILABLE:
                         top,
                     )
             cnt[i] = c[0]
-            for k in range(min(c[0], out_t.shape[1])):
-                out_t[i, k] = _center_flat(kid, p, out_t[i, k], out_b[i, k], noise, span[i])
+            n0 = min(c[0], out_t.shape[1])
+            w0 = 0
+            for k in range(n0):
+                x, lo, hi = _center_flat(kid, p, out_t[i, k], out_b[i, k], noise, span[i])
+                if hi - lo > CLUSTER_FAMILY_REL * span[i]:  # a numerical continuum: a family
+                    if fcnt[i] < fam.shape[1]:
+                        fam[i, fcnt[i], 0] = lo
+                        fam[i, fcnt[i], 1] = hi
+                        fam[i, fcnt[i], 2] = out_b[i, k]
+                    fcnt[i] += 1
+                else:
+                    out_t[i, w0] = x
+                    out_b[i, w0] = out_b[i, k]
+                    w0 += 1
+            if c[0] <= out_t.shape[1]:
+                c[0] = w0
+            cnt[i] = c[0]
             # merge noise-level clusters per branch (candidates sorted by branch, then theta)
             n = min(c[0], out_t.shape[1])
             if n > 1:

@@ -32,9 +32,12 @@ JointType = Literal["revolute", "prismatic"]
 DHConvention = Literal["modified", "standard"]
 Array = NDArray[np.float64]
 
-#: Joint values this far outside a limit (radians or length unit) still count as inside: IK results at a
-#: limit carry rounding errors of ~1e-12, far below any mechanical meaning.
+#: Joint values this far outside a limit still count as inside: 1e-9 rad for revolute joints and
+#: LIMIT_TOL_REL times the arm's length scale for prismatic ones (C-Arm: 2.8e-6 mm). A solution exactly at a
+#: limit comes out of the solver with a rounding error that can be larger than that of a generic solution
+#: (the root is found to ~noise / slope, and the slope can be small), far below any mechanical meaning.
 LIMIT_TOL = 1e-9
+LIMIT_TOL_REL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -191,19 +194,24 @@ class Robot:
         w = np.pi - np.mod(np.pi - qa, 2.0 * np.pi)
         for shift in (2.0 * np.pi, -2.0 * np.pi):
             cand = w + shift
-            better = (w < self.lower - LIMIT_TOL) | (w > self.upper + LIMIT_TOL)
-            ok = (cand >= self.lower - LIMIT_TOL) & (cand <= self.upper + LIMIT_TOL)
+            better = (w < self.lower - self.limit_tol) | (w > self.upper + self.limit_tol)
+            ok = (cand >= self.lower - self.limit_tol) & (cand <= self.upper + self.limit_tol)
             w = np.where(better & ok, cand, w)
         return np.where(self.is_revolute, w, qa)
 
     def within_limits(self, q: ArrayLike) -> NDArray[np.bool_]:
-        """``(...)`` bool: all joint values inside their limits (revolute ones after ``wrap``), with ``LIMIT_TOL``."""
+        """``(...)`` bool: all joint values inside their limits (revolute ones after ``wrap``), with ``limit_tol``."""
         return self.wrapped_within_limits(q)[1]
 
     def wrapped_within_limits(self, q: ArrayLike) -> tuple[Array, NDArray[np.bool_]]:
         """``wrap(q)`` and ``within_limits(q)`` in one pass."""
         w = self.wrap(q)
-        return w, np.all((w >= self.lower - LIMIT_TOL) & (w <= self.upper + LIMIT_TOL), axis=-1)
+        return w, np.all((w >= self.lower - self.limit_tol) & (w <= self.upper + self.limit_tol), axis=-1)
+
+    @cached_property
+    def limit_tol(self) -> Array:
+        """``(n,)`` tolerance of the limit checks (see ``LIMIT_TOL``)."""
+        return np.where(self.is_revolute, LIMIT_TOL, LIMIT_TOL_REL * self.length_scale)
 
     @cached_property
     def base_is_identity(self) -> bool:

@@ -20,7 +20,7 @@ from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, get_reduction
 from .robot import Robot
 from .solutions import Family, Solutions
-from .sweep import N_SAMPLES, FamilySpan, find_candidates
+from .sweep import CLUSTER_FAMILY_REL, N_SAMPLES, FamilySpan, find_candidates
 from .units import mm_per_unit, orientation_weight
 
 __all__ = ["solve", "solve_many", "STRATEGIES"]
@@ -120,43 +120,90 @@ _DEDUPE_WINDOW = 16
 _DEDUPE_PAIRWISE = 48
 
 
+def _family_members_ok(
+    robot: Robot,
+    red: Reduction,
+    chain: Array,
+    pose: NDArray[np.intp],
+    branch: NDArray[np.intp],
+    theta: Array,
+    limits: bool,
+) -> NDArray[np.bool_]:
+    """``theta (K, M)``: members exist, are certified by FK and (with limits) lie inside the limits."""
+    q = red.solve_rest(chain[pose], theta, np.broadcast_to(branch[:, None], theta.shape))
+    ok = np.all(np.isfinite(q), axis=-1)
+    qz = np.nan_to_num(q)
+    flange = fastsweep.flange_poses(robot, qz.reshape(-1, qz.shape[-1])).reshape(*qz.shape[:-1], 4, 4)
+    T = robot.T_base_world @ flange
+    ok &= pose_error_geodesic(T, chain[pose][:, None], orientation_weight(robot.length_unit)) <= (
+        ACCEPT_TOL_REL * robot.length_scale
+    )
+    if limits:
+        ok &= robot.within_limits(qz)
+    return np.asarray(ok)
+
+
 def _families(
     robot: Robot, red: Reduction, chain: Array, spans: list[FamilySpan], limits: bool
-) -> dict[int, list[Family]]:
+) -> tuple[dict[int, list[Family]], NDArray[np.intp], Array]:
     """Family objects per pose: each span cut to the sub-intervals whose members are certified by FK
-    (and, with limits, inside the limits). All spans are sampled in one vectorised pass."""
+    (and, with limits, inside the limits): sampled, then each cut located by bisection (all at once).
+    Pieces that shrink to a point are returned as isolated members ``(pose index, q)``."""
     out: dict[int, list[Family]] = {}
     if not spans:
-        return out
-    weight = orientation_weight(robot.length_unit)
+        return out, np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
     pose = np.array([sp.pose for sp in spans])
     branch = np.array([sp.branch for sp in spans])
     u = np.linspace(0.0, 1.0, _FAMILY_SAMPLES)
     grid = np.array([sp.lo for sp in spans])[:, None] + np.array([sp.hi - sp.lo for sp in spans])[:, None] * u
-    q = red.solve_rest(chain[pose], grid, np.broadcast_to(branch[:, None], grid.shape))
-    ok = np.all(np.isfinite(q), axis=-1)
-    qz = np.nan_to_num(q)
-    shape = qz.shape
-    T = np.linalg.inv(robot.T_world_base) @ fastsweep.flange_poses(robot, qz.reshape(-1, shape[-1])).reshape(
-        *shape[:-1], 4, 4
+    ok = _family_members_ok(robot, red, chain, pose, branch, grid, limits)
+    pad = np.zeros((len(spans), 1), np.int8)
+    edges = np.diff(np.concatenate([pad, ok.astype(np.int8), pad], axis=1), axis=1)
+    pieces = []  # (span index, first ok sample, last ok sample)
+    for k in range(len(spans)):
+        for s_, e_ in zip(np.nonzero(edges[k] == 1)[0], np.nonzero(edges[k] == -1)[0], strict=True):
+            pieces.append((k, int(s_), int(e_ - 1)))
+    if not pieces:
+        return out, np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
+    K, S, E = (np.array(x) for x in zip(*pieces, strict=True))
+    M = grid.shape[1]
+    # bisect each cut between the last sample inside and the first outside
+    inside = np.concatenate([grid[K, S], grid[K, E]])
+    outside = np.concatenate([grid[K, np.maximum(S - 1, 0)], grid[K, np.minimum(E + 1, M - 1)]])
+    cut = np.concatenate([S > 0, E < M - 1])
+    which = np.concatenate([K, K])
+    for _ in range(_FAMILY_BISECT):
+        mid = 0.5 * (inside + outside)
+        good = _family_members_ok(robot, red, chain, pose[which], branch[which], mid[:, None], limits)[:, 0]
+        inside = np.where(cut & good, mid, inside)
+        outside = np.where(cut & ~good, mid, outside)
+    n = len(pieces)
+    lo, hi = inside[:n], inside[n:]
+    # a piece that shrinks to a point (the family touches the limits there) is an isolated solution
+    point = hi - lo <= CLUSTER_FAMILY_REL * (grid[K, -1] - grid[K, 0] + 1.0)
+    for j, k in enumerate(K):
+        if not point[j]:
+            sp = spans[k]
+            out.setdefault(sp.pose, []).append(
+                Family(red.free_joint, (float(lo[j]), float(hi[j])), red, chain[sp.pose], sp.branch)
+            )
+    pk = K[point]
+    # its member: of the piece's ends and middle, the one deepest inside the limits
+    three = np.stack([lo[point], 0.5 * (lo + hi)[point], hi[point]], axis=1)
+    q3 = red.solve_rest(chain[pose[pk]], three, np.broadcast_to(branch[pk][:, None], three.shape))
+    w = robot.wrap(np.nan_to_num(q3, nan=np.inf))
+    excess = np.sum(np.maximum(robot.lower - w, 0.0) + np.maximum(w - robot.upper, 0.0), axis=-1)
+    mid = three[np.arange(pk.size), np.argmin(excess, axis=1)] if pk.size else np.zeros(0)
+    q_pts = (
+        red.solve_rest(chain[pose[pk]], mid[:, None], branch[pk][:, None])[:, 0]
+        if pk.size
+        else np.zeros((0, robot.n_joints))
     )
-    ok &= pose_error_geodesic(T, chain[pose][:, None], weight) <= ACCEPT_TOL_REL * robot.length_scale
-    if limits:
-        ok &= robot.within_limits(qz)
-    edges = np.diff(
-        np.concatenate(
-            [np.zeros((len(spans), 1), np.int8), ok.astype(np.int8), np.zeros((len(spans), 1), np.int8)], axis=1
-        ),
-        axis=1,
-    )
-    for k, sp in enumerate(spans):
-        for s, e in zip(np.nonzero(edges[k] == 1)[0], np.nonzero(edges[k] == -1)[0], strict=True):
-            if e - 1 > s:
-                fam = Family(red.free_joint, (float(grid[k, s]), float(grid[k, e - 1])), red, chain[sp.pose], sp.branch)
-                out.setdefault(sp.pose, []).append(fam)
-    return out
+    return out, pose[pk].astype(np.intp), q_pts
 
 
+#: Bisection steps locating where a family leaves the joint limits (or certification) between samples.
+_FAMILY_BISECT = 40
 #: Samples along a family span to certify its members and cut it to the joint limits.
 _FAMILY_SAMPLES = 65
 
@@ -168,6 +215,7 @@ def _solve_chunk(
     lo, hi = _theta_range(robot, red, chain, limits)
     weight = orientation_weight(robot.length_unit)
     spans: list[FamilySpan] = []
+    fams: dict[int, list[Family]]
     compiled = red.kernel_id is not None and fastsweep.AVAILABLE
     err_geo = err_paper = None
     if strategy == "precise":
@@ -187,8 +235,16 @@ def _solve_chunk(
                 err_geo, err_paper = np.concatenate([err_geo, eg_sp]), np.concatenate([err_paper, ep_sp])
             q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
+        fams, fam_p, fam_q = _families(robot, red, chain, spans, limits)
+        if fam_p.size:
+            if err_geo is not None and err_paper is not None:
+                eg_f, ep_f = _errors(robot, fam_q, poses[fam_p], weight)
+                err_geo, err_paper = np.concatenate([err_geo, eg_f]), np.concatenate([err_paper, ep_f])
+            q = np.concatenate([q, fam_q])
+            pose_idx = np.concatenate([pose_idx, fam_p])
     else:
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
+        fams = {}
     finite = np.all(np.isfinite(q), axis=-1)
     pose_idx, q = pose_idx[finite], q[finite]
     target = poses[pose_idx]
@@ -222,7 +278,6 @@ def _solve_chunk(
         )
     keep = _dedupe(robot, pose_idx, q, err_geo)
     pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
-    fams = _families(robot, red, chain, spans, limits) if spans else {}
 
     if limits and not red.periodic:
         # the sweep covered theta*'s limits only: for poses left without any solution, look beyond them
@@ -231,6 +286,13 @@ def _solve_chunk(
         if empty.size and red.search_range(chain[empty]) is not None:
             beyond = _solve_chunk(robot, red, poses[empty], strategy, False, n_samples)
             n_reachable[empty] = [len(b) for b in beyond]
+    fallback: dict[int, Solutions] = {}
+    if strategy == "precise" and red.fallback is not None:
+        deg = red.degenerate(chain)
+        if deg is not None and deg.any():
+            idx = np.nonzero(deg)[0]
+            alt = _solve_chunk(robot, get_reduction(robot, red.fallback), poses[idx], strategy, limits, n_samples)
+            fallback = {int(i): a for i, a in zip(idx, alt, strict=True) if a.families}
     order = np.argsort(pose_idx, kind="stable")
     pose_idx, q, err_paper, err_geo, inside = (
         pose_idx[order],
@@ -264,6 +326,9 @@ def _solve_chunk(
                 if n_reachable[i] > 0
                 else "unreachable: no configuration of the arm reaches this pose"
             )
+        if i in fallback:  # the reduction's blind spot: the fallback reduction's answer (with its families)
+            results.append(fallback[i])
+            continue
         results.append(
             Solutions(
                 q=qi[s_keep],

@@ -290,17 +290,22 @@ class _Search:
             self._root(p, b, x)
         p = np.concatenate(self.roots_p).astype(np.intp)
         b = np.concatenate(self.roots_b).astype(np.intp)
-        t = self._center_flat(p, b, np.concatenate(self.roots_t))
-        return self._merge_clusters(p, b, t)
+        t, lo, hi = self._center_flat(p, b, np.concatenate(self.roots_t))
+        # a flat stretch wider than a double root's is a numerical continuum: a family
+        wide = hi - lo > CLUSTER_FAMILY_REL * self.span[p]
+        for k in np.nonzero(wide)[0]:
+            self.spans.append(FamilySpan(int(p[k]), int(b[k]), float(lo[k]), float(hi[k])))
+        return self._merge_clusters(p[~wide], b[~wide], t[~wide])
 
-    def _center_flat(self, p: IntArray, b: IntArray, t: Array) -> Array:
+    def _center_flat(self, p: IntArray, b: IntArray, t: Array) -> tuple[Array, Array, Array]:
         """Move each root to the middle of the stretch around it where |residual| stays within the noise.
 
         A simple root's stretch is ~noise / |f'| wide: nothing moves. At a root of high multiplicity (the
         residual ~ c x^k, k >= 3) the residual crosses zero at places decided by rounding anywhere in a
-        stretch of width ~(noise / c)^(1/k); its middle is the root."""
+        stretch of width ~(noise / c)^(1/k); its middle is the root. Returns the moved roots and the
+        stretches' ends."""
         if t.size == 0:
-            return t
+            return t, t, t
         noise = self.red.residual_noise
         d0 = FLAT_PROBE_REL * self.span[p]
 
@@ -311,7 +316,7 @@ class _Search:
         idx = np.arange(t.size)
         flat = np.nonzero(small(t - d0, idx) | small(t + d0, idx))[0]
         if flat.size == 0:
-            return t
+            return t, t, t
         reach = np.empty((flat.size, 2))
         for side, sgn in enumerate((-1.0, 1.0)):
             inner = np.zeros(flat.size)
@@ -330,9 +335,10 @@ class _Search:
                 inner = np.where(sm, mid, inner)
                 outer = np.where(sm, outer, mid)
             reach[:, side] = inner
-        t = t.copy()
-        t[flat] += 0.5 * (reach[:, 1] - reach[:, 0])
-        return t
+        lo, hi = t.copy(), t.copy()
+        lo[flat] -= reach[:, 0]
+        hi[flat] += reach[:, 1]
+        return 0.5 * (lo + hi), lo, hi
 
     def _merge_clusters(self, p: IntArray, b: IntArray, t: Array) -> Candidates:
         """Merge neighbouring roots of one branch between which the residual stays within its rounding
@@ -376,7 +382,7 @@ def _extend(reduction: Reduction, poses: Array, branch: IntArray, inside: Array,
 
 
 def _families(
-    reduction: Reduction, poses: Array, theta: Array, f: Array, valid: NDArray[np.bool_]
+    reduction: Reduction, poses: Array, theta: Array, f: Array, valid: NDArray[np.bool_], span: Array
 ) -> tuple[list[FamilySpan], NDArray[np.bool_]]:
     """Runs of vanishing samples ``(N, M, B)`` -> family spans (ends located by bisection towards the
     neighbouring samples), and the mask of samples they cover."""
@@ -389,7 +395,8 @@ def _families(
         col = flat[p, :, b]
         edges = np.diff(np.concatenate([[0], col.astype(np.int8), [0]]))
         for s0, e0 in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0], strict=True):
-            if e0 - s0 >= FAMILY_MIN_RUN and theta[p, e0 - 1] > theta[p, s0]:
+            # a run must also be long: coinciding samples (hints at one point) are one root, not a family
+            if e0 - s0 >= FAMILY_MIN_RUN and theta[p, e0 - 1] - theta[p, s0] > CLUSTER_FAMILY_REL * span[p]:
                 runs.append((int(p), int(b), int(s0), int(e0 - 1)))
                 in_family[p, s0:e0, b] = True
     if not runs:
@@ -445,7 +452,7 @@ def find_candidates(
         f = reduction.residual(poses, theta)
     N, M, B = f.shape
     valid = np.isfinite(f)
-    spans, in_family = _families(reduction, poses, theta, f, valid)
+    spans, in_family = _families(reduction, poses, theta, f, valid, hi - lo)
     valid &= ~in_family
     search = _Search(reduction, poses, hi - lo)
     p = np.repeat(np.arange(N), B)

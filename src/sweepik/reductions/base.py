@@ -49,6 +49,9 @@ class Reduction(ABC):
     #: Rounding noise of ``residual`` (absolute). A residual extremum that dips below zero by less than this
     #: is treated as one double root. 1e-14 suits residuals built from O(1) sines, cosines and unit vectors.
     residual_noise: float = 1e-14
+    #: Registry name of a reduction to hand poses to where ``degenerate`` says this one cannot describe
+    #: the solution set (e.g. a continuum along a joint other than theta*).
+    fallback: str | None = None
     #: Id of a compiled scalar residual in ``reductions.kernels`` (None: the NumPy engine is used).
     kernel_id: int | None = None
 
@@ -91,6 +94,10 @@ class Reduction(ABC):
         """Candidate configurations ``(N, K, n)`` (NaN-padded) at theta* values where the reduction itself
         degenerates (its blind spots). The engine certifies them by forward kinematics like any other.
         """
+        return None
+
+    def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
+        """``(N,)`` True where this reduction cannot describe the pose's solutions (``fallback`` solves them)."""
         return None
 
     def search_range(self, poses: Array) -> Array | None:

@@ -18,6 +18,7 @@ Geometry used by both (derivation in docs/carm.md). With the chain pose ``R_D, P
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..errors import RobotDefinitionError
 from ..robot import Robot
@@ -73,6 +74,21 @@ class _CArmBase(Reduction):
         out[:, 3:6] = poses[:, :3, 2]
         out[:, 6], out[:, 7] = self.L1, self.L2
         return out
+
+    def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
+        """(d1, C2, S2, u, Py, C34, S34, z, R) at theta*; each subclass ties theta2 and d1 its own way."""
+        raise NotImplementedError
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        _, c2, s2, _, _, c34, s34, z, _ = self._position(poses, theta, branch)
+        return self._residual(c2, s2, c34, s34, z)
+
+    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        d1, c2, s2, u, Py, c34, s34, _, R = self._position(poses, theta, branch)
+        shape = c34.shape
+        return self._configuration(
+            np.broadcast_to(d1, shape), np.broadcast_to(c2, shape), np.broadcast_to(s2, shape), u, Py, c34, s34, R
+        )
 
     # --- shared closed form ----------------------------------------------------------------------
     def _elbow(self, u: Array, Py: Array, eps: Array) -> tuple[Array, Array]:
@@ -132,6 +148,7 @@ class CArmD1(_CArmBase):
 
     name = "carm-d1"
     kernel_id = kernels.CARM_D1
+    fallback = "carm-theta2"
     blind_spots = "d1 = Pz with Px = 0 (wrist on joint 2's axis): solved separately as a special slice"
 
     def __init__(self, robot: Robot) -> None:
@@ -161,15 +178,6 @@ class CArmD1(_CArmBase):
         c34, s34 = self._elbow(u, Py, eps)
         return d1, c2, s2, u, Py, c34, s34, z, R
 
-    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        _, c2, s2, _, _, c34, s34, z, _ = self._position(poses, theta, branch)
-        return self._residual(c2, s2, c34, s34, z)
-
-    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        d1, c2, s2, u, Py, c34, s34, _, R = self._position(poses, theta, branch)
-        d1 = np.broadcast_to(d1, c34.shape)
-        return self._configuration(d1, c2, s2, u, Py, c34, s34, R)
-
     def sample_hints(self, poses: Array) -> Array:
         L1, L2 = self.L1, self.L2
         Px, Py, Pz = poses[:, 0, 3], poses[:, 1, 3], poses[:, 2, 3]
@@ -181,6 +189,21 @@ class CArmD1(_CArmBase):
         swing = Pz[:, None] - np.abs(Px)[:, None] * _TAN_SWING[None, :]
         cols = [Pz - t_out, Pz + t_out, Pz - t_in, Pz + t_in, Pz]
         return np.concatenate([np.stack(cols, axis=-1), swing], axis=-1)
+
+    def degenerate(self, poses: Array) -> NDArray[np.bool_]:
+        """Wrist on joint 2's axis (Px = 0) where the orientation does not fix theta2 either (A = B = c = 0 in
+        ``special_solutions``, e.g. theta3 = 0, theta4 = -90 deg, theta5 = 0): a continuum along theta2, which a
+        d1 sweep cannot describe; carm-theta2 reports it as a family."""
+        tol = 1e-9
+        Px, Py, z = poses[:, 0, 3], poses[:, 1, 3], poses[:, :3, 2]
+        out = np.zeros(poses.shape[0], dtype=bool)
+        near = np.abs(Px) <= tol * (self.L1 + self.L2)
+        for eps in (1.0, -1.0):
+            c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))
+            with np.errstate(invalid="ignore"):
+                flat = (np.hypot(c34 * z[:, 0], c34 * z[:, 2]) <= tol) & (np.abs(s34 * z[:, 1]) <= tol)
+            out |= near & flat
+        return out
 
     def search_range(self, poses: Array) -> Array:
         L = self.L1 + self.L2
@@ -241,17 +264,6 @@ class CArmTheta2(_CArmBase):
         u = np.where(np.abs(c2) > 1e-300, u, np.nan)
         c34, s34 = self._elbow(u, Py, eps)
         return d1, c2, s2, u, Py, c34, s34, z, R
-
-    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        _, c2, s2, _, _, c34, s34, z, _ = self._position(poses, theta, branch)
-        return self._residual(c2, s2, c34, s34, z)
-
-    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        d1, c2, s2, u, Py, c34, s34, _, R = self._position(poses, theta, branch)
-        shape = c34.shape
-        return self._configuration(
-            np.broadcast_to(d1, shape), np.broadcast_to(c2, shape), np.broadcast_to(s2, shape), u, Py, c34, s34, R
-        )
 
     def sample_hints(self, poses: Array) -> Array:
         L1, L2 = self.L1, self.L2

@@ -41,17 +41,21 @@ def _elbow_residual(
     return c34 * (c2 * zx + s2 * zz) + s34 * zy
 
 
-def _carm_d1(p, d1: float, b: int) -> float:
-    Px, Py, Pz, zx, zy, zz, L1, L2 = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+def _d1_position(Px: float, Pz: float, d1: float, b: int) -> tuple[float, float, float, float]:
+    """(C2, S2, u, elbow sign) of branch b at rail position d1 (carm-d1)."""
     sigma = 1.0 if b < 2 else -1.0
     eps = 1.0 if b % 2 == 0 else -1.0
     t = Pz - d1
     r = math.hypot(Px, t)
     if r > 0.0:
-        c2, s2 = sigma * Px / r, sigma * t / r
-    else:
-        c2, s2 = sigma, 0.0
-    return _elbow_residual(c2, s2, sigma * r, Py, zx, zy, zz, eps, L1, L2)
+        return sigma * Px / r, sigma * t / r, sigma * r, eps
+    return sigma, 0.0, 0.0, eps
+
+
+def _carm_d1(p, d1: float, b: int) -> float:
+    Px, Py, Pz, zx, zy, zz, L1, L2 = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    c2, s2, u, eps = _d1_position(Px, Pz, d1, b)
+    return _elbow_residual(c2, s2, u, Py, zx, zy, zz, eps, L1, L2)
 
 
 def _carm_theta2(p, th2: float, b: int) -> float:
@@ -71,6 +75,7 @@ def _dispatch(kid: int, p, x: float, b: int) -> float:
 
 if _njit is not None:
     _elbow = _njit(cache=True)(_elbow)
+    _d1_position = _njit(cache=True)(_d1_position)
     _elbow_residual = _njit(cache=True)(_elbow_residual)
     _carm_d1 = _njit(cache=True)(_carm_d1)
     _carm_theta2 = _njit(cache=True)(_carm_theta2)
@@ -84,16 +89,8 @@ def _carm_configuration(kid: int, p, R, x: float, b: int, out) -> None:
     exist), as CArmD1/CArmTheta2.solve_rest; ``R`` is the chain pose's rotation (3, 3)."""
     Px, Py, Pz, L1, L2 = p[0], p[1], p[2], p[6], p[7]
     if kid == CARM_D1:
-        sigma = 1.0 if b < 2 else -1.0
-        eps = 1.0 if b % 2 == 0 else -1.0
         d1 = x
-        t = Pz - d1
-        r = math.hypot(Px, t)
-        if r > 0.0:
-            c2, s2 = sigma * Px / r, sigma * t / r
-        else:
-            c2, s2 = sigma, 0.0
-        u = sigma * r
+        c2, s2, u, eps = _d1_position(Px, Pz, d1, b)
     else:
         eps = 1.0 if b == 0 else -1.0
         c2, s2 = math.cos(x), math.sin(x)
