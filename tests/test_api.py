@@ -37,9 +37,7 @@ def test_version_matches_metadata() -> None:
 
 # Every module of the package (``__main__`` excluded: importing it would run the command).
 MODULES = sorted(
-    m.name
-    for m in pkgutil.walk_packages(sweepik.__path__, prefix="sweepik.")
-    if not m.name.endswith("__main__")
+    m.name for m in pkgutil.walk_packages(sweepik.__path__, prefix="sweepik.") if not m.name.endswith("__main__")
 )
 
 
@@ -48,9 +46,5 @@ def test_docstring_examples_run(module_name: str) -> None:
     if module_name == "sweepik.plot":
         pytest.importorskip("matplotlib")
     module = importlib.import_module(module_name)
-    result = doctest.testmod(
-        module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False
-    )
-    assert result.failed == 0, (
-        f"{result.failed} of {result.attempted} doctest examples failed in {module_name}"
-    )
+    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False)
+    assert result.failed == 0, f"{result.failed} of {result.attempted} doctest examples failed in {module_name}"

@@ -52,9 +52,7 @@ def test_fk_carm_zero_pose(capsys: pytest.CaptureFixture[str]) -> None:
     assert (code, err) == (0, "")
     assert position(out) == (402.0, -350.0, 500.0)
     assert "robot: carm" in out
-    assert re.search(r"ZYZ Euler \[deg\]: alpha = 0\.000000\s+beta = 0\.000000\s+gamma = -90\.000000", out), (
-        out
-    )
+    assert re.search(r"ZYZ Euler \[deg\]: alpha = 0\.000000\s+beta = 0\.000000\s+gamma = -90\.000000", out), out
     assert "gimbal" in out  # beta = 0: the text says which combination is defined
     # The 4x4 matrix: rows of four numbers; the first row is 0 1 0 402.
     rows = [line.split() for line in out.splitlines() if re.fullmatch(r"\s*(-?\d+\.\d+\s*){4}", line)]
@@ -214,9 +212,7 @@ def test_version(capsys: pytest.CaptureFixture[str]) -> None:
     assert re.fullmatch(r"sweepik \d+\.\d+\.\d+\S*", out.strip())
 
 
-@pytest.mark.parametrize(
-    "argv", [[], ["frobnicate"], ["fk", "--bogus", *CARM_ZERO], ["robots", "--precision", "x"]]
-)
+@pytest.mark.parametrize("argv", [[], ["frobnicate"], ["fk", "--bogus", *CARM_ZERO], ["robots", "--precision", "x"]])
 def test_usage_errors_return_2(capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
     code, out, err = run(capsys, *argv)
     assert code == 2

@@ -91,9 +91,7 @@ def test_single_configuration_gives_single_pose(carm: Robot, rng: np.random.Gene
 
 
 @pytest.mark.parametrize("batch", [(), (1,), (3, 2), (2, 1, 3)])
-def test_batched_shapes_match_elementwise(
-    carm: Robot, rng: np.random.Generator, batch: tuple[int, ...]
-) -> None:
+def test_batched_shapes_match_elementwise(carm: Robot, rng: np.random.Generator, batch: tuple[int, ...]) -> None:
     q = random_configs(carm, rng, batch, spread=2.0)
     assert q.shape == (*batch, 6)
     n = carm.n_joints
@@ -116,9 +114,7 @@ def test_frames_start_at_base_and_end_at_tool(rng: np.random.Generator) -> None:
         np.testing.assert_allclose(F[..., 0, :, :], np.broadcast_to(robot.T_world_base, (4, 3, 4, 4)), atol=0)
         np.testing.assert_allclose(F[..., -1, :, :], robot.fk(q), rtol=0, atol=1e-14)
         # The tool frame is the last link frame times T_flange_tool (not equal to it for a real tool).
-        np.testing.assert_allclose(
-            F[..., -1, :, :], F[..., -2, :, :] @ robot.T_flange_tool, rtol=0, atol=1e-14
-        )
+        np.testing.assert_allclose(F[..., -1, :, :], F[..., -2, :, :] @ robot.T_flange_tool, rtol=0, atol=1e-14)
         assert not np.allclose(F[..., -1, :, :], F[..., -2, :, :])
 
 
@@ -192,9 +188,7 @@ def test_standard_table_read_as_modified_differs(rng: np.random.Generator) -> No
     assert np.abs(std.fk(q) - same_rows.fk(q)).max() > 1e-3
 
 
-def test_puma560_modified_and_standard_bundles_agree(
-    puma: Robot, puma_std: Robot, rng: np.random.Generator
-) -> None:
+def test_puma560_modified_and_standard_bundles_agree(puma: Robot, puma_std: Robot, rng: np.random.Generator) -> None:
     for spread in (1.0, 3.0):
         q = random_configs(puma, rng, 2000, spread=spread)
         np.testing.assert_allclose(puma.fk(q), puma_std.fk(q), rtol=0, atol=1e-12)

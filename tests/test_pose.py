@@ -258,9 +258,7 @@ def test_pose_error_geodesic_is_distance_plus_weighted_angle(rng: np.random.Gene
 
 
 def test_pose_error_geodesic_zero_for_identical_poses(rng: np.random.Generator) -> None:
-    T = np.stack(
-        [random_pose(rng, 1000.0) for _ in range(100)] + [load_robot("carm").fk([500.0, 0, 0, 0, 0, 0])]
-    )
+    T = np.stack([random_pose(rng, 1000.0) for _ in range(100)] + [load_robot("carm").fk([500.0, 0, 0, 0, 0, 0])])
     np.testing.assert_allclose(pose_error_geodesic(T, T), 0.0, rtol=0, atol=1e-12)
 
 

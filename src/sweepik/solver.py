@@ -6,6 +6,7 @@ configurations -> FK check against the target -> joint limits -> duplicates remo
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Literal
 
 import numpy as np
@@ -326,9 +327,13 @@ def _solve_chunk(
                 if n_reachable[i] > 0
                 else "unreachable: no configuration of the arm reaches this pose"
             )
-        if i in fallback:  # the reduction's blind spot: the fallback reduction's answer (with its families)
-            results.append(fallback[i])
-            continue
+        if i in fallback:  # the reduction's blind spot: add the fallback reduction's families
+            other = fallback[i]
+            fam = fam + other.families
+            if e == s:  # and its isolated solutions when this reduction has none
+                results.append(replace(other, families=fam))
+                continue
+            reason = None
         results.append(
             Solutions(
                 q=qi[s_keep],

@@ -25,6 +25,10 @@ from ..robot import Robot
 from . import kernels
 from .base import Array, IntArray, Reduction
 
+#: |Px| below this times L1 + L2 (7.5e-10 mm on the C-Arm) is taken as exactly 0: the wrist then lies in the
+#: plane of joint 2's axis and the rail, where theta2 = +-90 deg exactly; rounding of the pose would otherwise
+#: make d1 = Pz - Px tan(theta2) and the theta2 swing ill-defined.
+PX_SNAP_REL = 1e-12
 #: Relative tolerance on the structure check of a robot against the C-Arm's DH table.
 _STRUCT_TOL = 1e-9
 #: rho^2 - k^2 down to -DISC_TOL * (L1 + L2)^2 counts as 0: the elbow domain edges are sampled exactly
@@ -65,12 +69,14 @@ class _CArmBase(Reduction):
     def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:
         super().__init__(robot, free_joint, n_branches)
         self.L1, self.L2 = carm_lengths(robot)
+        self.px_snap = PX_SNAP_REL * (self.L1 + self.L2)
 
     def kernel_params(self, poses: Array) -> Array:
         """``(N, 8)``: Px, Py, Pz, zx, zy, zz, L1, L2 for the compiled residual (reductions/kernels.py)."""
         N = poses.shape[0]
         out = np.empty((N, 8))
         out[:, 0:3] = poses[:, :3, 3]
+        out[:, 0] = np.where(np.abs(out[:, 0]) <= self.px_snap, 0.0, out[:, 0])
         out[:, 3:6] = poses[:, :3, 2]
         out[:, 6], out[:, 7] = self.L1, self.L2
         return out
@@ -128,11 +134,13 @@ class _CArmBase(Reduction):
         return np.stack([d1, th2, th3, th4, th5, th6], axis=-1)
 
 
-def _unpack(poses: Array, extra_dims: int) -> tuple[Array, Array, Array, Array, Array]:
-    """Px, Py, Pz, z axis (3, N, 1...) and R (3, 3, N, 1...) broadcastable against (N, M[, B])."""
+def _unpack(poses: Array, extra_dims: int, snap: float) -> tuple[Array, Array, Array, Array, Array]:
+    """Px, Py, Pz, z axis (3, N, 1...) and R (3, 3, N, 1...) broadcastable against (N, M[, B]); |Px| <= snap
+    is taken as 0 (see ``PX_SNAP_REL``)."""
     shape = (poses.shape[0],) + (1,) * extra_dims
     P = poses[:, :3, 3]
     Px, Py, Pz = (P[:, i].reshape(shape) for i in range(3))
+    Px = np.where(np.abs(Px) <= snap, 0.0, Px)
     R = np.moveaxis(poses[:, :3, :3], 0, -1).reshape(3, 3, *shape)
     z = R[:, 2]
     return Px, Py, Pz, z, R
@@ -165,7 +173,7 @@ class CArmD1(_CArmBase):
 
     def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
         extra = 2 if branch is None else 1
-        Px, Py, Pz, z, R = _unpack(poses, extra)
+        Px, Py, Pz, z, R = _unpack(poses, extra, self.px_snap)
         sigma, eps = self._signs(theta.ndim, branch)
         d1 = theta[..., None] if branch is None else theta
         t = Pz - d1
@@ -216,7 +224,7 @@ class CArmD1(_CArmBase):
         sel = np.abs(poses[:, 0, 3]) <= 1e-9 * (self.L1 + self.L2)
         if not sel.any():
             return None
-        Px, Py, Pz, z, R = _unpack(poses, 0)
+        Px, Py, Pz, z, R = _unpack(poses, 0, self.px_snap)
         out = []
         for eps in (1.0, -1.0):
             c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))
@@ -253,7 +261,7 @@ class CArmTheta2(_CArmBase):
 
     def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
         extra = 2 if branch is None else 1
-        Px, Py, Pz, z, R = _unpack(poses, extra)
+        Px, Py, Pz, z, R = _unpack(poses, extra, self.px_snap)
         th = theta[..., None] if branch is None else theta
         b = np.arange(2).reshape((1,) * theta.ndim + (2,)) if branch is None else np.asarray(branch)
         eps = np.where(b == 0, 1.0, -1.0)
