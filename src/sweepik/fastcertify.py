@@ -8,6 +8,7 @@ hundred small array operations per solve.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,6 +17,10 @@ from .fastsweep import AVAILABLE, PARALLEL_MIN, _fk_one
 from .pose import GIMBAL_TOL
 from .reductions.kernels import configuration_by_id
 from .units import orientation_weight
+
+if TYPE_CHECKING:
+    from .reductions.base import IntArray, Reduction
+    from .robot import Robot
 
 Array = NDArray[np.float64]
 _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
@@ -130,3 +135,27 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, 
         ep,
     )
     return q, eg, ep
+
+
+if AVAILABLE:
+
+    @njit(cache=True)
+    def _configurations(kid, params, chain, pose, theta, branch, q):
+        for k in range(pose.shape[0]):
+            configuration_by_id(kid, params[pose[k]], chain[pose[k]], theta[k], branch[k], q[k])
+
+
+def configurations(robot: Robot, red: Reduction, chain: Array, pose: IntArray, theta: Array, branch: IntArray) -> Array:
+    """Configurations ``(K, n)`` of branch ``branch`` at theta* ``theta`` of chain poses ``chain[pose]`` (compiled
+    ``solve_rest`` for reductions with a kernel; NaN rows where the branch does not exist)."""
+    q = np.empty((pose.shape[0], robot.n_joints))
+    _configurations(
+        red.kernel_id,
+        np.ascontiguousarray(red.kernel_params(chain)),
+        np.ascontiguousarray(chain),
+        pose.astype(np.int64),
+        theta.astype(np.float64),
+        branch.astype(np.int64),
+        q,
+    )
+    return q

@@ -206,6 +206,8 @@ class CArmD1(_CArmBase):
         Px, Py, z = poses[:, 0, 3], poses[:, 1, 3], poses[:, :3, 2]
         out = np.zeros(poses.shape[0], dtype=bool)
         near = np.abs(Px) <= tol * (self.L1 + self.L2)
+        if not near.any():
+            return out
         for eps in (1.0, -1.0):
             c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))
             with np.errstate(invalid="ignore"):
