@@ -9,6 +9,7 @@ from importlib.metadata import PackageNotFoundError, version
 from .errors import (
     InvalidPoseError,
     NonFiniteError,
+    PoseFileError,
     RobotDefinitionError,
     RobotFileError,
     ShapeError,
@@ -70,4 +71,5 @@ __all__ = [
     "NonFiniteError",
     "InvalidPoseError",
     "UnknownOptionError",
+    "PoseFileError",
 ]

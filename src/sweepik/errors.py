@@ -11,6 +11,7 @@ __all__ = [
     "NonFiniteError",
     "InvalidPoseError",
     "UnknownOptionError",
+    "PoseFileError",
 ]
 
 
@@ -44,3 +45,7 @@ class InvalidPoseError(SweepikError):
 
 class UnknownOptionError(SweepikError):
     """An option takes one of a fixed set of values (strategy, reduction, ...) and got another."""
+
+
+class PoseFileError(SweepikError):
+    """A pose file cannot be read: missing, unknown extension, or content not in a supported layout."""

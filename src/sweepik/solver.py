@@ -15,15 +15,14 @@ from numpy.typing import ArrayLike, NDArray
 from . import fastcertify, fastsweep
 from ._validate import check_poses
 from .errors import ShapeError, UnknownOptionError
+from .families import families_of
 from .paper_sweep import paper_candidates
 from .polish import polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, get_reduction
-from .reductions.base import IntArray
 from .robot import Robot
-from .rootfind import find_roots
 from .solutions import Family, Solutions
-from .sweep import CLUSTER_FAMILY_REL, N_SAMPLES, FamilySpan, find_candidates
+from .sweep import N_SAMPLES, FamilySpan, find_candidates
 from .units import mm_per_unit, orientation_weight
 
 __all__ = ["solve", "solve_many", "STRATEGIES"]
@@ -123,145 +122,6 @@ _DEDUPE_WINDOW = 16
 _DEDUPE_PAIRWISE = 48
 
 
-def _family_members(
-    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], theta: Array
-) -> Array:
-    """Members ``(K, n)`` at ``theta (K,)`` of the families (pose, branch) (compiled where possible)."""
-    if red.kernel_id is not None and fastsweep.AVAILABLE:
-        return fastcertify.configurations(robot, red, chain, pose, theta, branch)
-    return red.solve_rest(chain[pose], theta[:, None], branch[:, None])[:, 0]
-
-
-def _family_members_ok(
-    robot: Robot,
-    red: Reduction,
-    chain: Array,
-    world: Array,
-    pose: NDArray[np.intp],
-    branch: NDArray[np.intp],
-    theta: Array,
-    limits: bool,
-) -> NDArray[np.bool_]:
-    """``theta (K, M)``: members exist, are certified by FK and (with limits) lie inside the limits."""
-    tol = ACCEPT_TOL_REL * robot.length_scale
-    if red.kernel_id is not None and fastsweep.AVAILABLE:
-        # compiled: configuration, FK and error per member (flange frame compared with the chain pose)
-        M = theta.shape[1]
-        flat_p = np.repeat(pose, M)
-        flat_b = np.repeat(branch, M)
-        q = fastcertify.configurations(robot, red, chain, flat_p, theta.ravel(), flat_b)
-        q = q.reshape(*theta.shape, robot.n_joints)
-        ok = np.all(np.isfinite(q), axis=-1)
-        # FK certification of every _FAMILY_CERTIFY_EVERY-th member (the family came from a vanishing
-        # residual); a span with a failing member is certified member by member
-        sub = np.arange(0, M, _FAMILY_CERTIFY_EVERY)
-        Ms = sub.size
-        _, err, _ = fastcertify.certify(
-            robot, red, chain, world, np.repeat(pose, Ms), theta[:, sub].ravel(), np.repeat(branch, Ms)
-        )
-        bad = np.nonzero(np.any(err.reshape(-1, Ms) > tol, axis=1))[0]
-        if bad.size:
-            _, err_b, _ = fastcertify.certify(
-                robot, red, chain, world, np.repeat(pose[bad], M), theta[bad].ravel(), np.repeat(branch[bad], M)
-            )
-            ok[bad] &= (err_b <= tol).reshape(bad.size, M)
-        qz = np.nan_to_num(q)
-    else:
-        q = red.solve_rest(chain[pose], theta, np.broadcast_to(branch[:, None], theta.shape))
-        ok = np.all(np.isfinite(q), axis=-1)
-        qz = np.nan_to_num(q)
-        flange = fastsweep.flange_poses(robot, qz.reshape(-1, qz.shape[-1])).reshape(*qz.shape[:-1], 4, 4)
-        T = robot.T_base_world @ flange
-        ok &= pose_error_geodesic(T, chain[pose][:, None], orientation_weight(robot.length_unit)) <= tol
-    if limits:
-        ok &= robot.within_limits(qz)
-    return np.asarray(ok)
-
-
-def _families(
-    robot: Robot, red: Reduction, chain: Array, world: Array, spans: list[FamilySpan], limits: bool
-) -> tuple[dict[int, list[Family]], NDArray[np.intp], Array]:
-    """Family objects per pose: each span cut to the sub-intervals whose members are certified by FK
-    (and, with limits, inside the limits): sampled, then each cut at a limit located by root finding.
-    Pieces that shrink to a point are returned as isolated members ``(pose index, q)``."""
-    out: dict[int, list[Family]] = {}
-    if not spans:
-        return out, np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
-    pose = np.array([sp.pose for sp in spans])
-    branch = np.array([sp.branch for sp in spans])
-    u = np.linspace(0.0, 1.0, _FAMILY_SAMPLES)
-    grid = np.array([sp.lo for sp in spans])[:, None] + np.array([sp.hi - sp.lo for sp in spans])[:, None] * u
-    ok = _family_members_ok(robot, red, chain, world, pose, branch, grid, limits)
-    pad = np.zeros((len(spans), 1), np.int8)
-    edges = np.diff(np.concatenate([pad, ok.astype(np.int8), pad], axis=1), axis=1)
-    pieces = []  # (span index, first ok sample, last ok sample)
-    for k in range(len(spans)):
-        for s_, e_ in zip(np.nonzero(edges[k] == 1)[0], np.nonzero(edges[k] == -1)[0], strict=True):
-            pieces.append((k, int(s_), int(e_ - 1)))
-    if not pieces:
-        return out, np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
-    K, S, E = (np.array(x) for x in zip(*pieces, strict=True))
-    M = grid.shape[1]
-    # bisect each cut between the last sample inside and the first outside
-    inside = np.concatenate([grid[K, S], grid[K, E]])
-    outside = np.concatenate([grid[K, np.maximum(S - 1, 0)], grid[K, np.minimum(E + 1, M - 1)]])
-    cut = np.nonzero(np.concatenate([S > 0, E < M - 1]))[0]  # only cuts inside a span need locating
-    which = np.concatenate([K, K])[cut]
-    if cut.size and limits:
-        # members between certified samples are solutions too: the cut is where they leave the limits, i.e.
-        # a root of the largest limit excess (continuous along the family): bracketed root finding
-        def limit_excess(x: Array, sel: IntArray) -> Array:
-            qx = _family_members(robot, red, chain, pose[which[sel]], branch[which[sel]], x)
-            w = robot.wrap(np.nan_to_num(qx, nan=np.inf))
-            return np.max(np.maximum(robot.lower - w, w - robot.upper), axis=-1)
-
-        idx = np.arange(cut.size)
-        e_in, e_out = limit_excess(inside[cut], idx), limit_excess(outside[cut], idx)
-        ok = (e_in <= 0) & (e_out > 0) & np.isfinite(e_out)
-        kk = np.nonzero(ok)[0]
-        if kk.size:
-            root = find_roots(
-                lambda x, sel: limit_excess(x, kk[sel]),
-                inside[cut][kk],
-                outside[cut][kk],
-                e_in[kk],
-                e_out[kk],
-                1e-9 * robot.length_scale,
-            )
-            # keep the side that is inside (the root finder may end on either side of the crossing)
-            good = limit_excess(root, kk) <= robot.limit_tol.min()
-            inside[cut[kk]] = np.where(good, root, inside[cut[kk]])
-    n = len(pieces)
-    lo, hi = inside[:n], inside[n:]
-    # a piece that shrinks to a point (the family touches the limits there) is an isolated solution
-    point = hi - lo <= CLUSTER_FAMILY_REL * (grid[K, -1] - grid[K, 0] + 1.0)
-    for j, k in enumerate(K):
-        if not point[j]:
-            sp = spans[k]
-            out.setdefault(sp.pose, []).append(
-                Family(red.free_joint, (float(lo[j]), float(hi[j])), red, chain[sp.pose], sp.branch)
-            )
-    pk = K[point]
-    # its member: of the piece's ends and middle, the one deepest inside the limits
-    three = np.stack([lo[point], 0.5 * (lo + hi)[point], hi[point]], axis=1)
-    q3 = red.solve_rest(chain[pose[pk]], three, np.broadcast_to(branch[pk][:, None], three.shape))
-    w = robot.wrap(np.nan_to_num(q3, nan=np.inf))
-    over = np.sum(np.maximum(robot.lower - w, 0.0) + np.maximum(w - robot.upper, 0.0), axis=-1)
-    mid = three[np.arange(pk.size), np.argmin(over, axis=1)] if pk.size else np.zeros(0)
-    q_pts = (
-        red.solve_rest(chain[pose[pk]], mid[:, None], branch[pk][:, None])[:, 0]
-        if pk.size
-        else np.zeros((0, robot.n_joints))
-    )
-    return out, pose[pk].astype(np.intp), q_pts
-
-
-#: Samples along a family span to certify its members and cut it to the joint limits.
-_FAMILY_SAMPLES = 33
-#: Every this many samples of a family span is certified by FK (all of them if one fails).
-_FAMILY_CERTIFY_EVERY = 8
-
-
 def _solve_chunk(
     robot: Robot, red: Reduction, poses: Array, strategy: str, limits: bool, n_samples: int
 ) -> list[Solutions]:
@@ -289,7 +149,7 @@ def _solve_chunk(
                 err_geo, err_paper = np.concatenate([err_geo, eg_sp]), np.concatenate([err_paper, ep_sp])
             q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
-        fams, fam_p, fam_q = _families(robot, red, chain, poses, spans, limits)
+        fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, ACCEPT_TOL_REL * robot.length_scale)
         if fam_p.size:
             if err_geo is not None and err_paper is not None:
                 eg_f, ep_f = _errors(robot, fam_q, poses[fam_p], weight)

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._validate import check_configuration, check_poses
-from .errors import ShapeError, SweepikError, UnknownOptionError
+from .errors import PoseFileError, ShapeError, UnknownOptionError
 from .pose import pose_error_paper, pose_from_xyz_zyz
 from .reductions import Reduction
 from .robot import Robot
@@ -57,10 +57,6 @@ BRANCH_SWITCH_LENGTH_REL = 0.1
 #: Members sampled along a self-motion family before the nearest one is refined (golden section).
 _FAMILY_SAMPLES = 721
 _GOLDEN_ITERS = 60
-
-
-class PoseFileError(SweepikError):
-    """A pose file cannot be read: missing, unknown extension, or content not in a supported layout."""
 
 
 def weighted_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
