@@ -447,11 +447,11 @@ if AVAILABLE:
             _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt, i)
 
 
-def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int):
+def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
     """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
     Poses whose candidate or family buffers overflow are redone by the NumPy engine."""
     theta = _ref.sample_grid(reduction, poses, lo, hi, n_samples)
-    params = np.ascontiguousarray(reduction.kernel_params(poses), dtype=np.float64)
+    params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
     out_b = np.empty((N, MAX_CAND), dtype=np.int64)

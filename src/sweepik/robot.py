@@ -192,7 +192,7 @@ class Robot:
         """
         qa = check_configuration(q, self.n_joints, finite=False)
         w = np.pi - np.mod(np.pi - qa, 2.0 * np.pi)
-        for shift in (2.0 * np.pi, -2.0 * np.pi):
+        for shift in (2.0 * np.pi, -2.0 * np.pi) if self._limits_beyond_pi else ():
             cand = w + shift
             better = (w < self.lower - self.limit_tol) | (w > self.upper + self.limit_tol)
             ok = (cand >= self.lower - self.limit_tol) & (cand <= self.upper + self.limit_tol)
@@ -207,6 +207,12 @@ class Robot:
         """``wrap(q)`` and ``within_limits(q)`` in one pass."""
         w = self.wrap(q)
         return w, np.all((w >= self.lower - self.limit_tol) & (w <= self.upper + self.limit_tol), axis=-1)
+
+    @cached_property
+    def _limits_beyond_pi(self) -> bool:
+        """Some revolute limit lies outside [-pi, pi]: only then can a shift by 2 pi bring a value inside."""
+        rev = self.is_revolute
+        return bool(np.any(rev & ((self.lower < -np.pi - LIMIT_TOL) | (self.upper > np.pi + LIMIT_TOL))))
 
     @cached_property
     def limit_tol(self) -> Array:

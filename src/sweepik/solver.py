@@ -134,8 +134,11 @@ def _solve_chunk(
     err_geo = err_paper = None
     if strategy == "precise":
         if compiled:
-            cand, spans = fastsweep.search(red, chain, lo, hi, n_samples)
-            q, err_geo, err_paper = fastcertify.certify(robot, red, chain, poses, cand.pose, cand.theta, cand.branch)
+            params = red.kernel_params(chain)
+            cand, spans = fastsweep.search(red, chain, lo, hi, n_samples, params)
+            q, err_geo, err_paper = fastcertify.certify(
+                robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
+            )
         else:
             cand, spans = find_candidates(red, chain, lo, hi, n_samples)
             q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
