@@ -24,6 +24,9 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
+#: Candidates whose geodesic error exceeds this times the orientation weight (1e-4 x 100 mm = 0.01 mm) are far
+#: from any solution (accepted ones are below 1e-9 mm, polished ones below 3e-3 mm): their J is reported as inf.
+J_CUTOFF_FACTOR = 1e-4
 
 if AVAILABLE:
     from numba import njit, prange
@@ -60,6 +63,8 @@ if AVAILABLE:
         vx, vy, vz = M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]
         ang = math.atan2(0.5 * math.sqrt(vx * vx + vy * vy + vz * vz), 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0))
         geo = dp + weight * ang
+        if geo > J_CUTOFF_FACTOR * weight:  # far from a solution: the paper's J is not needed
+            return geo, np.inf
         a, b, g = _zyz(T)
         ad, bd, gd = _zyz(Td)
         da, db, dg = _wrap(a - ad), b - bd, _wrap(g - gd)
