@@ -194,7 +194,9 @@ def test_run_trajectory_precise_is_continuous_and_exact() -> None:
     assert tr["points"] >= 41 and tr["recall"] == 1.0
     assert tr["branch_switches"] == 0 and tr["switch_steps"] == []
     assert tr["J_max"] <= 1e-9
-    step = tr["max_joint_step"]
+    assert 0 < tr["max_joint_step"] < 30  # degrees
+    step = tr["max_joint_step_detail"]
+    assert step["angle_deg"] == tr["max_joint_step"]
     assert 0 < step["angle_deg"] < 30 and 0 < step["length"] < 200 and step["length_unit"] == "mm"
     assert set(step["per_joint"]) == set(CARM.joint_names)
     np.testing.assert_allclose(tr["achieved_xyz"], tr["xyz"], atol=1e-9)

@@ -198,7 +198,7 @@ def save_verification_figures(result: Mapping[str, Any], directory: str | PathLi
             np.array(tr["q"], dtype=np.float64),
             joint_names=tr.get("joint_names"),
             revolute=tr.get("joint_revolute"),
-            length_unit=tr.get("max_joint_step", {}).get("length_unit"),
+            length_unit=tr.get("max_joint_step_detail", {}).get("length_unit"),
         )
         ax.set_title("Joint values along the trajectory", fontsize=10)
         save(ax, "trajectory_joints")

@@ -474,9 +474,9 @@ def run_trajectory(
     """Table 4 / Figure 5: follow the rectangle, nearest solution at every step (see ``follow_path``).
 
     Returns ``points``, ``recall`` (share of points with a solution), ``J_max``, ``J_mean``, ``J_99_6`` (mm,
-    of the chosen solutions), ``seconds_per_point``, ``max_joint_step`` (``{"angle_deg", "length",
-    "length_unit", "per_joint"}``: largest change between consecutive points; per joint in degrees or the
-    length unit), ``branch_switches`` (steps over ``branch_switch_thresholds``: 30 deg, or 10 % of a
+    of the chosen solutions), ``seconds_per_point``, ``max_joint_step`` (the largest change of a revolute joint between
+    consecutive points, degrees), ``max_joint_step_detail`` (``{"angle_deg", "length", "length_unit",
+    "per_joint"}``: the same per joint, in degrees or the length unit), ``branch_switches`` (steps over ``branch_switch_thresholds``: 30 deg, or 10 % of a
     prismatic joint's range), ``switch_steps``, ``solutions_per_point`` and, for plotting, ``corners``,
     ``xyz`` (desired positions), ``achieved_xyz`` (FK of the chosen configurations) and ``q`` (d1 mm,
     angles rad; None where a point has no solution).
@@ -502,7 +502,9 @@ def run_trajectory(
         "recall": _num(res.recall),
         **_error_stats(res.error),
         "seconds_per_point": _num(seconds / poses.shape[0]),
-        "max_joint_step": {
+        # a number, like the other metrics: the largest change of any revolute joint, in degrees
+        "max_joint_step": _num(shown[rev].max()) if np.any(rev) else None,
+        "max_joint_step_detail": {
             "angle_deg": _num(shown[rev].max()) if np.any(rev) else None,
             "length": _num(shown[~rev].max()) if np.any(~rev) else None,
             "length_unit": robot.length_unit,

@@ -59,7 +59,7 @@ _METRICS = (
     ("J_mean", "J_mean (mm)", "num"),
     ("J_99_6", "J_99.6% (mm)", "num"),
     ("seconds_per_point", "time per point", "time"),
-    ("max_joint_step", "max joint step", "step"),
+    ("max_joint_step_detail", "max joint step", "step"),
     ("branch_switches", "branch switches", "int"),
 )
 
@@ -237,7 +237,7 @@ def _explanations(result: dict[str, Any]) -> list[str]:
             f"({e(ref['trajectory']['J_max'])} / {e(ref['trajectory']['J_mean'])} mm; ours: "
             f"{_fmt(tr['J_max'], 'num')} / {_fmt(tr['J_mean'], 'num')} mm — the difference is rounding). "
             f"Following the nearest solution gives {tr['branch_switches']} branch switch(es) and a largest step "
-            f"of {_fmt(tr['max_joint_step'], 'step')}."
+            f"of {_fmt(tr['max_joint_step_detail'], 'step')}."
         )
     return out
 
