@@ -478,8 +478,9 @@ def run_trajectory(
     joint between consecutive points, degrees), ``max_joint_step_detail`` (``{"angle_deg", "length",
     "length_unit", "per_joint"}``: the same per joint, in degrees or the length unit), ``branch_switches``
     (steps over ``branch_switch_thresholds``: 30 deg, or 10 % of a prismatic joint's range),
-    ``switch_steps``, ``solutions_per_point`` and, for plotting, ``corners``, ``xyz`` (desired positions), ``achieved_xyz`` (FK of the chosen configurations) and ``q`` (d1 mm,
-    angles rad; None where a point has no solution).
+    ``switch_steps``, ``solutions_per_point`` and, for plotting, ``corners``, ``xyz`` (desired positions),
+    ``achieved_xyz`` (FK of the chosen configurations) and ``q`` (d1 mm, angles rad; None where a point has
+    no solution).
     """
     _check_strategy(strategy, STRATEGIES)
     poses = trajectory_poses(robot, corners, per_edge)
