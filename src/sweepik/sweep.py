@@ -11,7 +11,10 @@ giving one residual sequence per (pose, branch). On each sequence:
 * intervals where the curve bends enough to hide two roots between its samples (judged from second
   differences), or that touch a domain edge (square-root behaviour), are resampled more finely, recursively,
   and searched the same way;
-* runs of samples where the residual vanishes identically -> self-motion families.
+* runs of samples where the residual vanishes identically -> self-motion families;
+* roots in a stretch where the residual stays at rounding level (roots of high multiplicity) -> moved to the
+  middle of the stretch; a stretch longer than ``CLUSTER_FAMILY_REL`` of the range is a family (a numerical
+  continuum); roots joined by such stretches are merged.
 
 The result is a flat list of candidates ``(pose index, branch, theta*)``; ``solve`` turns them into
 configurations, certifies each by forward kinematics and applies limits.
