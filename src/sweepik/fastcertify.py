@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from .fastsweep import AVAILABLE, PARALLEL_MIN, _fk_one
+from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
 from .reductions.kernels import configuration_by_id
 from .units import orientation_weight
@@ -30,6 +30,8 @@ J_CUTOFF_FACTOR = 1e-4
 
 if AVAILABLE:
     from numba import njit, prange
+
+    from .fastsweep import _fk_one
 
     @njit(cache=True)
     def _wrap(x):

@@ -14,6 +14,7 @@ one row of ``Reduction.kernel_params(poses)``. The kernel is selected by ``Reduc
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,7 +26,8 @@ from .robot import Robot
 try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
     from numba import njit, prange
 
-    AVAILABLE = True
+    #: The compiled kernels are used; set SWEEPIK_DISABLE_NUMBA=1 to run the NumPy reference engine.
+    AVAILABLE = not os.environ.get("SWEEPIK_DISABLE_NUMBA")
 except ImportError:  # pragma: no cover - exercised only without numba
     AVAILABLE = False
 
