@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -265,6 +266,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SweepikError as exc:
         _error(str(exc))
         return EXIT_USAGE
+    except BrokenPipeError:  # output piped into a command that stopped reading (e.g. `| head`)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except (OSError, UnicodeError) as exc:  # unreadable or undecodable robot file
         _error(str(exc))
         return EXIT_IO
