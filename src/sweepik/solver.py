@@ -123,7 +123,13 @@ _DEDUPE_PAIRWISE = 48
 
 
 def _solve_chunk(
-    robot: Robot, red: Reduction, poses: Array, strategy: str, limits: bool, n_samples: int
+    robot: Robot,
+    red: Reduction,
+    poses: Array,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    use_fallback: bool = True,
 ) -> list[Solutions]:
     chain = _chain_poses(robot, poses)
     lo, hi = _theta_range(robot, red, chain, limits)
@@ -182,7 +188,23 @@ def _solve_chunk(
         certified = err_geo <= ACCEPT_TOL_REL * robot.length_scale
     else:
         certified = err_paper < PAPER_ACCEPT_MM / mm_per_unit(robot.length_unit)
+    rescue = np.zeros(0, dtype=np.intp)
+    if strategy == "precise" and use_fallback and red.fallback is not None:
+        # a candidate that polishing could not certify (error between rounding level and 1e-6 of the arm):
+        # the reduction's closed form is ill-conditioned there; the fallback reduction solves the pose too
+        miss = ~certified & (err_geo <= POLISH_BELOW_REL * robot.length_scale)
+        rescue = np.unique(pose_idx[miss])
     pose_idx, q, err_paper, err_geo = pose_idx[certified], q[certified], err_paper[certified], err_geo[certified]
+    if rescue.size:
+        rescued = _solve_chunk(
+            robot, get_reduction(robot, red.fallback), poses[rescue], strategy, limits, n_samples, False
+        )
+        for r_pose, r_sol in zip(rescue, rescued, strict=True):
+            if len(r_sol):
+                pose_idx = np.concatenate([pose_idx, np.full(len(r_sol), r_pose, dtype=pose_idx.dtype)])
+                q = np.concatenate([q, r_sol.q])
+                err_paper = np.concatenate([err_paper, r_sol.error])
+                err_geo = np.concatenate([err_geo, r_sol.error_geodesic])
     q, inside = robot.wrapped_within_limits(q)
     n_reachable = np.bincount(pose_idx, minlength=len(poses))
     if limits:
@@ -201,14 +223,16 @@ def _solve_chunk(
         # so that the reason can tell "out of joint limits" from "unreachable"
         empty = np.nonzero((np.bincount(pose_idx, minlength=len(poses)) == 0) & (n_reachable == 0))[0]
         if empty.size and red.search_range(chain[empty]) is not None:
-            beyond = _solve_chunk(robot, red, poses[empty], strategy, False, n_samples)
+            beyond = _solve_chunk(robot, red, poses[empty], strategy, False, n_samples, use_fallback)
             n_reachable[empty] = [len(b) for b in beyond]
     fallback: dict[int, Solutions] = {}
-    if strategy == "precise" and red.fallback is not None:
+    if strategy == "precise" and use_fallback and red.fallback is not None:
         deg = red.degenerate(chain)
         if deg is not None and deg.any():
             idx = np.nonzero(deg)[0]
-            alt = _solve_chunk(robot, get_reduction(robot, red.fallback), poses[idx], strategy, limits, n_samples)
+            alt = _solve_chunk(
+                robot, get_reduction(robot, red.fallback), poses[idx], strategy, limits, n_samples, False
+            )
             fallback = {int(i): a for i, a in zip(idx, alt, strict=True) if a.families}
     order = np.argsort(pose_idx, kind="stable")
     pose_idx, q, err_paper, err_geo, inside = (

@@ -49,8 +49,9 @@ class Reduction(ABC):
     #: Rounding noise of ``residual`` (absolute). A residual extremum that dips below zero by less than this
     #: is treated as one double root. 1e-14 suits residuals built from O(1) sines, cosines and unit vectors.
     residual_noise: float = 1e-14
-    #: Registry name of a reduction to hand poses to where ``degenerate`` says this one cannot describe
-    #: the solution set (e.g. a continuum along a joint other than theta*).
+    #: Registry name of a reduction that also solves poses where this one cannot describe the solution set
+    #: (``degenerate``: e.g. a continuum along a joint other than theta*) or where its closed form is
+    #: ill-conditioned (a candidate that even a Newton polish cannot certify); its solutions are merged in.
     fallback: str | None = None
     #: Id of a compiled scalar residual in ``reductions.kernels`` (None: the NumPy engine is used).
     kernel_id: int | None = None

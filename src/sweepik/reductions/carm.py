@@ -256,6 +256,7 @@ class CArmTheta2(_CArmBase):
 
     name = "carm-theta2"
     kernel_id = kernels.CARM_THETA2
+    fallback = "carm-d1"
     blind_spots = "cos(theta2) = 0 (d1 drops out): solved separately as a special slice; families need carm-d1"
 
     def __init__(self, robot: Robot) -> None:
