@@ -157,7 +157,9 @@ def add_path_parser(sub: _SubParsers) -> None:
         ),
     )
     p.add_argument("args", nargs="+", metavar="[ROBOT] POSES_FILE", help="robot (optional), then the pose file")
-    p.add_argument("--start", nargs="+", metavar="Q", help="start configuration (degrees / length unit)")
+    p.add_argument(
+        "--start", nargs="+", metavar="Q", help="start configuration (degrees, or radians with --rad; length unit)"
+    )
     p.add_argument("-o", "--output", metavar="FILE", help="write the joint path here (.csv or .json)")
     _add_ik_options(p)
     _add_json(p, ": summary (points, max joint step, branch switches, errors) and the path")

@@ -81,6 +81,19 @@ def _members_ok(
     return np.asarray(ok)
 
 
+def merge_spans(spans: list[FamilySpan]) -> list[FamilySpan]:
+    """One span per stretch: spans of one pose and branch that overlap or touch are united (the sweep finds a
+    family from its samples and again from flat stretches around roots)."""
+    out: list[FamilySpan] = []
+    for sp in sorted(spans, key=lambda x: (x.pose, x.branch, x.lo)):
+        last = out[-1] if out else None
+        if last is not None and last.pose == sp.pose and last.branch == sp.branch and sp.lo <= last.hi:
+            out[-1] = FamilySpan(last.pose, last.branch, last.lo, max(last.hi, sp.hi))
+        else:
+            out.append(sp)
+    return out
+
+
 def families_of(
     robot: Robot, red: Reduction, chain: Array, world: Array, spans: list[FamilySpan], limits: bool, tol: float
 ) -> tuple[dict[int, list[Family]], NDArray[np.intp], Array]:
@@ -88,6 +101,7 @@ def families_of(
     (and, with limits, inside the limits): sampled, then each cut at a limit located by root finding.
     Pieces that shrink to a point are returned as isolated members ``(pose index, q)``."""
     out: dict[int, list[Family]] = {}
+    spans = merge_spans(spans)
     if not spans:
         return out, np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
     pose = np.array([sp.pose for sp in spans])

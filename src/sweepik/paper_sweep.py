@@ -52,6 +52,8 @@ def paper_candidates(
     else:
         step = COARSE_STEP_MM / mm_per_unit(robot.length_unit)
     N = chain.shape[0]
+    if not limits and not red.periodic:  # keep the paper's lattice (multiples of the step) when unbounded
+        lo = np.floor(lo / step) * step
     m = int(np.floor((hi - lo).max() / step + 1e-9)) + 1
     grid = lo[:, None] + step * np.arange(m)[None, :]
     grid = np.minimum(grid, hi[:, None])

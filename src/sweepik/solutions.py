@@ -114,7 +114,7 @@ class Solutions:
             best, best_d = self.q[i], float(d[i])
         for fam in self.families:
             lo, hi = fam.interval
-            for _ in range(4):  # coarse-to-fine search along the family
+            for _ in range(8):  # coarse-to-fine search along the family (each pass narrows 50x)
                 grid = np.linspace(lo, hi, 101)
                 d = np.linalg.norm(joint_distance(self.robot, fam.at(grid), ref), axis=-1)
                 i = int(np.nanargmin(d))

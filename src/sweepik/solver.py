@@ -218,7 +218,7 @@ def _solve_chunk(
     keep = _dedupe(robot, pose_idx, q, err_geo)
     pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
 
-    if limits and not red.periodic:
+    if limits and not red.periodic and strategy == "precise":
         # the sweep covered theta*'s limits only: for poses left without any solution, look beyond them
         # so that the reason can tell "out of joint limits" from "unreachable"
         empty = np.nonzero((np.bincount(pose_idx, minlength=len(poses)) == 0) & (n_reachable == 0))[0]
@@ -262,11 +262,15 @@ def _solve_chunk(
             s_keep = slice(None)  # type: ignore[assignment]
         reason = None
         if e == s and not fam:
-            reason = (
-                f"out of joint limits: {n_reachable[i]} solution(s) reach the pose but violate the limits"
-                if n_reachable[i] > 0
-                else "unreachable: no configuration of the arm reaches this pose"
-            )
+            if strategy == "paper":  # its fixed 0.001 mm resolution decides nothing about reachability
+                reason = (
+                    "no solution with J < 1e-5 mm found by the paper's strategy (its final 0.001 mm step "
+                    "misses roots off its grid); strategy='precise' finds every solution"
+                )
+            elif n_reachable[i] > 0:
+                reason = f"out of joint limits: {n_reachable[i]} solution(s) reach the pose but violate the limits"
+            else:
+                reason = "unreachable: no configuration of the arm reaches this pose"
         if i in fallback:  # the reduction's blind spot: add the fallback reduction's families
             other = fallback[i]
             fam = fam + other.families
@@ -316,6 +320,8 @@ def solve_many(
     Results are identical to calling :func:`solve` on each pose.
     """
     _check_strategy(strategy)
+    if np.size(np.asarray(poses, dtype=object) if not isinstance(poses, np.ndarray) else poses) == 0:
+        return []  # an empty batch (e.g. [] or an array (0, 4, 4))
     P = check_poses(poses, "poses")
     if P.ndim != 3:
         raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")

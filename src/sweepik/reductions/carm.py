@@ -251,7 +251,7 @@ class CArmTheta2(_CArmBase):
     Given theta2, entry {2,4} fixes ``d1 = Pz - Px tan(theta2)``. Blind spot: cos(theta2) = 0, where d1
     drops out of that equation (possible only when Px = 0), and its neighbourhood, where d1 is
     ill-conditioned; ``special_solutions`` covers it with the d1 reduction. Self-motion families
-    (theta2 = +-90 deg with theta5 = 0) lie entirely in that slice: they are reported by carm-d1 only.
+    (theta2 = +-90 deg with theta5 = 0) lie entirely in that slice: ``degenerate`` hands them to carm-d1.
     """
 
     name = "carm-theta2"
@@ -292,6 +292,11 @@ class CArmTheta2(_CArmBase):
                 a = np.where(c <= 1.0, np.arccos(np.minimum(c, 1.0)), np.nan)
             cols += [a, -a, np.pi - a, a - np.pi]
         return np.stack(cols, axis=-1)
+
+    def degenerate(self, poses: Array) -> NDArray[np.bool_]:
+        """Wrist in the plane Px = 0: self-motion families (theta2 = +-90 deg with theta5 = 0) lie in the blind
+        spot cos(theta2) = 0, where a theta2 sweep cannot describe them; carm-d1 reports them."""
+        return np.asarray(np.abs(poses[:, 0, 3]) <= 1e-9 * (self.L1 + self.L2))
 
     def special_solutions(self, poses: Array) -> Array | None:
         """Solutions near the blind spot cos(theta2) = 0, found with the d1 reduction.
