@@ -117,3 +117,13 @@ def bench_grid_small() -> np.ndarray:
     from sweepik.verify import grid_configurations
 
     return grid_configurations(False)[::159][:100]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["solve", "--xyz", "1", "2", "3", "--strategy", "fast"], ["fk"], ["nosuch"], ["path"], ["solve", "--xyz", "1"]],
+)
+def test_usage_errors_are_one_line(capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("sweepik: error:")

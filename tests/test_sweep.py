@@ -61,3 +61,13 @@ def test_self_motion_family_members_solve_the_pose() -> None:
     np.testing.assert_allclose(sol.nearest(q), q, atol=1e-6)
     with pytest.raises(sweepik.SweepikError, match="outside the family"):
         sol.families[0].at(sol.families[0].interval[1] + 10.0)
+
+
+@pytest.mark.parametrize("reduction", ["carm-d1", "carm-theta2"])
+def test_self_motion_reported_by_both_reductions_without_duplicates(reduction: str) -> None:
+    q = np.array([1000.0, np.pi / 2, 0.3, -0.5, 0.0, 0.2])
+    sol = sweepik.solve(CARM, CARM.fk(q), reduction=reduction)
+    assert sol.families
+    keys = [(f.free_joint, round(f.interval[0], 6), round(f.interval[1], 6), f.branch) for f in sol.families]
+    assert len(keys) == len(set(keys))
+    np.testing.assert_allclose(sol.nearest(q), q, atol=1e-6)
