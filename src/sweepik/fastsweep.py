@@ -341,51 +341,17 @@ if AVAILABLE:
                     else:
                         j += 1
                 top = np.zeros(1, dtype=np.int64)
-                _scan(
-                    kid,
-                    p,
-                    b,
-                    th,
-                    f,
-                    0,
-                    False,
-                    False,
-                    span[i],
-                    noise,
-                    xtol,
-                    out_t[i],
-                    out_b[i],
-                    c,
-                    stk_t,
-                    stk_f,
-                    stk_i,
-                    top,
-                )
-                while top[0] > 0:
+                # the sequence itself, then the resampled intervals it (and they) push on the stack
+                seq_t, seq_f, level, el, er = th, f, 0, False, False
+                while True:
+                    _scan(kid, p, b, seq_t, seq_f, level, el, er, span[i], noise, xtol, out_t[i], out_b[i], c,
+                          stk_t, stk_f, stk_i, top)  # fmt: skip
+                    if top[0] == 0:
+                        break
                     top[0] -= 1
                     k0 = top[0]
-                    sub_t = stk_t[k0].copy()
-                    sub_f = stk_f[k0].copy()
-                    _scan(
-                        kid,
-                        p,
-                        b,
-                        sub_t,
-                        sub_f,
-                        stk_i[k0, 0],
-                        stk_i[k0, 1] == 1,
-                        stk_i[k0, 2] == 1,
-                        span[i],
-                        noise,
-                        xtol,
-                        out_t[i],
-                        out_b[i],
-                        c,
-                        stk_t,
-                        stk_f,
-                        stk_i,
-                        top,
-                    )
+                    seq_t, seq_f = stk_t[k0].copy(), stk_f[k0].copy()
+                    level, el, er = stk_i[k0, 0], stk_i[k0, 1] == 1, stk_i[k0, 2] == 1
             cnt[i] = c[0]
             n0 = min(c[0], out_t.shape[1])
             w0 = 0
