@@ -171,3 +171,44 @@ def families_of(
         else np.zeros((0, robot.n_joints))
     )
     return out, pose[pk].astype(np.intp), q_pts
+
+
+#: Two points are the same member when every joint agrees within this (radians modulo 2 pi / relative length).
+_MEMBER_TOL = 1e-6
+
+
+def _same_configuration(robot: Robot, a: Array, b: Array) -> NDArray[np.bool_]:
+    d = np.abs(a - b)
+    d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - (a - b), 2.0 * np.pi)), d)
+    return np.asarray(np.all(d <= _MEMBER_TOL * np.maximum(1.0, np.abs(a)), axis=-1))
+
+
+def off_families(robot: Robot, q: Array, families: tuple[Family, ...]) -> NDArray[np.bool_]:
+    """``(k,)`` mask of the configurations ``q (k, n)`` that are not members of any of ``families``."""
+    on = np.zeros(q.shape[0], dtype=bool)
+    for f in families if q.shape[0] else ():
+        th = q[:, f.free_joint]
+        inn = (th >= f.interval[0]) & (th <= f.interval[1])
+        if inn.any():
+            on |= inn & _same_configuration(robot, f.at(np.clip(th, *f.interval)), q)
+    return ~on
+
+
+def unique_families(families: tuple[Family, ...]) -> tuple[Family, ...]:
+    """``families`` without repeats: a family whose free joint and interval equal an earlier one's and whose
+    members agree with it (two branches of a reduction can meet along a whole continuum) is dropped."""
+    out: list[Family] = []
+    for f in families:
+        robot = f.reduction.robot
+        lo, hi = f.interval
+        tol = _MEMBER_TOL * max(1.0, hi - lo)
+        probe = np.linspace(lo, hi, 5)
+        if not any(
+            g.free_joint == f.free_joint
+            and abs(g.interval[0] - lo) <= tol
+            and abs(g.interval[1] - hi) <= tol
+            and bool(np.all(_same_configuration(robot, g.at(np.clip(probe, *g.interval)), f.at(probe))))
+            for g in out
+        ):
+            out.append(f)
+    return tuple(out)

@@ -48,6 +48,9 @@ CLUSTER_FAMILY_REL = _ref.CLUSTER_FAMILY_REL
 FLAT_PROBE_REL = _ref.FLAT_PROBE_REL
 FLAT_MAX_REL = _ref.FLAT_MAX_REL
 FLAT_BISECT = _ref.FLAT_BISECT
+JUMP_NOISE = _ref.JUMP_NOISE
+MULT_LEVEL = _ref.MULT_LEVEL
+MULT_MAX = _ref.MULT_MAX
 #: Candidates and family spans kept per pose (the C-Arm has at most 8 solutions; edges and near misses add
 #: candidates). Overflow is reported and the pose is redone by the NumPy engine.
 MAX_CAND = 256
@@ -118,12 +121,13 @@ if AVAILABLE:
 
     @njit(cache=True)
     def _center_flat(kid, p, x, b, noise, span):
-        """As sweep._Search._center_flat, for one root."""
+        """As sweep._Search._center_flat, for one root: (centre, lo, hi, is a family)."""
         d0 = FLAT_PROBE_REL * span
         if not (_small(kid, p, x - d0, b, noise) or _small(kid, p, x + d0, b, noise)):
-            return x, x, x
+            return x, x, x, False
         limit = FLAT_MAX_REL * span
         reach = np.zeros(2)
+        n_open = 0
         for side in range(2):
             sgn = -1.0 if side == 0 else 1.0
             inner, outer = 0.0, d0
@@ -135,15 +139,43 @@ if AVAILABLE:
                     outer = min(2.0 * outer, limit)
                     if not _small(kid, p, x + sgn * outer, b, noise):
                         break
+            at_limit = inner >= limit
             for _ in range(FLAT_BISECT):
                 mid = 0.5 * (inner + outer)
                 if _small(kid, p, x + sgn * mid, b, noise):
                     inner = mid
                 else:
                     outer = mid
+            past = abs(_res(kid, p, x + sgn * outer, b))
+            far = abs(_res(kid, p, x + 2.0 * sgn * outer, b))
+            if at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise:
+                n_open += 1
             reach[side] = inner
         lo, hi = x - reach[0], x + reach[1]
-        return 0.5 * (lo + hi), lo, hi
+        family = n_open == 2 and hi - lo > CLUSTER_FAMILY_REL * span
+        return 0.5 * (lo + hi), lo, hi, family
+
+    @njit(cache=True)
+    def _multiplicity(kid, p, x, b, noise, span):
+        """As sweep._Search._multiplicity, for one root."""
+        level = MULT_LEVEL * noise
+        limit = FLAT_MAX_REL * span
+        total, count = 0.0, 0
+        for side in range(2):
+            sgn = -1.0 if side == 0 else 1.0
+            d = FLAT_PROBE_REL * span
+            f1 = abs(_res(kid, p, x + sgn * d, b))
+            for _ in range(64):
+                if not (f1 < level and d < limit):
+                    break
+                d *= 2.0
+                f1 = abs(_res(kid, p, x + sgn * d, b))
+            f2 = abs(_res(kid, p, x + 2.0 * sgn * d, b))
+            if f1 >= level and f2 > 0.0 and not math.isnan(f2) and not math.isinf(f2):
+                total += math.log2(f2 / f1)
+                count += 1
+        m = total / count if count > 0 else 1.0
+        return int(min(max(round(m), 1), MULT_MAX))
 
     @njit(cache=True)
     def _extend(kid, p, b, inside, outside):
@@ -225,24 +257,32 @@ if AVAILABLE:
         return x
 
     @njit(cache=True)
-    def _scan(kid, p, b, th, f, level, el, er, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, top):
+    def _scan(
+        kid, p, b, th, f, level, el, er, ctx, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top
+    ):
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
-        hold recursive functions)."""
+        hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, as in sweep._Search.scan."""
         M = th.shape[0]
         valid = np.empty(M, dtype=np.bool_)
         for j in range(M):
             valid[j] = not math.isnan(f[j])
-        for j in range(M):  # exact zeros
-            if valid[j] and f[j] == 0.0:
+        for j in range(M):  # samples on a root (the ends of a resampled interval are its parent's)
+            if valid[j] and abs(f[j]) <= noise and (level == 0 or 0 < j < M - 1):
                 _push(out_t, out_b, cnt, th[j], b)
-        for j in range(1, M - 1):  # interior extrema of |f| without a sign change
-            if valid[j - 1] and valid[j] and valid[j + 1] and th[j + 1] > th[j - 1]:
-                fm, fc, fp = f[j - 1], f[j], f[j + 1]
-                hl, hr = th[j] - th[j - 1], th[j + 1] - th[j]
-                ddj = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr) if hl > 0 and hr > 0 else np.inf
-                may_touch = abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2
-                if abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0 and may_touch:
-                    _extremum(kid, p, b, th[j - 1], th[j], th[j + 1], fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
+        j0, j1 = (0, M) if level > 0 else (1, M - 1)
+        for j in range(j0, j1):  # extrema of |f| without a sign change (the ends with their context)
+            tm, fm = (th[j - 1], f[j - 1]) if j > 0 else (ctx[0], ctx[1])
+            tp, fp = (th[j + 1], f[j + 1]) if j < M - 1 else (ctx[2], ctx[3])
+            fc = f[j]
+            if math.isnan(fm) or math.isnan(fc) or math.isnan(fp):
+                continue
+            hl, hr = th[j] - tm, tp - th[j]
+            if not (hl > 0 and hr > 0):
+                continue
+            ddj = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr)
+            may_touch = abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2
+            if abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0 and may_touch:
+                _extremum(kid, p, b, tm, th[j], tp, fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
         for j in range(M):  # samples next to a domain edge (or at the range ends, level 0)
             if not valid[j]:
                 continue
@@ -294,6 +334,14 @@ if AVAILABLE:
                 stk_i[k0, 0] = level + 1
                 stk_i[k0, 1] = 1 if open_l else 0
                 stk_i[k0, 2] = 1 if open_r else 0
+                if j >= 1:
+                    stk_c[k0, 0], stk_c[k0, 1] = th[j - 1], f[j - 1]
+                else:
+                    stk_c[k0, 0], stk_c[k0, 1] = ctx[0], ctx[1]
+                if j + 2 <= M - 1:
+                    stk_c[k0, 2], stk_c[k0, 3] = th[j + 2], f[j + 2]
+                else:
+                    stk_c[k0, 2], stk_c[k0, 3] = ctx[2], ctx[3]
                 top[0] += 1
             elif prod < 0:
                 _push(out_t, out_b, cnt, _root(kid, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
@@ -302,7 +350,7 @@ if AVAILABLE:
     _U_EDGE_ARR = _U_EDGE.copy()
 
     @njit(cache=True)
-    def _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt, i):
+    def _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
         M = grid.shape[1]
         if True:
             p = params[i]
@@ -312,6 +360,8 @@ if AVAILABLE:
             stk_t = np.empty((STACK, SUB + 2))
             stk_f = np.empty((STACK, SUB + 2))
             stk_i = np.empty((STACK, 3), dtype=np.int64)
+            stk_c = np.empty((STACK, 4))
+            no_ctx = np.full(4, np.nan)
             for b in range(n_branches):
                 f = np.empty(M)
                 for j in range(M):
@@ -342,22 +392,22 @@ if AVAILABLE:
                         j += 1
                 top = np.zeros(1, dtype=np.int64)
                 # the sequence itself, then the resampled intervals it (and they) push on the stack
-                seq_t, seq_f, level, el, er = th, f, 0, False, False
+                seq_t, seq_f, level, el, er, ctx = th, f, 0, False, False, no_ctx
                 while True:
-                    _scan(kid, p, b, seq_t, seq_f, level, el, er, span[i], noise, xtol, out_t[i], out_b[i], c,
-                          stk_t, stk_f, stk_i, top)  # fmt: skip
+                    _scan(kid, p, b, seq_t, seq_f, level, el, er, ctx, span[i], noise, xtol, out_t[i], out_b[i], c,
+                          stk_t, stk_f, stk_i, stk_c, top)  # fmt: skip
                     if top[0] == 0:
                         break
                     top[0] -= 1
                     k0 = top[0]
-                    seq_t, seq_f = stk_t[k0].copy(), stk_f[k0].copy()
+                    seq_t, seq_f, ctx = stk_t[k0].copy(), stk_f[k0].copy(), stk_c[k0].copy()
                     level, el, er = stk_i[k0, 0], stk_i[k0, 1] == 1, stk_i[k0, 2] == 1
             cnt[i] = c[0]
             n0 = min(c[0], out_t.shape[1])
             w0 = 0
             for k in range(n0):
-                x, lo, hi = _center_flat(kid, p, out_t[i, k], out_b[i, k], noise, span[i])
-                if hi - lo > CLUSTER_FAMILY_REL * span[i]:  # a numerical continuum: a family
+                x, lo, hi, family = _center_flat(kid, p, out_t[i, k], out_b[i, k], noise, span[i])
+                if family:
                     if fcnt[i] < fam.shape[1]:
                         fam[i, fcnt[i], 0] = lo
                         fam[i, fcnt[i], 1] = hi
@@ -389,30 +439,23 @@ if AVAILABLE:
                         and (ts[e + 1] == ts[e] or abs(_res(kid, p, 0.5 * (ts[e] + ts[e + 1]), bs[s])) <= noise)
                     ):
                         e += 1
-                    lo, hi = ts[s], ts[e]
-                    if hi - lo > CLUSTER_FAMILY_REL * span[i]:
-                        if fcnt[i] < fam.shape[1]:
-                            fam[i, fcnt[i], 0] = lo
-                            fam[i, fcnt[i], 1] = hi
-                            fam[i, fcnt[i], 2] = bs[s]
-                        fcnt[i] += 1
-                    else:
-                        x = 0.5 * (lo + hi)
-                        out_t[i, w] = x
-                        out_b[i, w] = bs[s]
-                        w += 1
+                    out_t[i, w] = 0.5 * (ts[s] + ts[e])  # a cluster is one root (families were set apart)
+                    out_b[i, w] = bs[s]
+                    w += 1
                     s = e + 1
                 cnt[i] = w if c[0] <= out_t.shape[1] else c[0]
+            for k in range(min(cnt[i], out_t.shape[1])):
+                out_m[i, k] = _multiplicity(kid, p, out_t[i, k], out_b[i, k], noise, span[i])
 
     @njit(cache=True, parallel=True)
-    def _search_parallel(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt):
+    def _search_parallel(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in prange(grid.shape[0]):
-            _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt, i)
+            _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
 
     @njit(cache=True)
-    def _search_serial(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt):
+    def _search_serial(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in range(grid.shape[0]):
-            _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, cnt, fam, fcnt, i)
+            _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
 
 
 def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
@@ -423,6 +466,7 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
     out_b = np.empty((N, MAX_CAND), dtype=np.int64)
+    out_m = np.ones((N, MAX_CAND), dtype=np.int64)
     cnt = np.zeros(N, dtype=np.int64)
     fam = np.empty((N, MAX_FAM, 3))
     fcnt = np.zeros(N, dtype=np.int64)
@@ -438,6 +482,7 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         float(reduction.residual_noise),
         out_t,
         out_b,
+        out_m,
         cnt,
         fam,
         fcnt,
@@ -447,6 +492,7 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
     pose_idx = np.repeat(np.arange(N), counts)
     slot = np.arange(pose_idx.size) - np.repeat(np.cumsum(counts) - counts, counts)
     cand_p, cand_b, cand_t = [pose_idx], [out_b[pose_idx, slot]], [out_t[pose_idx, slot]]
+    cand_m = [out_m[pose_idx, slot]]
     spans: list[_ref.FamilySpan] = []
     if fcnt.any():
         fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(fcnt, MAX_FAM)[:, None]) & ~over[:, None])
@@ -458,11 +504,13 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         cand_p.append(idx[c2.pose])
         cand_b.append(c2.branch)
         cand_t.append(c2.theta)
+        cand_m.append(c2.mult)
         spans += [_ref.FamilySpan(int(idx[s.pose]), s.branch, s.lo, s.hi) for s in s2]
     cand = _ref.Candidates(
         pose=np.concatenate(cand_p).astype(np.intp),
         branch=np.concatenate(cand_b).astype(np.intp),
         theta=np.concatenate(cand_t),
+        mult=np.concatenate(cand_m).astype(np.intp),
     )
     return cand, spans
 

@@ -191,7 +191,8 @@ class Robot:
         the limits. Prismatic values are unchanged.
         """
         qa = check_configuration(q, self.n_joints, finite=False)
-        w = np.pi - np.mod(np.pi - qa, 2.0 * np.pi)
+        with np.errstate(invalid="ignore"):  # inf (a branch that does not exist) stays non-finite
+            w = np.pi - np.mod(np.pi - qa, 2.0 * np.pi)
         for shift in (2.0 * np.pi, -2.0 * np.pi) if self._limits_beyond_pi else ():
             cand = w + shift
             better = (w < self.lower - self.limit_tol) | (w > self.upper + self.limit_tol)

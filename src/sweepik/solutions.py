@@ -71,6 +71,10 @@ class Solutions:
         error: ``(k,)`` the paper's error J (eq. 6) in the robot's length unit.
         error_geodesic: ``(k,)`` position error + weight x rotation angle (length unit).
         within_limits: ``(k,)`` bool; all True when solved with ``limits=True``.
+        multiplicity: ``(k,)`` int, the order of each solution as a root of the sweep's residual: 1 for a
+            regular solution, 2 where two solutions merge (the arm is singular there), 3 or more on
+            intersections of singular sets. A solution of multiplicity m is pinned down by the pose only to
+            about (rounding / c)^(1/m) along theta*: ~1e-8 of the range for m = 2, ~1e-5 for m = 3.
         families: self-motion continua (empty for almost every pose).
         reason: why there is no solution, when ``q`` and ``families`` are empty; else ``None``.
         pose: the target ``(4, 4)``.
@@ -80,6 +84,7 @@ class Solutions:
     error: Array
     error_geodesic: Array
     within_limits: NDArray[np.bool_]
+    multiplicity: NDArray[np.intp]
     families: tuple[Family, ...]
     reason: str | None
     pose: Array

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import fastcertify, fastsweep
 from ._validate import check_poses
 from .errors import ShapeError, UnknownOptionError
-from .families import families_of
+from .families import families_of, off_families, unique_families
 from .paper_sweep import paper_candidates
 from .polish import polish
 from .pose import pose_error_geodesic, pose_error_paper
@@ -62,17 +62,21 @@ def _chain_poses(robot: Robot, poses: Array) -> Array:
     return out
 
 
-def _theta_range(robot: Robot, red: Reduction, chain: Array, limits: bool) -> tuple[Array, Array]:
+def _theta_range(robot: Robot, red: Reduction, chain: Array, paper_limits: bool = False) -> tuple[Array, Array]:
+    """theta* range of each chain pose: the circle for a revolute theta*; for a prismatic one the interval the
+    reduction says holds every solution, else the joint's limits. The same with and without joint limits, so
+    that ``limits=True`` is exactly ``limits=False`` filtered by the limits (the sweep sees the same samples).
+    ``paper_limits``: the paper's strategy with limits sweeps the joint's range on its own grid (section 5)."""
     n = chain.shape[0]
     j = red.free_joint
     if red.periodic:
         return np.full(n, -np.pi), np.full(n, np.pi)
-    lo, hi = np.full(n, robot.lower[j]), np.full(n, robot.upper[j])
-    if not limits:
-        rng = red.search_range(chain)
-        if rng is not None:
-            lo, hi = rng[:, 0], rng[:, 1]
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+    rng = None if paper_limits else red.search_range(chain)
+    if rng is not None:
+        lo, hi = rng[:, 0], rng[:, 1]
+    else:
+        lo, hi = np.full(n, robot.lower[j]), np.full(n, robot.upper[j])
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi - lo < np.inf)):
         raise ShapeError(f"joint {robot.joint_names[j]} (theta*) needs finite limits to be swept")
     return lo, hi
 
@@ -132,7 +136,7 @@ def _solve_chunk(
     use_fallback: bool = True,
 ) -> list[Solutions]:
     chain = _chain_poses(robot, poses)
-    lo, hi = _theta_range(robot, red, chain, limits)
+    lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
     weight = orientation_weight(robot.length_unit)
     spans: list[FamilySpan] = []
     fams: dict[int, list[Family]]
@@ -148,7 +152,7 @@ def _solve_chunk(
         else:
             cand, spans = find_candidates(red, chain, lo, hi, n_samples)
             q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
-        pose_idx = cand.pose
+        pose_idx, mult = cand.pose, cand.mult
         special = red.special_solutions(chain)
         if special is not None:
             sp_p, sp_k = np.nonzero(np.all(np.isfinite(special), axis=-1))
@@ -158,6 +162,7 @@ def _solve_chunk(
                 err_geo, err_paper = np.concatenate([err_geo, eg_sp]), np.concatenate([err_paper, ep_sp])
             q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
+            mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp)])
         fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, ACCEPT_TOL_REL * robot.length_scale)
         if fam_p.size:
             if err_geo is not None and err_paper is not None:
@@ -165,11 +170,13 @@ def _solve_chunk(
                 err_geo, err_paper = np.concatenate([err_geo, eg_f]), np.concatenate([err_paper, ep_f])
             q = np.concatenate([q, fam_q])
             pose_idx = np.concatenate([pose_idx, fam_p])
+            mult = np.concatenate([mult, np.ones(fam_p.size, dtype=np.intp)])
     else:
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
+        mult = np.ones(pose_idx.size, dtype=np.intp)
         fams = {}
     finite = np.all(np.isfinite(q), axis=-1)
-    pose_idx, q = pose_idx[finite], q[finite]
+    pose_idx, q, mult = pose_idx[finite], q[finite], mult[finite]
     target = poses[pose_idx]
     if err_geo is None or err_paper is None:
         err_geo, err_paper = _errors(robot, q, target, weight)
@@ -195,6 +202,7 @@ def _solve_chunk(
         miss = ~certified & (err_geo <= POLISH_BELOW_REL * robot.length_scale)
         rescue = np.unique(pose_idx[miss])
     pose_idx, q, err_paper, err_geo = pose_idx[certified], q[certified], err_paper[certified], err_geo[certified]
+    mult = mult[certified]
     if rescue.size:
         rescued = _solve_chunk(
             robot, get_reduction(robot, red.fallback), poses[rescue], strategy, limits, n_samples, False
@@ -205,26 +213,21 @@ def _solve_chunk(
                 q = np.concatenate([q, r_sol.q])
                 err_paper = np.concatenate([err_paper, r_sol.error])
                 err_geo = np.concatenate([err_geo, r_sol.error_geodesic])
+                mult = np.concatenate([mult, r_sol.multiplicity])
     q, inside = robot.wrapped_within_limits(q)
     n_reachable = np.bincount(pose_idx, minlength=len(poses))
     if limits:
-        pose_idx, q, err_paper, err_geo, inside = (
+        pose_idx, q, err_paper, err_geo, inside, mult = (
             pose_idx[inside],
             q[inside],
             err_paper[inside],
             err_geo[inside],
             inside[inside],
+            mult[inside],
         )
     keep = _dedupe(robot, pose_idx, q, err_geo)
     pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
-
-    if limits and not red.periodic and strategy == "precise":
-        # the sweep covered theta*'s limits only: for poses left without any solution, look beyond them
-        # so that the reason can tell "out of joint limits" from "unreachable"
-        empty = np.nonzero((np.bincount(pose_idx, minlength=len(poses)) == 0) & (n_reachable == 0))[0]
-        if empty.size and red.search_range(chain[empty]) is not None:
-            beyond = _solve_chunk(robot, red, poses[empty], strategy, False, n_samples, use_fallback)
-            n_reachable[empty] = [len(b) for b in beyond]
+    mult = mult[keep]
     fallback: dict[int, Solutions] = {}
     if strategy == "precise" and use_fallback and red.fallback is not None:
         deg = red.degenerate(chain)
@@ -235,31 +238,21 @@ def _solve_chunk(
             )
             fallback = {int(i): a for i, a in zip(idx, alt, strict=True) if a.families}
     order = np.argsort(pose_idx, kind="stable")
-    pose_idx, q, err_paper, err_geo, inside = (
+    pose_idx, q, err_paper, err_geo, inside, mult = (
         pose_idx[order],
         q[order],
         err_paper[order],
         err_geo[order],
         inside[order],
+        mult[order],
     )
     bounds = np.searchsorted(pose_idx, np.arange(len(poses) + 1))
     results = []
     for i in range(len(poses)):
         s, e = bounds[i], bounds[i + 1]
-        fam = tuple(fams.get(i, ()))
-        qi = q[s:e]
-        if fam and e > s:  # isolated points that lie on a family are reported by the family
-            on = np.zeros(e - s, dtype=bool)
-            for f in fam:
-                th = qi[:, f.free_joint]
-                inn = (th >= f.interval[0]) & (th <= f.interval[1])
-                if inn.any():
-                    member = f.at(np.clip(th, *f.interval))
-                    d = np.abs(np.pi - np.mod(np.pi - (member - qi), 2 * np.pi))
-                    on |= inn & np.all(d <= 1e-6 * np.maximum(1.0, np.abs(qi)), axis=-1)
-            s_keep = ~on
-        else:
-            s_keep = slice(None)  # type: ignore[assignment]
+        other = fallback.get(i)
+        # the reduction's blind spot: the fallback reduction's families are added
+        fam = unique_families(tuple(fams.get(i, ())) + (other.families if other is not None else ()))
         reason = None
         if e == s and not fam:
             if strategy == "paper":  # its fixed 0.001 mm resolution decides nothing about reachability
@@ -271,19 +264,28 @@ def _solve_chunk(
                 reason = f"out of joint limits: {n_reachable[i]} solution(s) reach the pose but violate the limits"
             else:
                 reason = "unreachable: no configuration of the arm reaches this pose"
-        if i in fallback:  # the reduction's blind spot: add the fallback reduction's families
-            other = fallback[i]
-            fam = fam + other.families
-            if e == s:  # and its isolated solutions when this reduction has none
-                results.append(replace(other, families=fam))
-                continue
-            reason = None
+        if other is not None and e == s:  # ... and its isolated solutions when this reduction has none
+            keep_o = off_families(robot, other.q, fam)
+            results.append(
+                replace(
+                    other,
+                    q=other.q[keep_o],
+                    error=other.error[keep_o],
+                    error_geodesic=other.error_geodesic[keep_o],
+                    within_limits=other.within_limits[keep_o],
+                    multiplicity=other.multiplicity[keep_o],
+                    families=fam,
+                )
+            )
+            continue
+        keep = off_families(robot, q[s:e], fam)  # points on a family are reported by the family
         results.append(
             Solutions(
-                q=qi[s_keep],
-                error=err_paper[s:e][s_keep],
-                error_geodesic=err_geo[s:e][s_keep],
-                within_limits=inside[s:e][s_keep],
+                q=q[s:e][keep],
+                error=err_paper[s:e][keep],
+                error_geodesic=err_geo[s:e][keep],
+                within_limits=inside[s:e][keep],
+                multiplicity=mult[s:e][keep],
                 families=fam,
                 reason=reason,
                 pose=poses[i].copy(),

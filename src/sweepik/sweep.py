@@ -56,7 +56,7 @@ FAMILY_TOL = 1e-10
 #: cluster longer than this fraction of the theta* range is reported as a family (a numerical continuum:
 #: every point of it solves the pose to rounding precision), a shorter one as its midpoint. A double root
 #: (f ~ c x^2) is flat at noise level over ~2 sqrt(1e-16 / c), about 1e-8 of the range: far shorter.
-CLUSTER_FAMILY_REL = 1e-6
+CLUSTER_FAMILY_REL = 1e-5
 #: Probe distance (relative to the range) deciding whether a root sits in a flat stretch of the residual,
 #: the largest half-width searched for such a stretch, and bisection steps locating its ends.
 FLAT_PROBE_REL = 1e-9
@@ -66,6 +66,17 @@ FLAT_BISECT = 30
 FAMILY_BISECT = 40
 #: Minimum number of consecutive vanishing samples that make a family.
 FAMILY_MIN_RUN = 3
+#: A flat stretch (|residual| within the noise around a root) ends where the residual leaves the noise. It
+#: leaves it *smoothly* next to an isolated root of high multiplicity (just past the end |f| is barely above
+#: the noise) and by a *jump* (a branch swap) or at a domain edge (NaN) where a continuum ends: a residual
+#: analytic along a branch that vanishes on an interval vanishes up to such an end. |f| above JUMP_NOISE x noise
+#: just past the end counts as a jump.
+JUMP_NOISE = 1e3
+#: Multiplicity of a root: from the growth of |f| away from it, measured where |f| first exceeds
+#: MULT_LEVEL x noise (on either side), comparing |f| at distances d and 2 d (ratio 2^m for a root of order m).
+MULT_LEVEL = 1e4
+#: Largest multiplicity reported (rounding decides nothing finer).
+MULT_MAX = 8
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
 XTOL_REL = 1e-16
 #: Half-step of the central difference used to locate extrema, relative to the theta* range.
@@ -78,11 +89,13 @@ DIFF_LEVELS = 3
 
 @dataclass(frozen=True)
 class Candidates:
-    """Flat candidate list: pose index, branch, theta* value, for ``K`` candidates."""
+    """Flat candidate list: pose index, branch, theta* value and the root's multiplicity (1 for a simple root,
+    2 where two solutions merge, ...), for ``K`` candidates."""
 
     pose: IntArray
     branch: IntArray
     theta: Array
+    mult: IntArray
 
 
 @dataclass(frozen=True)
@@ -111,7 +124,18 @@ def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samp
         inside = np.isfinite(hints) & (hints >= lo[:, None]) & (hints <= hi[:, None])
         hints = np.where(inside, hints, lo[:, None])
         grid = np.concatenate([grid, hints], axis=1)
-    return np.sort(grid, axis=1)
+    grid = np.sort(grid, axis=1)
+    # a sample repeated (a hint on the grid, two hints at one place) would leave a zero-width interval, where the
+    # three-sample extremum test cannot work (a double root exactly at that sample would go unseen): move each
+    # repeat halfway to the next distinct sample
+    for _ in range(8):
+        rep = np.zeros(grid.shape, dtype=bool)
+        rep[:, 1:-1] = (grid[:, 1:-1] == grid[:, :-2]) & (grid[:, 2:] > grid[:, 1:-1])
+        if not rep.any():
+            break
+        i, j = np.nonzero(rep)
+        grid[i, j] = 0.5 * (grid[i, j] + grid[i, j + 1])
+    return grid
 
 
 class _Search:
@@ -148,10 +172,14 @@ class _Search:
         level: int,
         edge_left: NDArray[np.bool_] | None = None,
         edge_right: NDArray[np.bool_] | None = None,
+        ctx: tuple[Array, Array, Array, Array] | None = None,
     ) -> None:
         """Find candidates on sequences ``th, f (S, M)`` (``valid``: usable samples); recurse into bends.
 
         ``edge_left``/``edge_right`` ``(S,)``: the sequence's first/last sample borders a domain edge.
+        ``ctx``: (theta, f) of the samples just left and right of a resampled interval (its parent's neighbours,
+        NaN where there is none), so that its end samples get the extremum test with their nearest neighbours:
+        a double root just beside a parent sample lies in the first or last sub-interval at every level.
         """
         S, M = f.shape
         if edge_left is None or edge_right is None:
@@ -161,36 +189,46 @@ class _Search:
         t0, t1 = th[:, :-1], th[:, 1:]
         v0, v1 = valid[:, :-1], valid[:, 1:]
         both = v0 & v1 & (t1 > t0)
-        # exact zeros
-        z_i, z_j = np.nonzero(valid & (f == 0))
+        # samples on a root (within the residual's rounding noise): a sample that lands on a double root is
+        # the root, whatever its neighbours do (the end samples of a resampled interval are its parent's)
+        own = valid.copy()
+        if level:
+            own[:, 0] = own[:, -1] = False
+        z_i, z_j = np.nonzero(own & (absf <= self.red.residual_noise))
         self._root(p[z_i], b[z_i], th[z_i, z_j])
-        # 3) interior extrema of |f| with no sign change around them
-        if M >= 3:
-            fm, fc, fp = fin[:, :-2], fin[:, 1:-1], fin[:, 2:]
-            hl, hr = th[:, 1:-1] - th[:, :-2], th[:, 2:] - th[:, 1:-1]
+        # 3) extrema of |f| with no sign change around them (interior samples; with context, the ends too)
+        if ctx is not None:
+            th_x = np.concatenate([ctx[0][:, None], th, ctx[2][:, None]], axis=1)
+            f_x = np.concatenate([ctx[1][:, None], fin, ctx[3][:, None]], axis=1)
+        else:
+            th_x, f_x = th, fin
+        if th_x.shape[1] >= 3:
+            fm, fc, fp = f_x[:, :-2], f_x[:, 1:-1], f_x[:, 2:]
+            hl, hr = th_x[:, 1:-1] - th_x[:, :-2], th_x[:, 2:] - th_x[:, 1:-1]
             with np.errstate(invalid="ignore", divide="ignore"):
                 dd = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr)
                 # a parabola through the samples dips at most |f''| h^2 / 2 below the middle one
                 may_touch = np.abs(fc) <= EXTREMUM_REACH * np.abs(dd) * np.maximum(hl, hr) ** 2
-            ext = (
-                (absf[:, 1:-1] <= absf[:, :-2])
-                & (absf[:, 1:-1] <= absf[:, 2:])
-                & (fm * fc > 0)
-                & (fc * fp > 0)
-                & (th[:, 2:] > th[:, :-2])
-                & may_touch
-            )
+                ext = (
+                    (np.abs(fc) <= np.abs(fm))
+                    & (np.abs(fc) <= np.abs(fp))
+                    & (fm * fc > 0)
+                    & (fc * fp > 0)
+                    & (hl > 0)
+                    & (hr > 0)
+                    & may_touch
+                )
             e_i, e_j = np.nonzero(ext)
             if e_i.size:
                 self._extrema(
                     p[e_i],
                     b[e_i],
-                    th[e_i, e_j],
-                    th[e_i, e_j + 1],
-                    th[e_i, e_j + 2],
-                    f[e_i, e_j + 1],
-                    f[e_i, e_j],
-                    f[e_i, e_j + 2],
+                    th_x[e_i, e_j],
+                    th_x[e_i, e_j + 1],
+                    th_x[e_i, e_j + 2],
+                    f_x[e_i, e_j + 1],
+                    f_x[e_i, e_j],
+                    f_x[e_i, e_j + 2],
                 )
         # 4) samples next to a domain edge (NaN) or at the range ends (level 0 only)
         end = level == 0
@@ -239,8 +277,17 @@ class _Search:
         fs = self.residual(pp, bb, sub)
         fs[:, 0], fs[:, -1] = f[r_i, r_j], f[r_i, r_j + 1]
         vs = np.isfinite(fs)
-        # the parent already handled the interval's end samples as candidates: only interior ones are new
-        self.scan(pp, bb, sub, fs, vs, level + 1, open_l[r_i, r_j], open_r[r_i, r_j + 1])
+        # the parent already handled the interval's end samples as candidates: only interior ones are new;
+        # its neighbours (or, at the sequence's ends, its own context) are the sub-sequence's context
+        nan = np.full(r_i.size, np.nan)
+        left = r_j >= 1
+        right = r_j + 2 <= M - 1
+        jl, jr = np.maximum(r_j - 1, 0), np.minimum(r_j + 2, M - 1)
+        cl_t = np.where(left, th[r_i, jl], nan if ctx is None else ctx[0][r_i])
+        cl_f = np.where(left, fin[r_i, jl], nan if ctx is None else ctx[1][r_i])
+        cr_t = np.where(right, th[r_i, jr], nan if ctx is None else ctx[2][r_i])
+        cr_f = np.where(right, fin[r_i, jr], nan if ctx is None else ctx[3][r_i])
+        self.scan(pp, bb, sub, fs, vs, level + 1, open_l[r_i, r_j], open_r[r_i, r_j + 1], (cl_t, cl_f, cr_t, cr_f))
 
     def _extrema(
         self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array, fa: Array, fb: Array
@@ -293,83 +340,114 @@ class _Search:
             self._root(p, b, x)
         p = np.concatenate(self.roots_p).astype(np.intp)
         b = np.concatenate(self.roots_b).astype(np.intp)
-        t, lo, hi = self._center_flat(p, b, np.concatenate(self.roots_t))
-        # a flat stretch wider than a double root's is a numerical continuum: a family
-        wide = hi - lo > CLUSTER_FAMILY_REL * self.span[p]
-        for k in np.nonzero(wide)[0]:
+        t, lo, hi, family = self._center_flat(p, b, np.concatenate(self.roots_t))
+        for k in np.nonzero(family)[0]:
             self.spans.append(FamilySpan(int(p[k]), int(b[k]), float(lo[k]), float(hi[k])))
-        return self._merge_clusters(p[~wide], b[~wide], t[~wide])
+        cand = self._merge_clusters(p[~family], b[~family], t[~family])
+        return Candidates(cand.pose, cand.branch, cand.theta, self._multiplicity(cand.pose, cand.branch, cand.theta))
 
-    def _center_flat(self, p: IntArray, b: IntArray, t: Array) -> tuple[Array, Array, Array]:
-        """Move each root to the middle of the stretch around it where |residual| stays within the noise.
+    def _small(self, p: IntArray, b: IntArray, x: Array) -> NDArray[np.bool_]:
+        """|residual| within the noise (NaN, outside the branch's domain, counts as not small)."""
+        return np.abs(self.residual(p, b, x[:, None])[:, 0]) <= self.red.residual_noise
 
-        A simple root's stretch is ~noise / |f'| wide: nothing moves. At a root of high multiplicity (the
-        residual ~ c x^k, k >= 3) the residual crosses zero at places decided by rounding anywhere in a
-        stretch of width ~(noise / c)^(1/k); its middle is the root. Returns the moved roots and the
-        stretches' ends."""
+    def _center_flat(self, p: IntArray, b: IntArray, t: Array) -> tuple[Array, Array, Array, NDArray[np.bool_]]:
+        """Move each root to the middle of the stretch around it where |residual| stays within the noise, and
+        tell a self-motion family from a root of high multiplicity.
+
+        A simple root's stretch is ~noise / |f'| wide: nothing moves. At a root of multiplicity k >= 3 (the
+        residual ~ c x^k) the residual crosses zero at places decided by rounding anywhere in a stretch of
+        width ~(noise / c)^(1/k); its middle is the root. Such a stretch ends *smoothly* on both sides (see
+        ``JUMP_NOISE``); a stretch that ends at a domain edge, a jump or the search reach on both sides is a
+        family. Returns the moved roots, the stretches' ends and the family mask."""
+        family = np.zeros(t.size, dtype=bool)
         if t.size == 0:
-            return t, t, t
+            return t, t, t, family
         noise = self.red.residual_noise
         d0 = FLAT_PROBE_REL * self.span[p]
-
-        def small(x: Array, sel: IntArray) -> NDArray[np.bool_]:
-            f = self.residual(p[sel], b[sel], x[:, None])[:, 0]
-            return np.abs(f) <= noise  # NaN (outside the branch's domain) counts as not small
-
-        idx = np.arange(t.size)
-        flat = np.nonzero(small(t - d0, idx) | small(t + d0, idx))[0]
+        flat = np.nonzero(self._small(p, b, t - d0) | self._small(p, b, t + d0))[0]
         if flat.size == 0:
-            return t, t, t
+            return t, t, t, family
+        pf, bf, tf = p[flat], b[flat], t[flat]
         reach = np.empty((flat.size, 2))
+        open_end = np.empty((flat.size, 2), dtype=bool)
         for side, sgn in enumerate((-1.0, 1.0)):
             inner = np.zeros(flat.size)
             outer = d0[flat].copy()
-            grow = small(t[flat] + sgn * outer, flat)
-            limit = FLAT_MAX_REL * self.span[p[flat]]
+            limit = FLAT_MAX_REL * self.span[pf]
+            grow = self._small(pf, bf, tf + sgn * outer)
             for _ in range(64):  # double until the residual leaves the noise (or the reach limit)
                 if not grow.any():
                     break
                 inner = np.where(grow, outer, inner)
                 outer = np.where(grow, np.minimum(2.0 * outer, limit), outer)
-                grow = grow & (inner < limit) & small(t[flat] + sgn * outer, flat)
+                grow = grow & (inner < limit) & self._small(pf, bf, tf + sgn * outer)
+            at_limit = inner >= limit
             for _ in range(FLAT_BISECT):  # boundary between inner (small) and outer (not small)
                 mid = 0.5 * (inner + outer)
-                sm = small(t[flat] + sgn * mid, flat)
+                sm = self._small(pf, bf, tf + sgn * mid)
                 inner = np.where(sm, mid, inner)
                 outer = np.where(sm, outer, mid)
+            past = np.abs(self.residual(pf, bf, (tf + sgn * outer)[:, None])[:, 0])
+            # ... and keeps growing (a rounding blip inside a continuum falls back into the noise)
+            far = np.abs(self.residual(pf, bf, (tf + 2.0 * sgn * outer)[:, None])[:, 0])
+            open_end[:, side] = at_limit | ~(past <= JUMP_NOISE * noise) | (far <= 2.0 * noise)  # NaN: domain edge
             reach[:, side] = inner
         lo, hi = t.copy(), t.copy()
         lo[flat] -= reach[:, 0]
         hi[flat] += reach[:, 1]
-        return 0.5 * (lo + hi), lo, hi
+        wide = hi[flat] - lo[flat] > CLUSTER_FAMILY_REL * self.span[pf]
+        family[flat] = wide & open_end[:, 0] & open_end[:, 1]
+        return 0.5 * (lo + hi), lo, hi, family
 
     def _merge_clusters(self, p: IntArray, b: IntArray, t: Array) -> Candidates:
         """Merge neighbouring roots of one branch between which the residual stays within its rounding
         noise: at a root of high multiplicity the residual is flat at noise level over a short stretch and
-        crosses zero there many times at random. Each such cluster becomes one candidate, its midpoint."""
+        crosses zero there many times at random. Each such cluster becomes one candidate, its midpoint
+        (families were set apart before, by ``_center_flat``)."""
         order = np.lexsort((t, b, p))
         p, b, t = p[order], b[order], t[order]
+        empty = np.zeros(0, dtype=np.intp)
         if t.size < 2:
-            return Candidates(p, b, t)
+            return Candidates(p, b, t, empty)
         same = (p[1:] == p[:-1]) & (b[1:] == b[:-1])
         k = np.nonzero(same & (t[1:] > t[:-1]))[0]
         joined = np.zeros(t.size - 1, dtype=bool)
         if k.size:
             mid = 0.5 * (t[k] + t[k + 1])
-            fm = self.residual(p[k], b[k], mid[:, None])[:, 0]
-            joined[k] = np.abs(fm) <= self.red.residual_noise
+            joined[k] = self._small(p[k], b[k], mid)
         joined |= same & (t[1:] == t[:-1])
-        start = np.concatenate([[True], ~joined])
-        first = np.nonzero(start)[0]
-        lo = np.minimum.reduceat(t, first)
-        hi = np.maximum.reduceat(t, first)
-        # a cluster longer than CLUSTER_FAMILY_REL of the range is a numerical continuum: a family
-        wide = hi - lo > CLUSTER_FAMILY_REL * self.span[p[first]]
-        for i in np.nonzero(wide)[0]:
-            self.spans.append(FamilySpan(int(p[first[i]]), int(b[first[i]]), float(lo[i]), float(hi[i])))
-        keep = first[~wide]
-        x = 0.5 * (lo + hi)[~wide]
-        return Candidates(pose=p[keep], branch=b[keep], theta=x)
+        first = np.nonzero(np.concatenate([[True], ~joined]))[0]
+        x = 0.5 * (np.minimum.reduceat(t, first) + np.maximum.reduceat(t, first))
+        return Candidates(pose=p[first], branch=b[first], theta=x, mult=empty)
+
+    def _multiplicity(self, p: IntArray, b: IntArray, t: Array) -> IntArray:
+        """Order of each root (1 simple, 2 double, ...), from how fast |f| grows away from it: at the first
+        distance d (doubling from ``FLAT_PROBE_REL``) where |f| exceeds ``MULT_LEVEL`` x noise, |f(2 d)| / |f(d)|
+        is 2^m. Both sides are averaged; a side outside the branch's domain is left out (1 where neither)."""
+        if t.size == 0:
+            return np.zeros(0, dtype=np.intp)
+        level = MULT_LEVEL * self.red.residual_noise
+        limit = FLAT_MAX_REL * self.span[p]
+        total, count = np.zeros(t.size), np.zeros(t.size)
+        for sgn in (-1.0, 1.0):
+            d = FLAT_PROBE_REL * self.span[p]
+            f1 = np.abs(self.residual(p, b, (t + sgn * d)[:, None])[:, 0])
+            for _ in range(64):
+                low = (f1 < level) & (d < limit)
+                if not low.any():
+                    break
+                d = np.where(low, 2.0 * d, d)
+                k = np.nonzero(low)[0]
+                f1[k] = np.abs(self.residual(p[k], b[k], (t[k] + sgn * d[k])[:, None])[:, 0])
+            f2 = np.abs(self.residual(p, b, (t + 2.0 * sgn * d)[:, None])[:, 0])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                m = np.log2(f2 / f1)
+            ok = np.isfinite(m) & (f1 >= level)
+            total += np.where(ok, m, 0.0)
+            count += ok
+        with np.errstate(invalid="ignore"):
+            m = np.where(count > 0, total / np.maximum(count, 1), 1.0)
+        return np.clip(np.rint(m), 1, MULT_MAX).astype(np.intp)
 
 
 def _extend(reduction: Reduction, poses: Array, branch: IntArray, inside: Array, outside: Array) -> Array:
