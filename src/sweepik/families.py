@@ -212,3 +212,40 @@ def unique_families(families: tuple[Family, ...]) -> tuple[Family, ...]:
         ):
             out.append(f)
     return tuple(out)
+
+
+#: A 6-DOF serial arm has at most 16 isolated IK solutions (a general 6R arm; fewer with prismatic joints). A pose
+#: with more certified, distinct solutions holds a numerical continuum: near a self-motion (e.g. two joint axes
+#: almost coaxial) a whole arc of configurations reproduces the pose to rounding level, the residual's rounding
+#: noise crosses zero along it again and again, and the Newton polish moves every such crossing onto the arc.
+MAX_ISOLATED_SOLUTIONS = 16
+#: On such a pose, solutions closer than this (joint distance, radians; prismatic joints in units of the
+#: paper's 100 mm per radian, see ``trajectory.weighted_joint_distance``) are linked; each linked group is
+#: reported once, by its medoid: the pose pins these solutions down no better than the group's extent.
+CONTINUUM_LINK = 0.05
+
+
+def collapse_continua(robot: Robot, pose: NDArray[np.intp], q: Array) -> NDArray[np.bool_]:
+    """Keep-mask over distinct certified solutions ``q (K, n)`` of poses ``pose (K,)``: on a pose with more than
+    ``MAX_ISOLATED_SOLUTIONS``, only the medoid of each group linked within ``CONTINUUM_LINK`` is kept."""
+    keep = np.ones(pose.size, dtype=bool)
+    if pose.size <= MAX_ISOLATED_SOLUTIONS:
+        return keep
+    counts = np.bincount(pose)
+    scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
+    for i in np.nonzero(counts > MAX_ISOLATED_SOLUTIONS)[0]:
+        idx = np.nonzero(pose == i)[0]
+        d = q[idx][:, None, :] - q[idx][None, :, :]
+        d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
+        dist = np.linalg.norm(d * scale, axis=-1)
+        label = np.arange(idx.size)
+        for _ in range(idx.size):  # connected components: each takes the smallest label linked to it
+            new = np.min(np.where(dist <= CONTINUUM_LINK, label[None, :], idx.size), axis=1)
+            if np.array_equal(new, label):
+                break
+            label = new
+        keep[idx] = False
+        for lab in np.unique(label):
+            g = np.nonzero(label == lab)[0]
+            keep[idx[g[np.argmin(dist[np.ix_(g, g)].max(axis=1))]]] = True
+    return keep

@@ -15,14 +15,14 @@ from numpy.typing import ArrayLike, NDArray
 from . import fastcertify, fastsweep
 from ._validate import check_poses
 from .errors import ShapeError, UnknownOptionError
-from .families import families_of, off_families, unique_families
+from .families import collapse_continua, families_of, off_families, unique_families
 from .paper_sweep import paper_candidates
 from .polish import polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, get_reduction
 from .robot import Robot
 from .solutions import Family, Solutions
-from .sweep import N_SAMPLES, FamilySpan, find_candidates
+from .sweep import N_SAMPLES, Candidates, FamilySpan, find_candidates
 from .units import mm_per_unit, orientation_weight
 
 __all__ = ["solve", "solve_many", "STRATEGIES"]
@@ -79,6 +79,31 @@ def _theta_range(robot: Robot, red: Reduction, chain: Array, paper_limits: bool 
     if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi - lo < np.inf)):
         raise ShapeError(f"joint {robot.joint_names[j]} (theta*) needs finite limits to be swept")
     return lo, hi
+
+
+#: A root of multiplicity >= 2 is pinned down along theta* only to its flat stretch (~1e-5 of the range for a
+#: triple root): one this close outside theta*'s limits gets a copy clipped to the limit, certified like any
+#: candidate, so that a solution exactly at a limit (a rail end) is not lost to its rounding.
+CLIP_REACH_REL = 1e-4
+
+
+def _limit_copies(robot: Robot, red: Reduction, cand: Candidates, span: Array) -> Candidates:
+    """``cand`` plus, for each multiple root within ``CLIP_REACH_REL`` of the range outside theta*'s limits, a copy
+    at the limit (same branch). Added with and without ``limits``: both see the same candidates."""
+    j = red.free_joint
+    lo, hi = robot.lower[j], robot.upper[j]
+    reach = CLIP_REACH_REL * span[cand.pose]
+    t = cand.theta
+    near = (cand.mult >= 2) & (((t < lo) & (t >= lo - reach)) | ((t > hi) & (t <= hi + reach)))
+    if not near.any():
+        return cand
+    k = np.nonzero(near)[0]
+    return Candidates(
+        np.concatenate([cand.pose, cand.pose[k]]),
+        np.concatenate([cand.branch, cand.branch[k]]),
+        np.concatenate([t, np.clip(t[k], lo, hi)]),
+        np.concatenate([cand.mult, cand.mult[k]]),
+    )
 
 
 def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:
@@ -146,11 +171,13 @@ def _solve_chunk(
         if compiled:
             params = red.kernel_params(chain)
             cand, spans = fastsweep.search(red, chain, lo, hi, n_samples, params)
+            cand = _limit_copies(robot, red, cand, hi - lo)
             q, err_geo, err_paper = fastcertify.certify(
                 robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
             )
         else:
             cand, spans = find_candidates(red, chain, lo, hi, n_samples)
+            cand = _limit_copies(robot, red, cand, hi - lo)
             q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         pose_idx, mult = cand.pose, cand.mult
         special = red.special_solutions(chain)
@@ -216,16 +243,13 @@ def _solve_chunk(
                 mult = np.concatenate([mult, r_sol.multiplicity])
     q, inside = robot.wrapped_within_limits(q)
     n_reachable = np.bincount(pose_idx, minlength=len(poses))
+    # duplicates first (of twins, the one inside the limits is kept), so that limits=True is exactly
+    # limits=False filtered by the limits
+    keep = _dedupe(robot, pose_idx, q, np.where(inside, err_geo, err_geo + robot.length_scale))
+    if strategy == "precise":  # a numerical continuum of certified solutions is reported once
+        keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
     if limits:
-        pose_idx, q, err_paper, err_geo, inside, mult = (
-            pose_idx[inside],
-            q[inside],
-            err_paper[inside],
-            err_geo[inside],
-            inside[inside],
-            mult[inside],
-        )
-    keep = _dedupe(robot, pose_idx, q, err_geo)
+        keep &= inside
     pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
     mult = mult[keep]
     fallback: dict[int, Solutions] = {}
