@@ -38,6 +38,8 @@ Array = NDArray[np.float64]
 #: (the root is found to ~noise / slope, and the slope can be small), far below any mechanical meaning.
 LIMIT_TOL = 1e-9
 LIMIT_TOL_REL = 1e-9
+#: ``Robot.length_scale`` counts a prismatic range at most this many times the sum of the link lengths.
+SPAN_CAP = 10.0
 
 
 @dataclass(frozen=True)
@@ -154,9 +156,14 @@ class Robot:
 
     @cached_property
     def length_scale(self) -> float:
-        """A characteristic length of the arm (sum of |a|, |d| and prismatic ranges), for relative tolerances."""
+        """A characteristic length of the arm, for relative tolerances: the sum of |a| and |d| plus the prismatic
+        ranges, each range counted at most ``SPAN_CAP`` times the links (a rail of 1e300 does not make the arm
+        coarser: its tolerances would grow with it)."""
+        links = float(np.sum(np.abs(self.dh_a)) + np.sum(np.abs(self.dh_d)))
         span = np.where(self.is_revolute, 0.0, self.upper - self.lower)
-        return float(np.sum(np.abs(self.dh_a)) + np.sum(np.abs(self.dh_d)) + np.sum(np.minimum(span, 1e12)))
+        if links > 0.0:
+            span = np.minimum(span, SPAN_CAP * links)
+        return links + float(np.sum(span))
 
     def fk(self, q: ArrayLike) -> Array:
         """Tool pose ``(..., 4, 4)`` for joint values ``q (..., n)``.

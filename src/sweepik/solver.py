@@ -181,6 +181,9 @@ def _solve_chunk(
             q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         pose_idx, mult = cand.pose, cand.mult
         special = red.special_solutions(chain)
+        sp_mult = None
+        if isinstance(special, tuple):
+            special, sp_mult = special
         if special is not None:
             sp_p, sp_k = np.nonzero(np.all(np.isfinite(special), axis=-1))
             q_sp = special[sp_p, sp_k]
@@ -189,7 +192,7 @@ def _solve_chunk(
                 err_geo, err_paper = np.concatenate([err_geo, eg_sp]), np.concatenate([err_paper, ep_sp])
             q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
-            mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp)])
+            mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp) if sp_mult is None else sp_mult[sp_p, sp_k]])
         fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, ACCEPT_TOL_REL * robot.length_scale)
         if fam_p.size:
             if err_geo is not None and err_paper is not None:

@@ -91,9 +91,10 @@ class Reduction(ABC):
         """
         return None
 
-    def special_solutions(self, poses: Array) -> Array | None:
+    def special_solutions(self, poses: Array) -> Array | tuple[Array, IntArray] | None:
         """Candidate configurations ``(N, K, n)`` (NaN-padded) at theta* values where the reduction itself
-        degenerates (its blind spots). The engine certifies them by forward kinematics like any other.
+        degenerates (its blind spots), optionally with their multiplicities ``(N, K)`` (else 1). The engine
+        certifies them by forward kinematics like any other.
         """
         return None
 

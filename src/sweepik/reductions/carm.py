@@ -62,7 +62,16 @@ def carm_lengths(robot: Robot) -> tuple[float, float]:
             f"robot {robot.name!r} does not have the C-Arm's DH structure (paper Table 1); "
             "the carm-d1/carm-theta2 reductions do not apply"
         )
-    return float(robot.dh_a[3]), float(robot.dh_d[4])
+    L1, L2 = float(robot.dh_a[3]), float(robot.dh_d[4])
+    if not (L1 > 0.0 and L2 > 0.0):
+        # the closed form divides by L1 and L2 and takes theta3 from the direction of link L1: it holds for
+        # positive lengths only (a zero length is another arm: the wrist point no longer moves with theta3/4)
+        raise RobotDefinitionError(
+            f"robot {robot.name!r}: the carm-d1/carm-theta2 reductions need L1 = a (joint 4 row) > 0 and "
+            f"L2 = d (joint 5 row) > 0, got L1 = {L1:g}, L2 = {L2:g} (their closed form is derived for positive "
+            "lengths; a zero length is another kinematic structure)"
+        )
+    return L1, L2
 
 
 class _CArmBase(Reduction):
@@ -298,8 +307,8 @@ class CArmTheta2(_CArmBase):
         spot cos(theta2) = 0, where a theta2 sweep cannot describe them; carm-d1 reports them."""
         return np.asarray(np.abs(poses[:, 0, 3]) <= 1e-9 * (self.L1 + self.L2))
 
-    def special_solutions(self, poses: Array) -> Array | None:
-        """Solutions near the blind spot cos(theta2) = 0, found with the d1 reduction.
+    def special_solutions(self, poses: Array) -> tuple[Array, IntArray] | None:
+        """Solutions near the blind spot cos(theta2) = 0, found with the d1 reduction (with their multiplicity).
 
         Near theta2 = +-90 deg, d1 = Pz - Px tan(theta2) races through its range within a window of width
         ~|Px| / (L1 + L2) in theta2, so a theta2 sweep is ill-conditioned there and blind at its centre.
@@ -317,14 +326,16 @@ class CArmTheta2(_CArmBase):
         cand, _ = find_candidates(d1red, poses[idx], rng[:, 0], rng[:, 1])
         q = d1red.solve_rest(poses[idx][cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         keep = np.all(np.isfinite(q), axis=-1) & (np.abs(np.cos(q[:, 1])) <= BLIND_COS)
-        pose, q = cand.pose[keep], q[keep]
+        pose, q, mult = cand.pose[keep], q[keep], cand.mult[keep]
         if pose.size == 0:
             return None
         counts = np.bincount(pose, minlength=idx.size)
         width = max(8, int(counts.max()))
         out = np.full((poses.shape[0], width, 6), np.nan)
+        out_m = np.ones((poses.shape[0], width), dtype=np.intp)
         order = np.argsort(pose, kind="stable")
-        pose, q = pose[order], q[order]
+        pose, q, mult = pose[order], q[order], mult[order]
         slot = np.arange(pose.size) - np.concatenate([[0], np.cumsum(counts)[:-1]])[pose]
         out[idx[pose], slot] = q
-        return out
+        out_m[idx[pose], slot] = mult
+        return out, out_m

@@ -1,0 +1,184 @@
+"""Multiple roots, multiplicity, families vs. high-order roots, numerical continua, limits, refused geometry."""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from importlib import resources
+
+import numpy as np
+import pytest
+
+import sweepik
+from sweepik import RobotDefinitionError, fastsweep, load_robot, solve, solve_many
+from sweepik.families import MAX_ISOLATED_SOLUTIONS
+from sweepik.pose import pose_error_geodesic
+from sweepik.robot_file import robot_from_dict
+from sweepik.solutions import joint_distance
+
+CARM = load_robot("carm")
+REDUCTIONS = ["carm-d1", "carm-theta2"]
+#: acceptance of a solution (position + 100 mm x angle), as the solver's
+ACCEPT = 2e-13 * CARM.length_scale
+
+
+def _deg(*q: float) -> np.ndarray:
+    return np.array([q[0], *np.radians(q[1:])])
+
+
+def _index_of(sol: sweepik.Solutions, q: np.ndarray, tol: float = 1e-4) -> int | None:
+    if len(sol) == 0:
+        return None
+    d = joint_distance(CARM, sol.q, q).max(axis=-1)
+    return int(np.argmin(d)) if d.min() <= tol else None
+
+
+def _certified(sol: sweepik.Solutions, T: np.ndarray) -> bool:
+    if len(sol) == 0:
+        return True
+    return bool(np.all(pose_error_geodesic(CARM.fk(sol.q), T, 100.0) <= ACCEPT))
+
+
+@pytest.mark.parametrize("reduction", REDUCTIONS)
+def test_issue_example_double_root_found_by_both_reductions(reduction: str) -> None:
+    # theta2 = 0 with theta3 + theta4 = 90 deg: link L2 along joint 2's axis, a double root next to a simple one
+    q = _deg(300, 0, 45, 45, 2, 0)
+    sol = solve(CARM, CARM.fk(q), reduction=reduction)
+    i = _index_of(sol, q)
+    assert i is not None
+    assert sol.multiplicity[i] == 2
+    assert _certified(sol, CARM.fk(q))
+
+
+@pytest.mark.parametrize("reduction", REDUCTIONS)
+def test_triple_root_is_one_solution_not_a_family(reduction: str) -> None:
+    # theta2 = 0, theta5 = 0, theta3 + theta4 = -90 deg: the pose error grows as delta^3 off the solution
+    q = _deg(500, 0, -60, -30, 0, -60)
+    sol = solve(CARM, CARM.fk(q), reduction=reduction)
+    assert sol.families == ()
+    i = _index_of(sol, q)
+    assert i is not None
+    assert sol.multiplicity[i] == 3
+    # one solution there, not a cluster of near-copies
+    assert np.sum(joint_distance(CARM, sol.q, q).max(axis=-1) <= 1e-2) == 1
+
+
+def test_generic_solutions_are_simple(rng: np.random.Generator) -> None:
+    q = rng.uniform(CARM.lower, CARM.upper, (200, 6))
+    for sol, qq in zip(solve_many(CARM, CARM.fk(q)), q, strict=True):
+        i = _index_of(sol, qq, 1e-6)
+        assert i is not None
+        assert sol.multiplicity[i] == 1
+        assert sol.multiplicity.dtype.kind == "i" and sol.multiplicity.shape == (len(sol),)
+
+
+@pytest.mark.parametrize("reduction", REDUCTIONS)
+def test_double_root_theta2_90_theta3_0(reduction: str, rng: np.random.Generator) -> None:
+    # the paper's 600 excluded grid points: theta2 = +-90 deg with theta3 = 0
+    q = rng.uniform(CARM.lower, CARM.upper, (60, 6))
+    q[:, 1] = rng.choice([-1.0, 1.0], 60) * np.pi / 2
+    q[:, 2] = 0.0
+    q[:, 4] = np.where(np.abs(q[:, 4]) < 0.05, 0.3, q[:, 4])  # theta5 = 0 would be a self-motion
+    for sol, qq in zip(solve_many(CARM, CARM.fk(q), reduction=reduction), q, strict=True):
+        i = _index_of(sol, qq)
+        assert i is not None
+        assert sol.multiplicity[i] >= 2
+
+
+@pytest.mark.parametrize("reduction", REDUCTIONS)
+def test_triple_root_at_the_rail_end_is_kept_within_limits(reduction: str) -> None:
+    # the root is pinned down to its flat stretch (~0.02 mm); its middle may fall just outside the rail.
+    # carm-d1 clips it to the rail end; through theta2 the rail is not theta* (a documented limitation)
+    q = np.array([0.0, 0.0, -np.pi / 12, -5 * np.pi / 12, -np.pi, np.pi / 3])
+    T = CARM.fk(q)
+    sol = solve(CARM, T, reduction=reduction)
+    if reduction == "carm-d1":
+        assert _index_of(sol, q) is not None
+    free = solve(CARM, T, reduction=reduction, limits=False)
+    assert _index_of(free, q, 1e-3) is not None
+    assert len(sol) == int(np.sum(free.within_limits))
+
+
+def _same_sets(a: np.ndarray, b: np.ndarray) -> bool:
+    if a.shape != b.shape:
+        return False
+    if a.size == 0:
+        return True
+    d = joint_distance(CARM, a[:, None, :], b[None, :, :]).max(axis=-1)
+    return bool(d.min(axis=1).max() <= 1e-6 and d.min(axis=0).max() <= 1e-6)
+
+
+@pytest.mark.parametrize("reduction", REDUCTIONS)
+def test_limits_true_is_limits_false_filtered(reduction: str, rng: np.random.Generator) -> None:
+    n = 300
+    q = rng.uniform(CARM.lower - 0.2 * (CARM.upper - CARM.lower), CARM.upper, (n, 6))
+    k = n // 3
+    q[:k, 1], q[:k, 3] = 0.0, rng.choice([-1.0, 1.0], k) * np.pi / 2 - q[:k, 2]  # theta2 = 0, theta3+4 = +-90
+    q[k : 2 * k, 0] = rng.choice([0.0, 2000.0], k)  # rail ends
+    q[k : k + k // 2, 4] = 0.0
+    T = CARM.fk(q)
+    with_limits = solve_many(CARM, T, reduction=reduction)
+    without = solve_many(CARM, T, reduction=reduction, limits=False)
+    for a, b in zip(with_limits, without, strict=True):
+        assert _same_sets(a.q, b.q[b.within_limits])
+        assert len(a.families) <= len(b.families)
+
+
+@pytest.mark.parametrize("scale", [1e-7, 1e-6, 1e-5])
+def test_near_continuum_is_not_hundreds_of_copies(scale: float, rng: np.random.Generator) -> None:
+    # within ~1e-4 rad of the wrist on joint 2's axis at full stretch, joints 2 and 5 are almost coaxial: a
+    # whole arc of configurations reproduces the pose to rounding level
+    q = rng.uniform(CARM.lower, CARM.upper, (60, 6))
+    q[:, 2] = rng.normal(0.0, scale, 60)
+    q[:, 3] = -np.pi / 2 + rng.normal(0.0, scale, 60)
+    T = CARM.fk(q)
+    for sol, TT in zip(solve_many(CARM, T), T, strict=True):
+        assert len(sol) <= 2 * MAX_ISOLATED_SOLUTIONS
+        assert _certified(sol, TT)
+
+
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.parametrize("reduction", REDUCTIONS)
+def test_engines_agree_on_the_singular_set(
+    reduction: str, rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    q = rng.uniform(CARM.lower, CARM.upper, (150, 6))
+    q[:, 1] = 0.0
+    q[:, 3] = rng.choice([-1.0, 1.0], 150) * np.pi / 2 - q[:, 2]
+    q[:50, 4] = 0.0
+    q = q[CARM.within_limits(q)]
+    T = CARM.fk(q)
+    fast = solve_many(CARM, T, reduction=reduction)
+    monkeypatch.setattr(fastsweep, "AVAILABLE", False)
+    ref = solve_many(CARM, T, reduction=reduction)
+    for a, b, qq in zip(fast, ref, q, strict=True):
+        assert _index_of(a, qq) is not None and _index_of(b, qq) is not None
+        assert len(a) == len(b) and len(a.families) == len(b.families)
+        np.testing.assert_array_equal(np.sort(a.multiplicity), np.sort(b.multiplicity))
+
+
+def _carm_variant(joint: int, field: str, value: object) -> dict:
+    data = tomllib.loads((resources.files("sweepik") / "robots" / "carm.toml").read_text())
+    data = copy.deepcopy(data)
+    data["joints"][joint][field] = value
+    return data
+
+
+@pytest.mark.parametrize(
+    ("joint", "field", "value"), [(3, "a", -350.0), (4, "d", -402.0), (4, "d", 0.0), (3, "a", 0.0)]
+)
+def test_reduction_refuses_lengths_it_cannot_solve(joint: int, field: str, value: float) -> None:
+    robot = robot_from_dict(_carm_variant(joint, field, value), "variant.toml")
+    with pytest.raises(RobotDefinitionError, match="L1 .* > 0"):
+        solve(robot, robot.fk(np.array([500.0, 0.3, 0.2, -0.4, 0.5, 0.1])))
+
+
+def test_huge_rail_limits_solve_every_pose(rng: np.random.Generator) -> None:
+    robot = robot_from_dict(_carm_variant(0, "limits", [-1e300, 1e300]), "rail.toml")
+    assert robot.length_scale < 1e5  # tolerances do not grow with the rail
+    q = rng.uniform(CARM.lower, CARM.upper, (300, 6))
+    q[:, 0] = rng.uniform(-5000.0, 5000.0, 300)
+    T = robot.fk(q)
+    for sol, qq, TT in zip(solve_many(robot, T), q, T, strict=True):
+        assert len(sol) and joint_distance(robot, sol.q, qq).max(axis=-1).min() <= 1e-6
+        assert np.all(pose_error_geodesic(robot.fk(sol.q), TT, 100.0) <= 2e-13 * robot.length_scale)
