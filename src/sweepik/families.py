@@ -152,8 +152,9 @@ def families_of(
     lo, hi = inside[:n], inside[n:]
     # a piece that shrinks to a point (the family touches the limits there) is an isolated solution
     point = hi - lo <= CLUSTER_FAMILY_REL * (grid[K, -1] - grid[K, 0] + 1.0)
+    duplicate = _repeated_pieces(robot, red, chain, pose[K], branch[K], lo, hi) & ~point
     for j, k in enumerate(K):
-        if not point[j]:
+        if not point[j] and not duplicate[j]:
             sp = spans[k]
             out.setdefault(sp.pose, []).append(
                 Family(red.free_joint, (float(lo[j]), float(hi[j])), red, chain[sp.pose], sp.branch)
@@ -183,10 +184,43 @@ def _same_configuration(robot: Robot, a: Array, b: Array) -> NDArray[np.bool_]:
     return np.asarray(np.all(d <= _MEMBER_TOL * np.maximum(1.0, np.abs(a)), axis=-1))
 
 
+def _repeated_pieces(
+    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], lo: Array, hi: Array
+) -> NDArray[np.bool_]:
+    """``(P,)`` True for a family piece equal to an earlier one of the same pose: same interval and the same
+    members (two branches of a reduction can meet along a whole continuum). One batched member evaluation."""
+    P = pose.size
+    dup = np.zeros(P, dtype=bool)
+    if P < 2:
+        return dup
+    tol = _MEMBER_TOL * np.maximum(1.0, hi - lo)
+    same_iv = (
+        (pose[:, None] == pose[None, :])
+        & (np.abs(lo[:, None] - lo[None, :]) <= tol[:, None])
+        & (np.abs(hi[:, None] - hi[None, :]) <= tol[:, None])
+        & np.tri(P, k=-1, dtype=bool)
+    )
+    rows = np.nonzero(same_iv.any(axis=1))[0]
+    if rows.size == 0:
+        return dup
+    u = np.linspace(0.0, 1.0, 5)
+    x = lo[:, None] + (hi - lo)[:, None] * u[None, :]
+    members = family_members(robot, red, chain, np.repeat(pose, u.size), np.repeat(branch, u.size), x.ravel())
+    members = robot.wrap(members).reshape(P, u.size, -1)
+    for i in rows:
+        for j in np.nonzero(same_iv[i])[0]:
+            if not dup[j] and np.all(_same_configuration(robot, members[i], members[j])):
+                dup[i] = True
+                break
+    return dup
+
+
 def off_families(robot: Robot, q: Array, families: tuple[Family, ...]) -> NDArray[np.bool_]:
     """``(k,)`` mask of the configurations ``q (k, n)`` that are not members of any of ``families``."""
     on = np.zeros(q.shape[0], dtype=bool)
-    for f in families if q.shape[0] else ():
+    if not families or q.shape[0] == 0:
+        return ~on
+    for f in families:
         th = q[:, f.free_joint]
         inn = (th >= f.interval[0]) & (th <= f.interval[1])
         if inn.any():
@@ -197,20 +231,24 @@ def off_families(robot: Robot, q: Array, families: tuple[Family, ...]) -> NDArra
 def unique_families(families: tuple[Family, ...]) -> tuple[Family, ...]:
     """``families`` without repeats: a family whose free joint and interval equal an earlier one's and whose
     members agree with it (two branches of a reduction can meet along a whole continuum) is dropped."""
+    if len(families) < 2:
+        return families
     out: list[Family] = []
+    probes: list[Array] = []  # members at 5 points of each kept family's interval
     for f in families:
-        robot = f.reduction.robot
         lo, hi = f.interval
         tol = _MEMBER_TOL * max(1.0, hi - lo)
-        probe = np.linspace(lo, hi, 5)
-        if not any(
-            g.free_joint == f.free_joint
-            and abs(g.interval[0] - lo) <= tol
-            and abs(g.interval[1] - hi) <= tol
-            and bool(np.all(_same_configuration(robot, g.at(np.clip(probe, *g.interval)), f.at(probe))))
-            for g in out
-        ):
+        mine: Array | None = None
+        duplicate = False
+        for g, g_members in zip(out, probes, strict=True):
+            if g.free_joint == f.free_joint and abs(g.interval[0] - lo) <= tol and abs(g.interval[1] - hi) <= tol:
+                mine = f.at(np.linspace(lo, hi, 5)) if mine is None else mine
+                if np.all(_same_configuration(f.reduction.robot, g_members, mine)):
+                    duplicate = True
+                    break
+        if not duplicate:
             out.append(f)
+            probes.append(f.at(np.linspace(lo, hi, 5)) if mine is None else mine)
     return tuple(out)
 
 

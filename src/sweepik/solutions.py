@@ -52,10 +52,14 @@ class Family:
         tol = _FAMILY_EDGE_TOL * max(hi - lo, 1.0)
         if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
             raise SweepikError(f"theta* = {th.tolist()} is outside the family's interval [{lo:.12g}, {hi:.12g}]")
-        flat = np.clip(th.reshape(1, -1), lo, hi)
-        q = self.reduction.solve_rest(self.chain_pose[None], flat, np.full(flat.shape, self.branch))
-        q = self.reduction.robot.wrap(q[0])
-        return q.reshape(*th.shape, -1)
+        flat = np.clip(th.reshape(-1), lo, hi)
+        from .families import family_members  # local import: families imports this module
+
+        red = self.reduction
+        q = family_members(
+            red.robot, red, self.chain_pose[None], np.zeros(flat.size, np.intp), np.full(flat.size, self.branch), flat
+        )
+        return red.robot.wrap(q).reshape(*th.shape, -1)
 
     def sample(self, count: int = 50) -> Array:
         """``(count, n)`` member configurations evenly spaced over the interval."""

@@ -219,8 +219,17 @@ def _solve_chunk(
             & ((err_geo > POLISH_ABOVE_REL * scale) | (err_paper > POLISH_PAPER_ABOVE_REL * scale))
         )[0]
         if near.size:
-            q[near] = polish(robot, q[near], target[near], weight)
-            err_geo[near], err_paper[near] = _errors(robot, q[near], target[near], weight)
+            polished = polish(robot, q[near], target[near], weight)
+            eg, ep = _errors(robot, polished, target[near], weight)
+            # at a singular configuration the step can drift along the near-null space: never out of the limits
+            # for a configuration that was inside them and already certified
+            drift = (
+                (err_geo[near] <= ACCEPT_TOL_REL * scale)
+                & robot.within_limits(q[near])
+                & ~robot.within_limits(polished)
+            )
+            take = np.nonzero(~drift)[0]
+            q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
     if strategy == "precise":
         certified = err_geo <= ACCEPT_TOL_REL * robot.length_scale
     else:
@@ -279,7 +288,9 @@ def _solve_chunk(
         s, e = bounds[i], bounds[i + 1]
         other = fallback.get(i)
         # the reduction's blind spot: the fallback reduction's families are added
-        fam = unique_families(tuple(fams.get(i, ())) + (other.families if other is not None else ()))
+        fam = tuple(fams.get(i, ()))
+        if other is not None:
+            fam = unique_families(fam + other.families)
         reason = None
         if e == s and not fam:
             if strategy == "paper":  # its fixed 0.001 mm resolution decides nothing about reachability

@@ -118,6 +118,10 @@ def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samp
     s = _unit_grid(n_samples)
     grid = lo[:, None] + (hi - lo)[:, None] * s[None, :]
     hints = reduction.sample_hints(poses)
+    if not reduction.periodic:  # theta*'s limits: a solution exactly at a limit (a rail end) is a sample
+        j = reduction.free_joint
+        ends = np.broadcast_to([reduction.robot.lower[j], reduction.robot.upper[j]], (poses.shape[0], 2))
+        hints = ends if hints is None else np.concatenate([hints, ends], axis=1)
     if hints is not None and hints.size:
         if reduction.periodic:
             hints = np.pi - np.mod(np.pi - hints, 2.0 * np.pi)
@@ -133,8 +137,8 @@ def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samp
         rep[:, 1:-1] = (grid[:, 1:-1] == grid[:, :-2]) & (grid[:, 2:] > grid[:, 1:-1])
         if not rep.any():
             break
-        i, j = np.nonzero(rep)
-        grid[i, j] = 0.5 * (grid[i, j] + grid[i, j + 1])
+        r_i, r_j = np.nonzero(rep)
+        grid[r_i, r_j] = 0.5 * (grid[r_i, r_j] + grid[r_i, r_j + 1])
     return grid
 
 
