@@ -126,19 +126,28 @@ def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samp
         if reduction.periodic:
             hints = np.pi - np.mod(np.pi - hints, 2.0 * np.pi)
         inside = np.isfinite(hints) & (hints >= lo[:, None]) & (hints <= hi[:, None])
-        hints = np.where(inside, hints, lo[:, None])
+        # a hint outside the range becomes a midpoint of the uniform grid (a distinct, harmless extra sample)
+        spare = lo[:, None] + (hi - lo)[:, None] * ((np.arange(hints.shape[1]) + 0.5) / (n_samples - 1))[None, :]
+        hints = np.where(inside, hints, spare)
         grid = np.concatenate([grid, hints], axis=1)
     grid = np.sort(grid, axis=1)
-    # a sample repeated (a hint on the grid, two hints at one place) would leave a zero-width interval, where the
-    # three-sample extremum test cannot work (a double root exactly at that sample would go unseen): move each
-    # repeat halfway to the next distinct sample
-    for _ in range(8):
-        rep = np.zeros(grid.shape, dtype=bool)
-        rep[:, 1:-1] = (grid[:, 1:-1] == grid[:, :-2]) & (grid[:, 2:] > grid[:, 1:-1])
-        if not rep.any():
-            break
-        r_i, r_j = np.nonzero(rep)
-        grid[r_i, r_j] = 0.5 * (grid[r_i, r_j] + grid[r_i, r_j + 1])
+    # a sample repeated (a hint on the grid, hints outside the range all set to lo) would leave zero-width
+    # intervals, where the three-sample extremum test cannot work (a double root exactly at that sample would go
+    # unseen): each run of equal samples is spread evenly towards the next distinct sample
+    new_run = np.ones(grid.shape, dtype=bool)
+    new_run[:, 1:] = grid[:, 1:] > grid[:, :-1]
+    if new_run.all():
+        return grid
+    M = grid.shape[1]
+    idx = np.broadcast_to(np.arange(M), grid.shape)
+    start = np.maximum.accumulate(np.where(new_run, idx, 0), axis=1)
+    nxt = np.full(grid.shape, M)
+    nxt[:, :-1] = np.minimum.accumulate(np.where(new_run, idx, M)[:, :0:-1], axis=1)[:, ::-1]
+    r_i, r_j = np.nonzero(~new_run & (nxt < M))
+    if r_i.size:
+        s0, e0 = start[r_i, r_j], nxt[r_i, r_j]
+        base = grid[r_i, s0]
+        grid[r_i, r_j] = base + (grid[r_i, e0] - base) * (r_j - s0) / (e0 - s0)
     return grid
 
 
