@@ -231,3 +231,20 @@ def test_write_joint_path_rejects_bad_input(tmp_path) -> None:
         write_joint_path(tmp_path / "q.txt", _smooth_configs(2), CARM)
     with pytest.raises(ShapeError):
         write_joint_path(tmp_path / "q.csv", np.zeros((2, 5)), CARM)
+
+
+def test_nearest_and_follow_path_use_one_metric(rng: np.random.Generator) -> None:
+    # the metric weighs 100 mm of rail like 1 rad: a reference far along the rail but close in angles
+    from sweepik.solutions import weighted_joint_distance
+
+    arm = load_robot("carm")
+    q = rng.uniform(arm.lower, arm.upper, (40, 6))
+    ref = rng.uniform(arm.lower, arm.upper, (40, 6))
+    T = arm.fk(q)
+    for TT, r in zip(T, ref, strict=True):
+        sol = solve(arm, TT)
+        if not sol:
+            continue
+        picked = follow_path(arm, TT[None], q_start=r).q[0]
+        np.testing.assert_allclose(picked, sol.nearest(r), atol=1e-9)
+        assert float(weighted_joint_distance(arm, sol.nearest(r), r)) <= float(sol.distances(r).min()) + 1e-12

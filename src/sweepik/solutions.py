@@ -29,6 +29,57 @@ def joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
     return np.where(robot.is_revolute, wrapped, np.abs(d))
 
 
+def weighted_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
+    """Distance ``(...)`` between configurations ``q (..., n)`` and ``q_ref (n,)``, dimensionless: the one metric
+    of joint space in sweepik (``Solutions.nearest``, ``follow_path``).
+
+    Angles are compared modulo 2 pi (radians); prismatic differences are divided by the paper's weight
+    (100 mm per radian, eq. 6c, in the robot's length unit), then the Euclidean norm is taken.
+    """
+    from .units import orientation_weight  # local import keeps this module's imports light
+
+    d = joint_distance(robot, q, q_ref)
+    scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
+    return np.asarray(np.linalg.norm(d * scale, axis=-1))
+
+
+#: Members sampled along a self-motion family before the nearest one is refined (golden section).
+_FAMILY_SAMPLES = 721
+_GOLDEN_ITERS = 60
+
+
+def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, float]:
+    """Member of ``fam`` nearest ``ref`` (weighted distance): dense sampling, then golden-section search."""
+    lo, hi = fam.interval
+    grid = np.linspace(lo, hi, _FAMILY_SAMPLES)
+    members = fam.at(grid)
+    d = weighted_joint_distance(robot, members, ref)
+    d = np.where(np.all(np.isfinite(members), axis=-1), d, np.inf)
+    i = int(np.argmin(d))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+
+    def dist(t: float) -> float:
+        return float(weighted_joint_distance(robot, fam.at(t), ref))
+
+    g = (np.sqrt(5.0) - 1.0) / 2.0
+    c, e = b - g * (b - a), a + g * (b - a)
+    fc, fe = dist(c), dist(e)
+    for _ in range(_GOLDEN_ITERS):
+        if fc <= fe:
+            b, e, fe = e, c, fc
+            c = b - g * (b - a)
+            fc = dist(c)
+        else:
+            a, c, fc = c, e, fe
+            e = a + g * (b - a)
+            fe = dist(e)
+    t = c if fc <= fe else e
+    best, bd = fam.at(t), dist(t)
+    if not bd <= float(d[i]):
+        best, bd = members[i], float(d[i])
+    return np.asarray(best, dtype=np.float64), bd
+
+
 @dataclass(frozen=True, eq=False)
 class Family:
     """A continuum of solutions (self-motion): every theta* in ``interval`` gives a solution.
@@ -107,14 +158,18 @@ class Solutions:
         return len(self) > 0 or bool(self.families)
 
     def distances(self, q_ref: ArrayLike) -> Array:
-        """``(k,)`` Euclidean joint-space distance to ``q_ref`` (angles modulo 2 pi, mixed units)."""
+        """``(k,)`` distance of each solution to ``q_ref``: :func:`weighted_joint_distance` (angles modulo 2 pi in
+        radians, prismatic joints in units of 100 mm per radian)."""
         ref = check_configuration(q_ref, self.robot.n_joints, "q_ref")
-        return np.asarray(np.linalg.norm(joint_distance(self.robot, self.q, ref), axis=-1))
+        return weighted_joint_distance(self.robot, self.q, ref)
 
     def nearest(self, q_ref: ArrayLike) -> Array:
-        """The solution ``(n,)`` closest to ``q_ref`` (angles modulo 2 pi). Family members count too: the
-        nearest member is searched along each family. Raises SweepikError when there is no solution."""
+        """The solution ``(n,)`` closest to ``q_ref`` by :func:`weighted_joint_distance` (the metric
+        ``follow_path`` uses too). Family members count: the nearest member is searched along each family.
+        Raises SweepikError when there is no solution."""
         ref = check_configuration(q_ref, self.robot.n_joints, "q_ref")
+        if ref.ndim != 1:
+            raise SweepikError(f"q_ref must have shape ({self.robot.n_joints},), got {ref.shape}")
         best: Array | None = None
         best_d = np.inf
         if len(self):
@@ -122,15 +177,9 @@ class Solutions:
             i = int(np.argmin(d))
             best, best_d = self.q[i], float(d[i])
         for fam in self.families:
-            lo, hi = fam.interval
-            for _ in range(8):  # coarse-to-fine search along the family (each pass narrows 50x)
-                grid = np.linspace(lo, hi, 101)
-                d = np.linalg.norm(joint_distance(self.robot, fam.at(grid), ref), axis=-1)
-                i = int(np.nanargmin(d))
-                step = grid[1] - grid[0]
-                lo, hi = max(fam.interval[0], grid[i] - step), min(fam.interval[1], grid[i] + step)
-            if d[i] < best_d:
-                best, best_d = fam.at(grid[i]), float(d[i])
+            member, dm = _nearest_on_family(self.robot, fam, ref)
+            if dm < best_d:
+                best, best_d = member, dm
         if best is None:
             raise SweepikError(f"no solution to choose from ({self.reason})")
         return best.copy()

@@ -29,7 +29,7 @@ from .errors import PoseFileError, ShapeError, UnknownOptionError
 from .pose import pose_error_paper, pose_from_xyz_zyz
 from .reductions import Reduction
 from .robot import Robot
-from .solutions import Family, Solutions, joint_distance
+from .solutions import Solutions, joint_distance, weighted_joint_distance
 from .solver import solve_many
 from .units import orientation_weight
 
@@ -54,20 +54,6 @@ BRANCH_SWITCH_ANGLE_RAD = math.radians(30.0)
 #: ... or when a prismatic joint moves more than this share of its range (C-Arm rail: 10 % of 2000 mm).
 #: Joints without a finite range use the robot's ``length_scale`` instead of the range.
 BRANCH_SWITCH_LENGTH_REL = 0.1
-#: Members sampled along a self-motion family before the nearest one is refined (golden section).
-_FAMILY_SAMPLES = 721
-_GOLDEN_ITERS = 60
-
-
-def weighted_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
-    """Distance ``(...)`` between configurations ``q (..., n)`` and ``q_ref (n,)``, dimensionless.
-
-    Angles are compared modulo 2 pi (radians); prismatic differences are divided by the paper's weight
-    (100 mm per radian, in the robot's length unit), then the Euclidean norm is taken.
-    """
-    d = joint_distance(robot, q, q_ref)
-    scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
-    return np.asarray(np.linalg.norm(d * scale, axis=-1))
 
 
 def branch_switch_thresholds(robot: Robot) -> Array:
@@ -110,63 +96,15 @@ class PathResult:
         return float(np.mean(self.found)) if self.found.size else 0.0
 
 
-def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, float]:
-    """Member of ``fam`` nearest ``ref`` (weighted distance): dense sampling, then golden-section search."""
-    lo, hi = fam.interval
-    grid = np.linspace(lo, hi, _FAMILY_SAMPLES)
-    members = fam.at(grid)
-    d = weighted_joint_distance(robot, members, ref)
-    d = np.where(np.all(np.isfinite(members), axis=-1), d, np.inf)
-    i = int(np.argmin(d))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
-
-    def dist(t: float) -> float:
-        return float(weighted_joint_distance(robot, fam.at(t), ref))
-
-    g = (math.sqrt(5.0) - 1.0) / 2.0
-    c, e = b - g * (b - a), a + g * (b - a)
-    fc, fe = dist(c), dist(e)
-    for _ in range(_GOLDEN_ITERS):
-        if fc <= fe:
-            b, e, fe = e, c, fc
-            c = b - g * (b - a)
-            fc = dist(c)
-        else:
-            a, c, fc = c, e, fe
-            e = a + g * (b - a)
-            fe = dist(e)
-    t = c if fc <= fe else e
-    best = fam.at(t)
-    bd = dist(t)
-    if not bd <= float(d[i]):
-        best, bd = members[i], float(d[i])
-    return np.asarray(best, dtype=np.float64), bd
-
-
 def _choose(robot: Robot, sols: Solutions, ref: Array | None, weight: float) -> tuple[Array, float] | None:
-    """The solution of ``sols`` nearest ``ref`` (the first one when ``ref`` is None) and its error J."""
-    best: Array | None = None
-    best_err = math.nan
-    best_d = math.inf
-    if len(sols):
-        if ref is None:
-            return sols.q[0].copy(), float(sols.error[0])
-        d = weighted_joint_distance(robot, sols.q, ref)
-        i = int(np.argmin(d))
-        best, best_err, best_d = sols.q[i].copy(), float(sols.error[i]), float(d[i])
-    for fam in sols.families:
-        if ref is None:
-            member, dm = fam.at(fam.interval[0]), 0.0
-        else:
-            member, dm = _nearest_on_family(robot, fam, ref)
-        if dm < best_d:
-            err = float(pose_error_paper(robot.fk(member), sols.pose, weight))
-            best, best_err, best_d = member, err, dm
-            if ref is None:
-                break
-    if best is None:
+    """The solution of ``sols`` nearest ``ref`` (:meth:`Solutions.nearest`; the first one when ``ref`` is None)
+    and its error J."""
+    if len(sols) and ref is None:
+        return sols.q[0].copy(), float(sols.error[0])
+    if not sols:
         return None
-    return best, best_err
+    best = sols.nearest(ref) if ref is not None else sols.families[0].at(sols.families[0].interval[0])
+    return best, float(pose_error_paper(robot.fk(best), sols.pose, weight))
 
 
 def follow_path(
