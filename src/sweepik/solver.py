@@ -293,9 +293,10 @@ def _solve_chunk(
             fam = unique_families(fam + other.families)
         reason = None
         if e == s and not fam:
-            if strategy == "paper":  # its fixed 0.001 mm resolution decides nothing about reachability
+            if strategy == "paper":  # its fixed final resolution decides nothing about reachability
+                step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"
                 reason = (
-                    "no solution with J < 1e-5 mm found by the paper's strategy (its final 0.001 mm step "
+                    f"no solution with J < 1e-5 mm found by the paper's strategy (its final {step} step "
                     "misses roots off its grid); strategy='precise' finds every solution"
                 )
             elif n_reachable[i] > 0:
