@@ -254,12 +254,12 @@ def _solve_chunk(
                 err_geo = np.concatenate([err_geo, r_sol.error_geodesic])
                 mult = np.concatenate([mult, r_sol.multiplicity])
     q, inside = robot.wrapped_within_limits(q)
-    n_reachable = np.bincount(pose_idx, minlength=len(poses))
     # duplicates first (of twins, the one inside the limits is kept), so that limits=True is exactly
     # limits=False filtered by the limits
     keep = _dedupe(robot, pose_idx, q, np.where(inside, err_geo, err_geo + robot.length_scale))
     if strategy == "precise":  # a numerical continuum of certified solutions is reported once
         keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
+    n_reachable = np.bincount(pose_idx[keep], minlength=len(poses))
     if limits:
         keep &= inside
     pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]

@@ -12,9 +12,12 @@ giving one residual sequence per (pose, branch). On each sequence:
   differences), or that touch a domain edge (square-root behaviour), are resampled more finely, recursively,
   and searched the same way;
 * runs of samples where the residual vanishes identically -> self-motion families;
+* samples within the residual's rounding noise -> candidates (a double root landing on a sample);
 * roots in a stretch where the residual stays at rounding level (roots of high multiplicity) -> moved to the
-  middle of the stretch; a stretch longer than ``CLUSTER_FAMILY_REL`` of the range is a family (a numerical
-  continuum); roots joined by such stretches are merged.
+  middle of the stretch; a stretch that ends at a domain edge, a jump or the search reach on both sides is a
+  family (an analytic residual vanishing on an interval vanishes up to such an end), one that leaves the noise
+  smoothly is a single root; roots joined by such stretches are merged;
+* each root's multiplicity, from the growth of the residual away from it.
 
 The result is a flat list of candidates ``(pose index, branch, theta*)``; ``solve`` turns them into
 configurations, certifies each by forward kinematics and applies limits.
