@@ -27,9 +27,11 @@ def _pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:
     return T, kinematics.geometric_jacobian(robot, q)
 
 
-def polish(robot: Robot, q: Array, target: Array, weight: float, iterations: int = 2) -> Array:
+def polish(
+    robot: Robot, q: Array, target: Array, weight: float, iterations: int = 2, fixed: NDArray[np.bool_] | None = None
+) -> Array:
     """Improve configurations ``q (K, n)`` towards poses ``target (K, 4, 4)``; keeps a step only if the
-    geodesic error (position + ``weight`` x angle) decreases."""
+    geodesic error (position + ``weight`` x angle) decreases. ``fixed (K, n)``: joints held where True."""
     if q.shape[0] == 0:
         return q
     q = q.copy()
@@ -43,6 +45,8 @@ def polish(robot: Robot, q: Array, target: Array, weight: float, iterations: int
         w = 0.5 * np.stack([dR[:, 2, 1] - dR[:, 1, 2], dR[:, 0, 2] - dR[:, 2, 0], dR[:, 1, 0] - dR[:, 0, 1]], -1)
         e = np.concatenate([dp, w], axis=-1) * scale
         Js = J * scale[:, None]
+        if fixed is not None:
+            Js = np.where(fixed[:, None, :], 0.0, Js)
         # pseudo-inverse per candidate: singular Jacobians (rank-deficient arms poses) stay bounded
         q_new = q + np.einsum("kij,kj->ki", np.linalg.pinv(Js, rcond=PINV_RCOND), e)
         T_new = kinematics.chain_frames(robot, q_new)[:, -1] @ robot.T_flange_tool

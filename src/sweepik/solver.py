@@ -106,6 +106,31 @@ def _limit_copies(robot: Robot, red: Reduction, cand: Candidates, span: Array) -
     )
 
 
+#: A certified solution at most this far outside a joint limit (radians; prismatic joints: times the arm's length
+#: scale) is tried at the limit: near a singular configuration the pose pins a solution down only to ~1e-8, so
+#: one exactly at a limit comes out a little beyond it.
+SNAP_REACH = 1e-4
+#: Newton steps (other joints free, the clamped ones held) for a solution moved onto its limit.
+SNAP_ITERATIONS = 4
+
+
+def _snap_to_limits(robot: Robot, q: Array, err_geo: Array, err_paper: Array, target: Array, weight: float) -> None:
+    """In place: certified configurations ``q (K, n)`` just outside the limits are clamped to them and polished
+    with the clamped joints held; where that still certifies, it replaces them (with their errors)."""
+    w = robot.wrap(q)
+    reach = np.where(robot.is_revolute, SNAP_REACH, SNAP_REACH * robot.length_scale)
+    over = np.maximum(robot.lower - robot.limit_tol - w, w - robot.upper - robot.limit_tol)
+    k = np.nonzero(np.any(over > 0, axis=-1) & np.all(over <= reach, axis=-1))[0]
+    if k.size == 0:
+        return
+    held = over[k] > 0
+    start = np.clip(w[k], robot.lower, robot.upper)
+    moved = polish(robot, start, target[k], weight, SNAP_ITERATIONS, fixed=held)
+    eg, ep = _errors(robot, moved, target[k], weight)
+    ok = (eg <= ACCEPT_TOL_REL * robot.length_scale) & robot.within_limits(moved)
+    q[k[ok]], err_geo[k[ok]], err_paper[k[ok]] = moved[ok], eg[ok], ep[ok]
+
+
 def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:
     """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one.
 
@@ -242,6 +267,8 @@ def _solve_chunk(
         rescue = np.unique(pose_idx[miss])
     pose_idx, q, err_paper, err_geo = pose_idx[certified], q[certified], err_paper[certified], err_geo[certified]
     mult = mult[certified]
+    if strategy == "precise":
+        _snap_to_limits(robot, q, err_geo, err_paper, poses[pose_idx], weight)
     if rescue.size:
         rescued = _solve_chunk(
             robot, get_reduction(robot, red.fallback), poses[rescue], strategy, limits, n_samples, False
