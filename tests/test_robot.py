@@ -133,7 +133,7 @@ def test_robot_validation() -> None:
         Robot("empty", ())
     with pytest.raises(RobotDefinitionError, match="non-empty"):
         Robot("bad", ("revolute",))  # type: ignore[arg-type]
-    with pytest.raises(RobotDefinitionError, match=r"dh_convention must be 'modified' or 'standard'.*'craig'"):
+    with pytest.raises(RobotDefinitionError, match=r"dh_convention must be 'modified', 'standard' or 'none'.*'craig'"):
         two_link(dh_convention="craig")
     with pytest.raises(InvalidPoseError, match="base transform"):
         two_link(T_world_base=2 * np.eye(4))

@@ -71,3 +71,20 @@ def test_self_motion_reported_by_both_reductions_without_duplicates(reduction: s
     keys = [(f.free_joint, round(f.interval[0], 6), round(f.interval[1], 6), f.branch) for f in sol.families]
     assert len(keys) == len(set(keys))
     np.testing.assert_allclose(sol.nearest(q), q, atol=1e-6)
+
+
+def test_subclass_overriding_the_residual_does_not_run_the_parents_kernel() -> None:
+    arm = sweepik.load_robot("carm")
+
+    class NoResidual(sweepik.CArmD1):
+        def residual(self, poses, theta, branch=None):  # type: ignore[no-untyped-def]
+            return None
+
+    class Renamed(sweepik.CArmD1):
+        name = "renamed"
+
+    assert sweepik.CArmD1(arm).uses_kernel and Renamed(arm).uses_kernel
+    assert not NoResidual(arm).uses_kernel
+    q = np.array([700.0, 0.4, 0.3, -0.5, 0.6, 0.2])
+    sols = sweepik.solve(arm, arm.fk(q), reduction=NoResidual(arm))
+    assert np.abs(sols.nearest(q) - q).max() < 1e-6

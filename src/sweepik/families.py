@@ -29,7 +29,7 @@ def family_members(
     robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], theta: Array
 ) -> Array:
     """Members ``(K, n)`` at ``theta (K,)`` of the families (pose, branch) (compiled where possible)."""
-    if red.kernel_id is not None and fastsweep.AVAILABLE:
+    if red.uses_kernel and fastsweep.AVAILABLE:
         return fastcertify.configurations(robot, red, chain, pose, theta, branch)
     return red.solve_rest(chain[pose], theta[:, None], branch[:, None])[:, 0]
 
@@ -47,7 +47,7 @@ def _members_ok(
 ) -> NDArray[np.bool_]:
     """``theta (K, M)``: members exist, are certified by FK (error <= ``tol``) and (with limits) lie inside the
     limits."""
-    if red.kernel_id is not None and fastsweep.AVAILABLE:
+    if red.uses_kernel and fastsweep.AVAILABLE:
         # compiled: configuration, FK and error per member (flange frame compared with the chain pose)
         M = theta.shape[1]
         flat_p = np.repeat(pose, M)

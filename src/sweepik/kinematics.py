@@ -17,8 +17,24 @@ if TYPE_CHECKING:
 Array = NDArray[np.float64]
 
 
+def _origin_axis_transforms(robot: Robot, q: Array) -> Array:
+    """``origin_i @ Rot(axis_i, q_i)`` or ``origin_i @ Trans(axis_i q_i)`` for ``dh_convention="none"``."""
+    from .chain import rotation_about
+
+    origins = np.array([j.origin for j in robot.joints], dtype=np.float64)
+    axes = np.array([j.axis for j in robot.joints], dtype=np.float64)
+    M = np.zeros((*q.shape, 4, 4))
+    rev = robot.is_revolute
+    M[..., :3, :3] = np.where(rev[:, None, None], rotation_about(axes, np.where(rev, q, 0.0)), np.eye(3))
+    M[..., :3, 3] = np.where(rev[:, None], 0.0, axes * q[..., None])
+    M[..., 3, 3] = 1.0
+    return np.asarray(origins @ M, dtype=np.float64)
+
+
 def link_transforms(robot: Robot, q: Array) -> Array:
     """Transforms ``(..., n, 4, 4)`` of each link frame relative to the previous one."""
+    if robot.dh_convention == "none":
+        return _origin_axis_transforms(robot, q)
     a = robot.dh_a
     alpha = robot.dh_alpha
     theta = robot.dh_theta + np.where(robot.is_revolute, q, 0.0)
@@ -71,10 +87,14 @@ def chain_frames(robot: Robot, q: Array) -> Array:
 def joint_axes(robot: Robot, frames: Array) -> tuple[Array, Array]:
     """Unit axes ``(..., n, 3)`` and points on them ``(..., n, 3)`` of each joint, in world coordinates.
 
-    Modified DH: joint i moves along/about z of frame i. Standard DH: about z of frame i - 1.
+    Modified DH: joint i moves along/about z of frame i. Standard DH: about z of frame i - 1. Origin + axis
+    (``dh_convention="none"``): about its axis in frame i.
     """
     n = robot.n_joints
-    sel = frames[..., 1 : n + 1, :, :] if robot.dh_convention == "modified" else frames[..., 0:n, :, :]
+    sel = frames[..., 0:n, :, :] if robot.dh_convention == "standard" else frames[..., 1 : n + 1, :, :]
+    if robot.dh_convention == "none":
+        axes = np.array([j.axis for j in robot.joints], dtype=np.float64)
+        return np.einsum("...ij,...j->...i", sel[..., :3, :3], axes), sel[..., :3, 3]
     return sel[..., :3, 2], sel[..., :3, 3]
 
 

@@ -8,7 +8,11 @@ Conventions
   ``RotZ(theta_i) TransZ(d_i) TransX(a_i) RotX(alpha_i)``.
 * A revolute joint's value q_i (radians) is added to the row's constant ``theta`` (its offset); a prismatic
   joint's value (length unit) is added to the row's constant ``d``.
+* ``dh_convention="none"``: no DH table; each joint carries ``origin`` (the fixed transform from the previous
+  joint's frame, or the base, to this joint's frame at q = 0) and ``axis`` (unit vector in that frame), as URDF
+  writes a chain: the link transform is ``origin @ Rot(axis, q_i)`` or ``origin @ Trans(axis * q_i)``.
 * ``fk(q) = T_world_base @ T_0_1(q_1) @ ... @ T_{n-1}_n(q_n) @ T_flange_tool``.
+* Robots are values: two robots with the same content are equal, hash alike and pickle to equal robots.
 """
 
 from __future__ import annotations
@@ -24,12 +28,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import kinematics
 from ._validate import check_configuration, check_poses
-from .errors import RobotDefinitionError
+from .chain import Chain
+from .errors import RobotDefinitionError, SweepikError
+from .structure import INTERSECT_TOL_REL, Structure, structure_of
 
 __all__ = ["Joint", "Robot", "JointType", "DHConvention"]
 
 JointType = Literal["revolute", "prismatic"]
-DHConvention = Literal["modified", "standard"]
+DHConvention = Literal["modified", "standard", "none"]
 Array = NDArray[np.float64]
 
 #: Joint values this far outside a limit still count as inside: 1e-9 rad for revolute joints and
@@ -40,6 +46,8 @@ LIMIT_TOL = 1e-9
 LIMIT_TOL_REL = 1e-9
 #: ``Robot.length_scale`` counts a prismatic range at most this many times the sum of the link lengths.
 SPAN_CAP = 10.0
+#: A joint axis shorter than this (before normalisation) is refused as having no direction.
+AXIS_MIN_NORM = 1e-9
 
 
 @dataclass(frozen=True)
@@ -57,6 +65,10 @@ class Joint:
     lower: float = -np.pi
     upper: float = np.pi
     name: str = ""
+    #: Only for ``dh_convention="none"``: the fixed 4x4 transform from the previous frame to this joint's frame
+    #: at q = 0 (rows, as nested tuples), and the joint axis in that frame (normalised on construction).
+    origin: tuple[tuple[float, ...], ...] | None = None
+    axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
 
     def __post_init__(self) -> None:
         label = self.name or "joint"
@@ -69,6 +81,20 @@ class Joint:
             object.__setattr__(self, f, float(v))
         if self.lower > self.upper:
             raise RobotDefinitionError(f"{label}: lower limit {self.lower:g} is above upper limit {self.upper:g}")
+        try:
+            axis = np.array(self.axis, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise RobotDefinitionError(f"{label}: axis must be 3 numbers, got {self.axis!r}") from None
+        norm = float(np.linalg.norm(axis)) if axis.shape == (3,) and np.all(np.isfinite(axis)) else 0.0
+        if norm < AXIS_MIN_NORM:
+            raise RobotDefinitionError(f"{label}: axis must be 3 finite numbers, not all zero, got {self.axis!r}")
+        object.__setattr__(self, "axis", tuple(float(v) for v in axis / norm))
+        if self.origin is not None:
+            try:
+                T = _frozen(self.origin, f"{label}: origin")
+            except SweepikError as exc:
+                raise RobotDefinitionError(str(exc)) from None
+            object.__setattr__(self, "origin", tuple(tuple(float(v) for v in row) for row in T))
 
     @property
     def is_revolute(self) -> bool:
@@ -107,13 +133,25 @@ class Robot:
     description: str = ""
 
     def __post_init__(self) -> None:
-        if self.dh_convention not in ("modified", "standard"):
+        if self.dh_convention not in ("modified", "standard", "none"):
             raise RobotDefinitionError(
-                f"{self.name}: dh_convention must be 'modified' or 'standard', got {self.dh_convention!r}"
+                f"{self.name}: dh_convention must be 'modified', 'standard' or 'none', got {self.dh_convention!r}"
             )
         joints = tuple(self.joints)
         if not joints or not all(isinstance(j, Joint) for j in joints):
             raise RobotDefinitionError(f"{self.name}: joints must be a non-empty sequence of Joint")
+        for i, j in enumerate(joints):
+            label = f"{self.name}: joint {i + 1} ({j.name or 'unnamed'})"
+            if self.dh_convention == "none" and j.origin is None:
+                raise RobotDefinitionError(f"{label}: dh_convention 'none' needs an origin transform on every joint")
+            if self.dh_convention != "none" and (j.origin is not None or j.axis != (0.0, 0.0, 1.0)):
+                raise RobotDefinitionError(
+                    f"{label}: origin/axis describe a joint only with dh_convention 'none' (DH joints move about z)"
+                )
+            if self.dh_convention == "none" and (j.a, j.alpha, j.d, j.theta) != (0.0, 0.0, 0.0, 0.0):
+                raise RobotDefinitionError(
+                    f"{label}: DH parameters a/alpha/d/theta are not used with dh_convention 'none'"
+                )
         object.__setattr__(self, "joints", joints)
         object.__setattr__(self, "T_world_base", _frozen(self.T_world_base, f"{self.name}: base transform"))
         object.__setattr__(self, "T_flange_tool", _frozen(self.T_flange_tool, f"{self.name}: tool transform"))
@@ -141,6 +179,56 @@ class Robot:
     upper: Array = field(init=False, repr=False)
     is_revolute: NDArray[np.bool_] = field(init=False, repr=False)
 
+    def _content(self) -> tuple[object, ...]:
+        return (
+            self.name,
+            self.joints,
+            self.dh_convention,
+            self.T_world_base.tobytes(),
+            self.T_flange_tool.tobytes(),
+            self.length_unit,
+            self.default_reduction,
+            self.description,
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Robot):
+            return NotImplemented
+        return self is other or self._content() == other._content()
+
+    def __hash__(self) -> int:
+        return hash(self._content())
+
+    def __reduce__(self) -> tuple[object, ...]:
+        # Rebuild through the constructor (validation, read-only arrays); cached properties are not pickled.
+        return (
+            Robot,
+            (
+                self.name,
+                self.joints,
+                self.dh_convention,
+                np.array(self.T_world_base),
+                np.array(self.T_flange_tool),
+                self.length_unit,
+                self.default_reduction,
+                self.description,
+            ),
+        )
+
+    @cached_property
+    def chain(self) -> Chain:
+        """The arm in product-of-exponentials form (world frame, q = 0): see :mod:`sweepik.chain`."""
+        zero = np.zeros(self.n_joints)
+        frames = kinematics.chain_frames(self, zero)
+        axes, points = kinematics.joint_axes(self, frames)
+        return Chain.from_frames(axes, points, self.is_revolute, frames[-1] @ self.T_flange_tool)
+
+    def structure(self, tol_rel: float | None = None) -> Structure:
+        """Which joint axes intersect or stay parallel (see :mod:`sweepik.structure`); distances below
+        ``tol_rel`` (default ``structure.INTERSECT_TOL_REL``) times ``length_scale`` count as zero."""
+        tol = INTERSECT_TOL_REL if tol_rel is None else float(tol_rel)
+        return structure_of(self.chain, self.length_scale, tol)
+
     @property
     def n_joints(self) -> int:
         return len(self.joints)
@@ -156,10 +244,11 @@ class Robot:
 
     @cached_property
     def length_scale(self) -> float:
-        """A characteristic length of the arm, for relative tolerances: the sum of |a| and |d| plus the prismatic
-        ranges, each range counted at most ``SPAN_CAP`` times the links (a rail of 1e300 does not make the arm
-        coarser: its tolerances would grow with it)."""
+        """A characteristic length of the arm, for relative tolerances: the sum of |a| and |d| (or of the origin
+        offsets, for ``dh_convention="none"``) plus the prismatic ranges, each range counted at most ``SPAN_CAP``
+        times the links (a rail of 1e300 does not make the arm coarser: its tolerances would grow with it)."""
         links = float(np.sum(np.abs(self.dh_a)) + np.sum(np.abs(self.dh_d)))
+        links += sum(float(np.linalg.norm(np.array(j.origin)[:3, 3])) for j in self.joints if j.origin is not None)
         span = np.where(self.is_revolute, 0.0, self.upper - self.lower)
         if links > 0.0:
             span = np.minimum(span, SPAN_CAP * links)

@@ -190,7 +190,7 @@ def _solve_chunk(
     weight = orientation_weight(robot.length_unit)
     spans: list[FamilySpan] = []
     fams: dict[int, list[Family]]
-    compiled = red.kernel_id is not None and fastsweep.AVAILABLE
+    compiled = red.uses_kernel and fastsweep.AVAILABLE
     err_geo = err_paper = None
     if strategy == "precise":
         if compiled:
@@ -408,7 +408,7 @@ def _solve_checked(
     if n_samples < 8:
         raise ShapeError(f"n_samples must be at least 8, got {n_samples}")
     red = get_reduction(robot, reduction)
-    if red.robot is not robot:
+    if red.robot != robot:
         raise UnknownOptionError(
             f"the reduction {red.name!r} was built for robot {red.robot.name!r}, not for {robot.name!r}"
         )

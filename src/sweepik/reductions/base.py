@@ -56,6 +56,18 @@ class Reduction(ABC):
     #: Id of a compiled scalar residual in ``reductions.kernels`` (None: the NumPy engine is used).
     kernel_id: int | None = None
 
+    @property
+    def uses_kernel(self) -> bool:
+        """The compiled kernel computes this reduction's residual: it has a ``kernel_id``, and no subclass below
+        the class that set it overrides ``residual``, ``solve_rest`` or ``kernel_params`` (a subclass that
+        changes the residual in Python must not silently run its parent's compiled kernel)."""
+        if self.kernel_id is None:
+            return False
+        mro = type(self).__mro__
+        owner = next(c for c in mro if "kernel_id" in vars(c))
+        below = mro[: mro.index(owner)]
+        return not any(name in vars(c) for c in below for name in ("residual", "solve_rest", "kernel_params"))
+
     def kernel_params(self, poses: Array) -> Array:
         """Per-pose parameters ``(N, P)`` of the compiled residual kernel (only with ``kernel_id``)."""
         raise NotImplementedError
