@@ -1,5 +1,6 @@
 """Compiled (Numba) certification of candidate roots: configuration from the reduction's kernel, forward
-kinematics, the geodesic error and the paper's J (eq. 6) in one pass per candidate. The same formulas as
+kinematics of the robot's product-of-exponentials chain (:mod:`sweepik.chain`, any robot), the geodesic error
+and the paper's J (eq. 6) in one pass per candidate. The same formulas as
 ``Reduction.solve_rest``, ``kinematics`` and ``pose`` (the references, used when Numba is missing or the
 robot or reduction has no kernel); cheaper than their NumPy versions by the per-call overhead of some
 hundred small array operations per solve.
@@ -15,7 +16,7 @@ from numpy.typing import NDArray
 
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
-from .reductions.kernels import configuration_by_id
+from .reductions.kernels import first_class
 from .units import orientation_weight
 
 if TYPE_CHECKING:
@@ -29,9 +30,44 @@ _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
 J_CUTOFF_FACTOR = 1e-4
 
 if AVAILABLE:
-    from numba import njit, prange
+    from numba import float64, int64, njit, prange, types
 
-    from .fastsweep import _fk_one
+    from .reductions.kernels import CONFIGURATION_SIG
+
+    _CFG = types.FunctionType(CONFIGURATION_SIG)
+
+    @njit(cache=True)
+    def _poe_fk(H, P, rev, R_end, q, T):
+        """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain into ``T (4, 4)``
+        (explicit loops: no BLAS)."""
+        R = np.eye(3)
+        Rn = np.empty((3, 3))
+        p = P[0].copy()
+        for i in range(H.shape[0]):
+            if rev[i]:
+                kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
+                c, s = math.cos(q[i]), math.sin(q[i])
+                v = 1.0 - c
+                k00, k01, k02 = c + kx * kx * v, kx * ky * v - kz * s, kx * kz * v + ky * s
+                k10, k11, k12 = ky * kx * v + kz * s, c + ky * ky * v, ky * kz * v - kx * s
+                k20, k21, k22 = kz * kx * v - ky * s, kz * ky * v + kx * s, c + kz * kz * v
+                for r in range(3):
+                    a0, a1, a2 = R[r, 0], R[r, 1], R[r, 2]
+                    Rn[r, 0] = a0 * k00 + a1 * k10 + a2 * k20
+                    Rn[r, 1] = a0 * k01 + a1 * k11 + a2 * k21
+                    Rn[r, 2] = a0 * k02 + a1 * k12 + a2 * k22
+                R[:, :] = Rn
+            else:
+                for r in range(3):
+                    p[r] += (R[r, 0] * H[i, 0] + R[r, 1] * H[i, 1] + R[r, 2] * H[i, 2]) * q[i]
+            for r in range(3):
+                p[r] += R[r, 0] * P[i + 1, 0] + R[r, 1] * P[i + 1, 1] + R[r, 2] * P[i + 1, 2]
+        for r in range(3):
+            for c2 in range(3):
+                T[r, c2] = R[r, 0] * R_end[0, c2] + R[r, 1] * R_end[1, c2] + R[r, 2] * R_end[2, c2]
+            T[r, 3] = p[r]
+            T[3, r] = 0.0
+        T[3, 3] = 1.0
 
     @njit(cache=True)
     def _wrap(x):
@@ -78,38 +114,44 @@ if AVAILABLE:
         return geo, math.sqrt(dp * dp + (weight * jo) ** 2)
 
     @njit(cache=True)
-    def _certify_one(kid, params, chain, world, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, i, k):
+    def _certify_one(cfg, params, world, theta, branch, H, P, rev, R_end, weight, q, i, k):
         """Configuration of candidate k (pose i) into q[k]; returns (geodesic error, paper J)."""
-        configuration_by_id(kid, params[i], chain[i], theta[k], branch[k], q[k])
+        cfg(params[i], theta[k], branch[k], q[k])
         if not np.all(np.isfinite(q[k])):
             return np.inf, np.inf
-        F = np.empty((1, 4, 4))
-        qq = np.empty((1, a.shape[0]))
-        qq[0] = q[k]
-        _fk_one(a, alpha, d, th0, rev, base, qq, F, 0)
-        T = np.zeros((4, 4))  # flange @ tool, without BLAS
-        for r in range(4):
-            for c in range(4):
-                T[r, c] = F[0, r, 0] * tool[0, c] + F[0, r, 1] * tool[1, c] + F[0, r, 2] * tool[2, c]
-                T[r, c] += F[0, r, 3] * tool[3, c]
+        T = np.empty((4, 4))
+        _poe_fk(H, P, rev, R_end, q[k], T)
         return _errors(T, world[i], weight)
 
-    @njit(cache=True, parallel=True)
-    def _certify_parallel(
-        kid, params, chain, world, pose, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, err_geo, err_paper
-    ):
+    _CERTIFY_SIG = (
+        _CFG,
+        float64[:, ::1],
+        float64[:, :, ::1],
+        int64[::1],
+        float64[::1],
+        int64[::1],
+        float64[:, ::1],
+        float64[:, ::1],
+        types.boolean[::1],
+        float64[:, ::1],
+        float64,
+        float64[:, ::1],
+        float64[::1],
+        float64[::1],
+    )
+
+    @njit(_CERTIFY_SIG, cache=True, parallel=True)
+    def _certify_parallel(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper):
         for k in prange(pose.shape[0]):
             err_geo[k], err_paper[k] = _certify_one(
-                kid, params, chain, world, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, pose[k], k
+                cfg, params, world, theta, branch, H, P, rev, R_end, weight, q, pose[k], k
             )
 
-    @njit(cache=True)
-    def _certify_serial(
-        kid, params, chain, world, pose, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, err_geo, err_paper
-    ):
+    @njit(_CERTIFY_SIG, cache=True)
+    def _certify_serial(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper):
         for k in range(pose.shape[0]):
             err_geo[k], err_paper[k] = _certify_one(
-                kid, params, chain, world, theta, branch, a, alpha, d, th0, rev, base, tool, weight, q, pose[k], k
+                cfg, params, world, theta, branch, H, P, rev, R_end, weight, q, pose[k], k
             )
 
 
@@ -121,22 +163,19 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, 
     eg = np.empty(K)
     ep = np.empty(K)
     run = _certify_parallel if K >= 16 * PARALLEL_MIN else _certify_serial
+    ch = robot.chain
     run(
-        red.kernel_id,
-        np.ascontiguousarray(red.kernel_params(chain) if params is None else params),
-        np.ascontiguousarray(chain),
-        np.ascontiguousarray(world),
+        first_class(red.kernel[1]),
+        np.ascontiguousarray(red.kernel_params(chain) if params is None else params, dtype=np.float64),
+        np.ascontiguousarray(world, dtype=np.float64),
         pose.astype(np.int64),
         theta.astype(np.float64),
         branch.astype(np.int64),
-        robot.dh_a,
-        robot.dh_alpha,
-        robot.dh_d,
-        robot.dh_theta,
-        robot.is_revolute,
-        np.ascontiguousarray(robot.T_world_base),
-        np.ascontiguousarray(robot.T_flange_tool),
-        orientation_weight(robot.length_unit),
+        np.array(ch.H),  # writable copies: the compiled signature takes writable arrays
+        np.array(ch.P),
+        np.array(ch.revolute),
+        np.array(ch.R_end),
+        float(orientation_weight(robot.length_unit)),
         q,
         eg,
         ep,
@@ -146,20 +185,20 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, 
 
 if AVAILABLE:
 
-    @njit(cache=True)
-    def _configurations(kid, params, chain, pose, theta, branch, q):
+    @njit((_CFG, float64[:, ::1], int64[::1], float64[::1], int64[::1], float64[:, ::1]), cache=True)
+    def _configurations(cfg, params, pose, theta, branch, q):
         for k in range(pose.shape[0]):
-            configuration_by_id(kid, params[pose[k]], chain[pose[k]], theta[k], branch[k], q[k])
+            cfg(params[pose[k]], theta[k], branch[k], q[k])
 
 
 def configurations(robot: Robot, red: Reduction, chain: Array, pose: IntArray, theta: Array, branch: IntArray) -> Array:
     """Configurations ``(K, n)`` of branch ``branch`` at theta* ``theta`` of chain poses ``chain[pose]`` (compiled
     ``solve_rest`` for reductions with a kernel; NaN rows where the branch does not exist)."""
     q = np.empty((pose.shape[0], robot.n_joints))
+    assert red.kernel is not None  # callers check red.uses_kernel
     _configurations(
-        red.kernel_id,
-        np.ascontiguousarray(red.kernel_params(chain)),
-        np.ascontiguousarray(chain),
+        first_class(red.kernel[1]),
+        np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
         pose.astype(np.int64),
         theta.astype(np.float64),
         branch.astype(np.int64),

@@ -7,8 +7,10 @@ noise-level clusters. Poses run in parallel threads (``prange``).
 Why: the NumPy engine spends most of its time in Python-level bookkeeping of small arrays; per pose the
 search is a few hundred scalar residual evaluations, which compiled code does in microseconds.
 
-A kernel is ``residual(params, theta, branch) -> float`` compiled with ``numba.njit``, where ``params`` is
-one row of ``Reduction.kernel_params(poses)``. The kernel is selected by ``Reduction.kernel_id``.
+A kernel is ``residual(params, theta, branch) -> float`` compiled with ``numba.njit`` to the signature
+``reductions.kernels.RESIDUAL_SIG``, where ``params`` is one row of ``Reduction.kernel_params(poses)``; the
+engine takes it as a first-class function (``Reduction.kernel[0]``), so one compiled engine serves every
+reduction.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import sweep as _ref
-from .reductions.kernels import residual_by_id
+from .reductions.kernels import first_class
 from .robot import Robot
 
 try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
@@ -65,11 +67,7 @@ _U_EDGE = _ref._U_EDGE
 if AVAILABLE:
 
     @njit(cache=True)
-    def _res(kid, p, x, b):
-        return residual_by_id(kid, p, x, b)
-
-    @njit(cache=True)
-    def _root(kid, p, b, a, c, fa, fc, xtol):
+    def _root(res, p, b, a, c, fa, fc, xtol):
         """Chandrupatla's bracketed root finder (scalar), as rootfind.find_roots."""
         eps = 2.220446049250313e-16
         x = a if abs(fa) < abs(fc) else c
@@ -82,7 +80,7 @@ if AVAILABLE:
         t = 0.5
         for _ in range(100):
             xt = a + t * (bb - a)
-            ft = _res(kid, p, xt, b)
+            ft = res(p, xt, b)
             if math.isnan(ft):
                 return x
             if (ft > 0) == (fa > 0):
@@ -115,15 +113,15 @@ if AVAILABLE:
         return x
 
     @njit(cache=True)
-    def _small(kid, p, x, b, noise):
-        f = _res(kid, p, x, b)
+    def _small(res, p, x, b, noise):
+        f = res(p, x, b)
         return (not math.isnan(f)) and abs(f) <= noise
 
     @njit(cache=True)
-    def _center_flat(kid, p, x, b, noise, span):
+    def _center_flat(res, p, x, b, noise, span):
         """As sweep._Search._center_flat, for one root: (centre, lo, hi, is a family)."""
         d0 = FLAT_PROBE_REL * span
-        if not (_small(kid, p, x - d0, b, noise) or _small(kid, p, x + d0, b, noise)):
+        if not (_small(res, p, x - d0, b, noise) or _small(res, p, x + d0, b, noise)):
             return x, x, x, False
         limit = FLAT_MAX_REL * span
         reach = np.zeros(2)
@@ -131,23 +129,23 @@ if AVAILABLE:
         for side in range(2):
             sgn = -1.0 if side == 0 else 1.0
             inner, outer = 0.0, d0
-            if _small(kid, p, x + sgn * outer, b, noise):
+            if _small(res, p, x + sgn * outer, b, noise):
                 for _ in range(64):
                     inner = outer
                     if inner >= limit:
                         break
                     outer = min(2.0 * outer, limit)
-                    if not _small(kid, p, x + sgn * outer, b, noise):
+                    if not _small(res, p, x + sgn * outer, b, noise):
                         break
             at_limit = inner >= limit
             for _ in range(FLAT_BISECT):
                 mid = 0.5 * (inner + outer)
-                if _small(kid, p, x + sgn * mid, b, noise):
+                if _small(res, p, x + sgn * mid, b, noise):
                     inner = mid
                 else:
                     outer = mid
-            past = abs(_res(kid, p, x + sgn * outer, b))
-            far = abs(_res(kid, p, x + 2.0 * sgn * outer, b))
+            past = abs(res(p, x + sgn * outer, b))
+            far = abs(res(p, x + 2.0 * sgn * outer, b))
             if at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise:
                 n_open += 1
             reach[side] = inner
@@ -156,7 +154,7 @@ if AVAILABLE:
         return 0.5 * (lo + hi), lo, hi, family
 
     @njit(cache=True)
-    def _multiplicity(kid, p, x, b, noise, span):
+    def _multiplicity(res, p, x, b, noise, span):
         """As sweep._Search._multiplicity, for one root."""
         level = MULT_LEVEL * noise
         limit = FLAT_MAX_REL * span
@@ -164,13 +162,13 @@ if AVAILABLE:
         for side in range(2):
             sgn = -1.0 if side == 0 else 1.0
             d = FLAT_PROBE_REL * span
-            f1 = abs(_res(kid, p, x + sgn * d, b))
+            f1 = abs(res(p, x + sgn * d, b))
             for _ in range(64):
                 if not (f1 < level and d < limit):
                     break
                 d *= 2.0
-                f1 = abs(_res(kid, p, x + sgn * d, b))
-            f2 = abs(_res(kid, p, x + 2.0 * sgn * d, b))
+                f1 = abs(res(p, x + sgn * d, b))
+            f2 = abs(res(p, x + 2.0 * sgn * d, b))
             if f1 >= level and f2 > 0.0 and not math.isnan(f2) and not math.isinf(f2):
                 total += math.log2(f2 / f1)
                 count += 1
@@ -178,10 +176,10 @@ if AVAILABLE:
         return int(min(max(round(m), 1), MULT_MAX))
 
     @njit(cache=True)
-    def _extend(kid, p, b, inside, outside):
+    def _extend(res, p, b, inside, outside):
         for _ in range(FAMILY_BISECT):
             mid = 0.5 * (inside + outside)
-            f = _res(kid, p, mid, b)
+            f = res(p, mid, b)
             if (not math.isnan(f)) and abs(f) <= FAMILY_TOL:
                 inside = mid
             else:
@@ -196,7 +194,7 @@ if AVAILABLE:
         cnt[0] += 1
 
     @njit(cache=True)
-    def _extremum(kid, p, b, ta, tc, tb, fa, fc, fb, span, noise, xtol, out_t, out_b, cnt):
+    def _extremum(res, p, b, ta, tc, tb, fa, fc, fb, span, noise, xtol, out_t, out_b, cnt):
         xe = tc
         lo, hi = ta, tb
         for level in range(DIFF_LEVELS):  # as sweep._Search._extrema
@@ -206,28 +204,28 @@ if AVAILABLE:
             a, c = lo + h, hi - h
             if not a < c:
                 break
-            ga = _res(kid, p, a + h, b) - _res(kid, p, a - h, b)
-            gc = _res(kid, p, c + h, b) - _res(kid, p, c - h, b)
+            ga = res(p, a + h, b) - res(p, a - h, b)
+            gc = res(p, c + h, b) - res(p, c - h, b)
             if not ga * gc < 0:
                 break
             # root of the central difference g(x) = f(x + h) - f(x - h)
-            xe = _root_diff(kid, p, b, a, c, ga, gc, h)
-        fx = _res(kid, p, xe, b)
+            xe = _root_diff(res, p, b, a, c, ga, gc, h)
+        fx = res(p, xe, b)
         if math.isnan(fx):
             return
         s = 1.0 if fc > 0 else -1.0
         if s * fx < -noise:
-            _push(out_t, out_b, cnt, _root(kid, p, b, ta, xe, fa, fx, xtol), b)
-            _push(out_t, out_b, cnt, _root(kid, p, b, xe, tb, fx, fb, xtol), b)
+            _push(out_t, out_b, cnt, _root(res, p, b, ta, xe, fa, fx, xtol), b)
+            _push(out_t, out_b, cnt, _root(res, p, b, xe, tb, fx, fb, xtol), b)
         else:
             _push(out_t, out_b, cnt, xe, b)
 
     @njit(cache=True)
-    def _g(kid, p, x, b, h):
-        return _res(kid, p, x + h, b) - _res(kid, p, x - h, b)
+    def _g(res, p, x, b, h):
+        return res(p, x + h, b) - res(p, x - h, b)
 
     @njit(cache=True)
-    def _root_diff(kid, p, b, a, c, ga, gc, h):
+    def _root_diff(res, p, b, a, c, ga, gc, h):
         """Root of the central difference between a and c (Illinois-safeguarded bisection)."""
         xtol = 1e-3 * h
         fa, fc = ga, gc
@@ -239,7 +237,7 @@ if AVAILABLE:
             x = (a * fc - c * fa) / (fc - fa) if fc != fa else 0.5 * (a + c)
             if not (a < x < c):
                 x = 0.5 * (a + c)
-            fx = _g(kid, p, x, b, h)
+            fx = _g(res, p, x, b, h)
             if fx != fx:
                 break
             if fx == 0.0:
@@ -258,7 +256,7 @@ if AVAILABLE:
 
     @njit(cache=True)
     def _scan(
-        kid, p, b, th, f, level, el, er, ctx, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top
+        res, p, b, th, f, level, el, er, ctx, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top
     ):
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
         hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, as in sweep._Search.scan."""
@@ -282,7 +280,7 @@ if AVAILABLE:
             ddj = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr)
             may_touch = abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2
             if abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0 and may_touch:
-                _extremum(kid, p, b, tm, th[j], tp, fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
+                _extremum(res, p, b, tm, th[j], tp, fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
         for j in range(M):  # samples next to a domain edge (or at the range ends, level 0)
             if not valid[j]:
                 continue
@@ -330,7 +328,7 @@ if AVAILABLE:
                 stk_f[k0, 0] = f[j]
                 stk_f[k0, SUB + 1] = f[j + 1]
                 for k in range(1, SUB + 1):
-                    stk_f[k0, k] = _res(kid, p, stk_t[k0, k], b)
+                    stk_f[k0, k] = res(p, stk_t[k0, k], b)
                 stk_i[k0, 0] = level + 1
                 stk_i[k0, 1] = 1 if open_l else 0
                 stk_i[k0, 2] = 1 if open_r else 0
@@ -344,13 +342,13 @@ if AVAILABLE:
                     stk_c[k0, 2], stk_c[k0, 3] = ctx[2], ctx[3]
                 top[0] += 1
             elif prod < 0:
-                _push(out_t, out_b, cnt, _root(kid, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
+                _push(out_t, out_b, cnt, _root(res, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
 
     _U_UNIFORM_ARR = _U_UNIFORM.copy()
     _U_EDGE_ARR = _U_EDGE.copy()
 
     @njit(cache=True)
-    def _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
+    def _search_pose(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
         M = grid.shape[1]
         if True:
             p = params[i]
@@ -365,7 +363,7 @@ if AVAILABLE:
             for b in range(n_branches):
                 f = np.empty(M)
                 for j in range(M):
-                    f[j] = _res(kid, p, th[j], b)
+                    f[j] = res(p, th[j], b)
                 # families: runs of vanishing samples
                 j = 0
                 while j < M:
@@ -377,9 +375,9 @@ if AVAILABLE:
                             if fcnt[i] < fam.shape[1]:
                                 lo, hi = th[j], th[k]
                                 if j > 0:
-                                    lo = _extend(kid, p, b, lo, th[j - 1])
+                                    lo = _extend(res, p, b, lo, th[j - 1])
                                 if k + 1 < M:
-                                    hi = _extend(kid, p, b, hi, th[k + 1])
+                                    hi = _extend(res, p, b, hi, th[k + 1])
                                 fam[i, fcnt[i], 0] = lo
                                 fam[i, fcnt[i], 1] = hi
                                 fam[i, fcnt[i], 2] = b
@@ -394,7 +392,7 @@ if AVAILABLE:
                 # the sequence itself, then the resampled intervals it (and they) push on the stack
                 seq_t, seq_f, level, el, er, ctx = th, f, 0, False, False, no_ctx
                 while True:
-                    _scan(kid, p, b, seq_t, seq_f, level, el, er, ctx, span[i], noise, xtol, out_t[i], out_b[i], c,
+                    _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, span[i], noise, xtol, out_t[i], out_b[i], c,
                           stk_t, stk_f, stk_i, stk_c, top)  # fmt: skip
                     if top[0] == 0:
                         break
@@ -406,7 +404,7 @@ if AVAILABLE:
             n0 = min(c[0], out_t.shape[1])
             w0 = 0
             for k in range(n0):
-                x, lo, hi, family = _center_flat(kid, p, out_t[i, k], out_b[i, k], noise, span[i])
+                x, lo, hi, family = _center_flat(res, p, out_t[i, k], out_b[i, k], noise, span[i])
                 if family:
                     if fcnt[i] < fam.shape[1]:
                         fam[i, fcnt[i], 0] = lo
@@ -436,7 +434,7 @@ if AVAILABLE:
                     while (
                         e + 1 < n
                         and bs[e + 1] == bs[s]
-                        and (ts[e + 1] == ts[e] or abs(_res(kid, p, 0.5 * (ts[e] + ts[e + 1]), bs[s])) <= noise)
+                        and (ts[e + 1] == ts[e] or abs(res(p, 0.5 * (ts[e] + ts[e + 1]), bs[s])) <= noise)
                     ):
                         e += 1
                     out_t[i, w] = 0.5 * (ts[s] + ts[e])  # a cluster is one root (families were set apart)
@@ -445,17 +443,38 @@ if AVAILABLE:
                     s = e + 1
                 cnt[i] = w if c[0] <= out_t.shape[1] else c[0]
             for k in range(min(cnt[i], out_t.shape[1])):
-                out_m[i, k] = _multiplicity(kid, p, out_t[i, k], out_b[i, k], noise, span[i])
+                out_m[i, k] = _multiplicity(res, p, out_t[i, k], out_b[i, k], noise, span[i])
 
-    @njit(cache=True, parallel=True)
-    def _search_parallel(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
+    from numba import float64, int64, types
+
+    from .reductions.kernels import RESIDUAL_SIG
+
+    #: The engine's entry signature: the residual is a first-class function, so the engine is compiled once
+    #: (and cached) for every reduction.
+    _SEARCH_SIG = (
+        types.FunctionType(RESIDUAL_SIG),
+        float64[:, ::1],
+        float64[:, ::1],
+        int64,
+        float64[::1],
+        float64,
+        float64[:, ::1],
+        int64[:, ::1],
+        int64[:, ::1],
+        int64[::1],
+        float64[:, :, ::1],
+        int64[::1],
+    )
+
+    @njit(_SEARCH_SIG, cache=True, parallel=True)
+    def _search_parallel(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in prange(grid.shape[0]):
-            _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
+            _search_pose(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
 
-    @njit(cache=True)
-    def _search_serial(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
+    @njit(_SEARCH_SIG, cache=True)
+    def _search_serial(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in range(grid.shape[0]):
-            _search_pose(kid, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
+            _search_pose(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
 
 
 def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
@@ -474,11 +493,11 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
     # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
     run = _search_parallel if N >= PARALLEL_MIN else _search_serial
     run(
-        reduction.kernel_id,
+        first_class(reduction.kernel[0]),
         params,
         np.ascontiguousarray(theta),
-        reduction.n_branches,
-        span,
+        int(reduction.n_branches),
+        np.ascontiguousarray(span, dtype=np.float64),
         float(reduction.residual_noise),
         out_t,
         out_b,

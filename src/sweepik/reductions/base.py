@@ -23,6 +23,7 @@ See docs/reductions.md for a complete example.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,23 +54,24 @@ class Reduction(ABC):
     #: (``degenerate``: e.g. a continuum along a joint other than theta*) or where its closed form is
     #: ill-conditioned (a candidate that even a Newton polish cannot certify); its solutions are merged in.
     fallback: str | None = None
-    #: Id of a compiled scalar residual in ``reductions.kernels`` (None: the NumPy engine is used).
-    kernel_id: int | None = None
+    #: Compiled scalar kernels ``(residual, configuration)`` with the signatures ``reductions.kernels.RESIDUAL_SIG``
+    #: and ``CONFIGURATION_SIG`` over rows of ``kernel_params(poses)`` (None: the NumPy engine is used).
+    kernel: tuple[Any, Any] | None = None
 
     @property
     def uses_kernel(self) -> bool:
-        """The compiled kernel computes this reduction's residual: it has a ``kernel_id``, and no subclass below
-        the class that set it overrides ``residual``, ``solve_rest`` or ``kernel_params`` (a subclass that
-        changes the residual in Python must not silently run its parent's compiled kernel)."""
-        if self.kernel_id is None:
+        """The compiled kernel computes this reduction's residual: it has a ``kernel``, and no subclass below the
+        class that set it overrides ``residual`` or ``solve_rest`` (a subclass that changes the residual in
+        Python must not silently run its parent's compiled kernel)."""
+        if self.kernel is None:
             return False
         mro = type(self).__mro__
-        owner = next(c for c in mro if "kernel_id" in vars(c))
+        owner = next(c for c in mro if "kernel" in vars(c))
         below = mro[: mro.index(owner)]
-        return not any(name in vars(c) for c in below for name in ("residual", "solve_rest", "kernel_params"))
+        return not any(name in vars(c) for c in below for name in ("residual", "solve_rest"))
 
     def kernel_params(self, poses: Array) -> Array:
-        """Per-pose parameters ``(N, P)`` of the compiled residual kernel (only with ``kernel_id``)."""
+        """Per-pose parameters ``(N, P)`` of the compiled kernels (only with ``kernel``)."""
         raise NotImplementedError
 
     def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:

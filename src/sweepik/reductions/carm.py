@@ -81,13 +81,14 @@ class _CArmBase(Reduction):
         self.px_snap = PX_SNAP_REL * (self.L1 + self.L2)
 
     def kernel_params(self, poses: Array) -> Array:
-        """``(N, 8)``: Px, Py, Pz, zx, zy, zz, L1, L2 for the compiled residual (reductions/kernels.py)."""
+        """``(N, 17)``: Px, Py, Pz, z (3), L1, L2, R (9, row-major) for the compiled kernels (reductions/kernels.py)."""
         N = poses.shape[0]
-        out = np.empty((N, 8))
+        out = np.empty((N, kernels.N_PARAMS))
         out[:, 0:3] = poses[:, :3, 3]
         out[:, 0] = np.where(np.abs(out[:, 0]) <= self.px_snap, 0.0, out[:, 0])
         out[:, 3:6] = poses[:, :3, 2]
         out[:, 6], out[:, 7] = self.L1, self.L2
+        out[:, 8:17] = poses[:, :3, :3].reshape(N, 9)
         return out
 
     def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
@@ -164,7 +165,7 @@ class CArmD1(_CArmBase):
     """
 
     name = "carm-d1"
-    kernel_id = kernels.CARM_D1
+    kernel = (kernels.carm_d1_residual, kernels.carm_d1_configuration)
     fallback = "carm-theta2"
     blind_spots = "d1 = Pz with Px = 0 (wrist on joint 2's axis): solved separately as a special slice"
 
@@ -264,7 +265,7 @@ class CArmTheta2(_CArmBase):
     """
 
     name = "carm-theta2"
-    kernel_id = kernels.CARM_THETA2
+    kernel = (kernels.carm_theta2_residual, kernels.carm_theta2_configuration)
     fallback = "carm-d1"
     blind_spots = "cos(theta2) = 0 (d1 drops out): solved separately as a special slice; families need carm-d1"
 

@@ -1,7 +1,10 @@
-"""Scalar residual kernels of the bundled reductions, compiled with Numba for :mod:`sweepik.fastsweep`.
+"""Scalar kernels of the C-Arm reductions, compiled with Numba for the generic engine (:mod:`sweepik.fastsweep`).
 
-Each kernel computes exactly what the reduction's vectorised ``residual`` computes, for one pose (its
-``kernel_params`` row), one theta* and one branch. ``residual_by_id`` dispatches on ``Reduction.kernel_id``.
+A reduction's kernel is a pair of compiled functions with fixed signatures (``RESIDUAL_SIG``,
+``CONFIGURATION_SIG``): ``residual(params, theta, branch) -> float`` and ``configuration(params, theta, branch,
+out)``, where ``params`` is one row of ``Reduction.kernel_params(poses)``. The engine receives them as
+first-class functions, so it is compiled once for every reduction. These two compute exactly what
+``CArmD1``/``CArmTheta2`` compute vectorised (``residual``, ``solve_rest``), for one pose, theta* and branch.
 """
 
 from __future__ import annotations
@@ -18,9 +21,8 @@ except ImportError:  # pragma: no cover - without numba the NumPy engine is used
 #: Same as carm.DISC_TOL (kept here so that this module has no import cycle with carm.py).
 DISC_TOL = 1e-12
 
-#: Kernel ids (Reduction.kernel_id).
-CARM_D1 = 0
-CARM_THETA2 = 1
+#: Row layout of ``kernel_params`` for both C-Arm reductions: Px, Py, Pz, z (3), L1, L2, R (9, row-major).
+N_PARAMS = 17
 
 
 def _elbow(u: float, Py: float, eps: float, L1: float, L2: float) -> tuple[float, float]:
@@ -67,28 +69,53 @@ def _carm_theta2(p, th2: float, b: int) -> float:
     return _elbow_residual(c2, s2, Px / c2, Py, zx, zy, zz, eps, L1, L2)
 
 
-def _dispatch(kid: int, p, x: float, b: int) -> float:
-    if kid == CARM_D1:
-        return _carm_d1(p, x, b)
-    return _carm_theta2(p, x, b)
-
-
 if _njit is not None:
+    from numba import float64, int64, void
+
+    RESIDUAL_SIG = float64(float64[::1], float64, int64)
+    CONFIGURATION_SIG = void(float64[::1], float64, int64, float64[::1])
     _elbow = _njit(cache=True)(_elbow)
     _d1_position = _njit(cache=True)(_d1_position)
     _elbow_residual = _njit(cache=True)(_elbow_residual)
-    _carm_d1 = _njit(cache=True)(_carm_d1)
-    _carm_theta2 = _njit(cache=True)(_carm_theta2)
-    residual_by_id = _njit(cache=True)(_dispatch)
+    carm_d1_residual = _njit(RESIDUAL_SIG, cache=True)(_carm_d1)
+    carm_theta2_residual = _njit(RESIDUAL_SIG, cache=True)(_carm_theta2)
 else:  # pragma: no cover
-    residual_by_id = _dispatch
+    carm_d1_residual, carm_theta2_residual = _carm_d1, _carm_theta2
 
 
-def _carm_configuration(kid: int, p, R, x: float, b: int, out) -> None:
-    """Full configuration of branch ``b`` at theta* = ``x`` into ``out (6,)`` (NaN where the branch does not
-    exist), as CArmD1/CArmTheta2.solve_rest; ``R`` is the chain pose's rotation (3, 3)."""
+_FIRST_CLASS: dict[Any, Any] = {}
+
+
+def first_class(fn: Any) -> Any:
+    """``fn`` (compiled with exactly one explicit signature) as a first-class function object for the engine.
+
+    Numba types a dispatcher argument anew on every call (~50 us); an object following its wrapper address
+    protocol costs a third of that. One object per function, cached.
+    """
+    wap = _FIRST_CLASS.get(fn)
+    if wap is None:
+        from numba import types
+
+        (sig,) = fn.nopython_signatures
+        cres = fn.overloads[sig.args]
+        address = cres.library.get_pointer_to_function(cres.fndesc.llvm_cfunc_wrapper_name)
+
+        class _Kernel(types.WrapperAddressProtocol):
+            def __wrapper_address__(self) -> int:
+                return int(address)
+
+            def signature(self) -> Any:
+                return sig
+
+        wap = _FIRST_CLASS[fn] = _Kernel()
+    return wap
+
+
+def _carm_configuration(p, x: float, b: int, out, rail: bool) -> None:
+    """Full configuration of branch ``b`` at theta* = ``x`` (d1 if ``rail`` else theta2) into ``out (6,)`` (NaN
+    where the branch does not exist), as CArmD1/CArmTheta2.solve_rest."""
     Px, Py, Pz, L1, L2 = p[0], p[1], p[2], p[6], p[7]
-    if kid == CARM_D1:
+    if rail:
         d1 = x
         c2, s2, u, eps = _d1_position(Px, Pz, d1, b)
     else:
@@ -108,10 +135,10 @@ def _carm_configuration(kid: int, p, R, x: float, b: int, out) -> None:
     th3 = math.atan2(u - L2 * c34, L2 * s34 - Py)
     th4 = math.atan2(s34, c34) - th3
     th4 = math.pi - ((math.pi - th4) % (2.0 * math.pi))
-    # V = R_B2^T R_D rows, N = R_24^T V
-    v0 = (c2 * R[0, 0] + s2 * R[2, 0], c2 * R[0, 1] + s2 * R[2, 1], c2 * R[0, 2] + s2 * R[2, 2])
-    v1z = -s2 * R[0, 2] + c2 * R[2, 2]
-    v2 = (-R[1, 0], -R[1, 1], -R[1, 2])
+    # V = R_B2^T R_D rows, N = R_24^T V; R = p[8:17] row-major
+    v0 = (c2 * p[8] + s2 * p[14], c2 * p[9] + s2 * p[15], c2 * p[10] + s2 * p[16])
+    v1z = -s2 * p[10] + c2 * p[16]
+    v2 = (-p[11], -p[12], -p[13])
     n0z = s34 * v0[2] + c34 * v2[2]
     n1x = c34 * v0[0] - s34 * v2[0]
     n1y = c34 * v0[1] - s34 * v2[1]
@@ -123,7 +150,17 @@ def _carm_configuration(kid: int, p, R, x: float, b: int, out) -> None:
     out[5] = math.atan2(n1x, n1y)
 
 
+def _carm_d1_configuration(p, x: float, b: int, out) -> None:
+    _carm_configuration(p, x, b, out, True)
+
+
+def _carm_theta2_configuration(p, x: float, b: int, out) -> None:
+    _carm_configuration(p, x, b, out, False)
+
+
 if _njit is not None:
-    configuration_by_id = _njit(cache=True)(_carm_configuration)
+    _carm_configuration = _njit(cache=True)(_carm_configuration)
+    carm_d1_configuration = _njit(CONFIGURATION_SIG, cache=True)(_carm_d1_configuration)
+    carm_theta2_configuration = _njit(CONFIGURATION_SIG, cache=True)(_carm_theta2_configuration)
 else:  # pragma: no cover
-    configuration_by_id = _carm_configuration
+    carm_d1_configuration, carm_theta2_configuration = _carm_d1_configuration, _carm_theta2_configuration
