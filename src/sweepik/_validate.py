@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import InvalidPoseError, NonFiniteError, ShapeError
+from .errors import InvalidPoseError, NonFiniteError, ShapeError, UnknownOptionError
 
 #: Largest deviation of R^T R from I (and of det R from 1) accepted for a pose's rotation.
 #: 1e-6 admits poses typed with 7 significant digits and rejects anything that is not a rotation.
@@ -13,12 +15,31 @@ ORTHONORMAL_TOL = 1e-6
 
 
 def as_float_array(x: ArrayLike, what: str) -> NDArray[np.float64]:
-    """Convert ``x`` to a float64 array or raise ShapeError naming ``what``."""
+    """Convert ``x`` to a float64 array or raise ShapeError naming ``what`` (complex values are refused, not cast)."""
+    if np.iscomplexobj(x):
+        raise ShapeError(f"{what} must be real, got complex values")
     try:
         arr = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ShapeError(f"{what} must be numeric, got {type(x).__name__}: {exc}") from None
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ShapeError(f"{what} must be numeric, got {type(x).__name__}: {str(exc)[:120]}") from None
     return arr
+
+
+def check_int(value: object, what: str, lo: int, hi: int) -> int:
+    """``value`` as an int in [lo, hi]; bools, floats (even 64.0), NaN and strings are refused."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise UnknownOptionError(f"{what} must be an integer in [{lo}, {hi}], got {value!r}")
+    v = int(value)
+    if not lo <= v <= hi:
+        raise UnknownOptionError(f"{what} must be an integer in [{lo}, {hi}], got {v}")
+    return v
+
+
+def check_bool(value: object, what: str) -> bool:
+    """``value`` as a bool; only True/False (and NumPy bools) are accepted, not 'no', 0 or None."""
+    if not isinstance(value, bool | np.bool_):
+        raise UnknownOptionError(f"{what} must be True or False, got {value!r}")
+    return bool(value)
 
 
 def check_finite(arr: NDArray[np.float64], what: str) -> None:

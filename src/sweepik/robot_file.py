@@ -49,10 +49,40 @@ def bundled_robots() -> list[str]:
     return sorted(p.name[:-5] for p in files.iterdir() if p.name.endswith(".toml"))
 
 
-def _number(value: Any, where: str, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+#: Robot files larger than this are refused before they are read (a 6-joint arm takes about 1 KiB).
+MAX_ROBOT_FILE_BYTES = 1 << 20
+#: Lengths (a, d, base/tool offsets) beyond this magnitude are refused: no arm in any unit is that large, and
+#: sums and squares of such numbers overflow.
+MAX_LENGTH = 1e12
+
+
+def _number(value: Any, where: str, field: str, bound: float = np.inf) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
         raise RobotFileError(f"{where}: field '{field}' must be a finite number, got {value!r}")
-    return float(value)
+    try:
+        x = float(value)
+    except OverflowError:
+        x = np.inf
+    if not np.isfinite(x) or abs(x) > bound:
+        limit = "" if bound == np.inf else f" of magnitude at most {bound:g}"
+        raise RobotFileError(f"{where}: field '{field}' must be a finite number{limit}, got {_short(value)}")
+    return x
+
+
+def _short(value: Any) -> str:
+    text = (
+        repr(value)
+        if not isinstance(value, int) or abs(value) < 10**30
+        else f"an integer of {len(str(abs(value)))} digits"
+    )
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _text(data: dict[str, Any], key: str, where: str, default: str | None) -> str | None:
+    value = data.get(key, default)
+    if value is not None and not isinstance(value, str):
+        raise RobotFileError(f"{where}: field '{key}' must be a string, got {_short(value)}")
+    return value
 
 
 def _transform(table: Any, where: str) -> np.ndarray:
@@ -66,7 +96,7 @@ def _transform(table: Any, where: str) -> np.ndarray:
         v = table.get(key, [0.0, 0.0, 0.0])
         if not isinstance(v, list) or len(v) != 3:
             raise RobotFileError(f"{where}: field '{key}' must be a list of 3 numbers, got {v!r}")
-        vecs.append([_number(x, where, key) for x in v])
+        vecs.append([_number(x, where, key, MAX_LENGTH if key == "xyz" else np.inf) for x in v])
     return pose_from_xyz_zyz(vecs[0], np.radians(vecs[1]))
 
 
@@ -78,7 +108,7 @@ def robot_from_dict(data: dict[str, Any], source: str = "<dict>") -> Robot:
     joints_raw = data.get("joints")
     if not isinstance(joints_raw, list) or not joints_raw:
         raise RobotFileError(f"{source}: needs at least one [[joints]] table")
-    name = str(data.get("name", Path(source).stem))
+    name = _text(data, "name", source, Path(source).stem) or Path(source).stem
     joints = []
     for i, jd in enumerate(joints_raw):
         label = jd.get("name", f"#{i + 1}") if isinstance(jd, dict) else f"#{i + 1}"
@@ -105,13 +135,13 @@ def robot_from_dict(data: dict[str, Any], source: str = "<dict>") -> Robot:
         joints.append(
             Joint(
                 type=jtype,
-                a=_number(jd.get("a", 0.0), where, "a"),
+                a=_number(jd.get("a", 0.0), where, "a", MAX_LENGTH),
                 alpha=float(np.radians(_number(jd.get("alpha", 0.0), where, "alpha"))),
-                d=_number(jd.get("d", 0.0), where, "d"),
+                d=_number(jd.get("d", 0.0), where, "d", MAX_LENGTH),
                 theta=float(np.radians(_number(jd.get("theta", 0.0), where, "theta"))),
                 lower=float(lo),
                 upper=float(hi),
-                name=str(jd.get("name", f"q{i + 1}")),
+                name=_text(jd, "name", where, f"q{i + 1}") or f"q{i + 1}",
             )
         )
     conv = data.get("dh_convention", "modified")
@@ -123,9 +153,9 @@ def robot_from_dict(data: dict[str, Any], source: str = "<dict>") -> Robot:
         dh_convention=conv,
         T_world_base=_transform(data["base"], f"{source}: [base]") if "base" in data else np.eye(4),
         T_flange_tool=_transform(data["tool"], f"{source}: [tool]") if "tool" in data else np.eye(4),
-        length_unit=str(data.get("length_unit", "mm")),
-        default_reduction=data.get("default_reduction"),
-        description=str(data.get("description", "")),
+        length_unit=_text(data, "length_unit", source, "mm") or "mm",
+        default_reduction=_text(data, "default_reduction", source, None),
+        description=_text(data, "description", source, "") or "",
     )
 
 
@@ -148,10 +178,18 @@ def load_robot(name_or_path: str | Path | Robot) -> Robot:
             raise UnknownRobotError(f"robot file {text_name!r} does not exist; bundled robots: {', '.join(bundled)}")
         if not path.is_file():
             raise RobotFileError(f"{text_name}: is not a file")
+        source = str(path)
         try:
-            raw, source = path.read_text(encoding="utf-8"), str(path)
-        except (OSError, UnicodeDecodeError) as exc:
-            raise RobotFileError(f"{path}: cannot read robot file: {exc}") from None
+            with path.open("rb") as fh:
+                blob = fh.read(MAX_ROBOT_FILE_BYTES + 1)
+        except OSError as exc:
+            raise RobotFileError(f"{path}: cannot read robot file: {exc.strerror or exc}") from None
+        if len(blob) > MAX_ROBOT_FILE_BYTES:
+            raise RobotFileError(f"{path}: larger than {MAX_ROBOT_FILE_BYTES} bytes; not a robot file")
+        try:
+            raw = blob.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise RobotFileError(f"{path}: not UTF-8 text (byte {exc.start}); robot files are TOML") from None
     else:
         raise UnknownRobotError(
             f"unknown robot {text_name!r}: not a bundled robot nor a file; bundled robots: {', '.join(bundled)}"
@@ -160,4 +198,8 @@ def load_robot(name_or_path: str | Path | Robot) -> Robot:
         data = tomllib.loads(raw)
     except tomllib.TOMLDecodeError as exc:
         raise RobotFileError(f"{source}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise RobotFileError(f"{source}: not a robot file: arrays or tables nested too deeply") from None
+    except ValueError:  # an integer beyond Python's int-string conversion limit (4300 digits)
+        raise RobotFileError(f"{source}: not a robot file: a number with thousands of digits") from None
     return robot_from_dict(data, source)

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import fastcertify, fastsweep
-from ._validate import check_poses
+from ._validate import check_bool, check_int, check_poses
 from .errors import ShapeError, UnknownOptionError
 from .families import collapse_continua, families_of, off_families, unique_families
 from .paper_sweep import paper_candidates
@@ -367,6 +367,10 @@ def _errors(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array
     return pose_error_geodesic(T, target, weight), pose_error_paper(T, target, weight)
 
 
+#: Largest ``n_samples`` accepted: a grid that fine costs seconds per pose and finds nothing the default misses.
+MAX_SAMPLES = 100_000
+
+
 def _check_strategy(strategy: str) -> None:
     if strategy not in STRATEGIES:
         raise UnknownOptionError(f"unknown strategy {strategy!r}; choose one of {', '.join(STRATEGIES)}")
@@ -405,8 +409,15 @@ def _solve_checked(
     n_samples: int,
     chunk_size: int = CHUNK,
 ) -> list[Solutions]:
-    if n_samples < 8:
-        raise ShapeError(f"n_samples must be at least 8, got {n_samples}")
+    if not isinstance(robot, Robot):
+        raise UnknownOptionError(f"robot must be a sweepik.Robot (see load_robot), got {type(robot).__name__}")
+    n_samples = check_int(n_samples, "n_samples", 8, MAX_SAMPLES)
+    chunk_size = check_int(chunk_size, "chunk_size", 1, 2**31)
+    limits = check_bool(limits, "limits")
+    if reduction is not None and not isinstance(reduction, str | Reduction):
+        raise UnknownOptionError(
+            f"reduction must be a name, a Reduction instance or None, got {type(reduction).__name__}"
+        )
     red = get_reduction(robot, reduction)
     if red.robot != robot:
         raise UnknownOptionError(
@@ -437,6 +448,11 @@ def solve(
         strategy: ``"precise"`` (every root to full precision, double roots and close roots included) or
             ``"paper"`` (the paper's 10 mm sweep refined to 0.001 mm, J < 1e-5 mm).
         limits: drop solutions outside the joint limits (True) or keep and flag them (False).
+        n_samples: uniform theta* samples before refinement, an integer in [8, ``MAX_SAMPLES``].
+
+    Raises:
+        SweepikError subclasses: a pose that is not a rigid transform (ShapeError, InvalidPoseError,
+        NonFiniteError), an unknown or ill-typed option (UnknownOptionError), a reduction that does not fit.
 
     >>> import numpy as np
     >>> from sweepik import load_robot, solve

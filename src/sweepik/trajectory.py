@@ -186,8 +186,13 @@ def _is_number(text: str) -> bool:
 
 def _read_csv(path: Path) -> Array:
     rows: list[list[float]] = []
-    with path.open(newline="") as fh:
-        lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    try:
+        with path.open(newline="", encoding="utf-8") as fh:
+            lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    except UnicodeDecodeError as exc:
+        raise PoseFileError(f"{path}: not UTF-8 text (byte {exc.start}); pose files are text CSV") from None
+    except OSError as exc:
+        raise PoseFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
     dialect_delim = "," if any("," in ln for ln in lines) else None
     for lineno, line in enumerate(lines, start=1):
         fields = [f.strip() for f in (line.split(dialect_delim) if dialect_delim else line.split())]
@@ -208,17 +213,19 @@ def _read_csv(path: Path) -> Array:
 
 def _read_npy(path: Path) -> Array:
     try:
-        arr = np.load(path, allow_pickle=False)
-    except (ValueError, OSError) as exc:
-        raise PoseFileError(f"{path}: not a readable .npy array ({exc})") from None
-    if not isinstance(arr, np.ndarray) or not np.issubdtype(arr.dtype, np.number):
-        raise PoseFileError(f"{path}: expected a numeric array, got dtype {getattr(arr, 'dtype', type(arr))}")
-    arr = arr.astype(np.float64)
+        # memory-mapped: a header declaring more data than the file holds fails here, before any allocation
+        arr = np.load(path, allow_pickle=False, mmap_mode="r")
+    except (ValueError, OSError, EOFError, MemoryError, OverflowError) as exc:
+        raise PoseFileError(f"{path}: not a readable .npy array ({str(exc)[:200]})") from None
+    if not isinstance(arr, np.ndarray) or not (
+        np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)
+    ):
+        raise PoseFileError(f"{path}: expected a real numeric array, got dtype {getattr(arr, 'dtype', type(arr))}")
     if arr.shape == (4, 4):
         arr = arr[None]
     if arr.ndim != 3 or arr.shape[1:] != (4, 4):
         raise PoseFileError(f"{path}: expected an array of shape (N, 4, 4), got {arr.shape}")
-    return arr
+    return np.array(arr, dtype=np.float64)
 
 
 def _json_item(item: Any, i: int, where: str) -> Array:
@@ -244,9 +251,17 @@ def _json_item(item: Any, i: int, where: str) -> Array:
 
 def _read_json(path: Path) -> Array:
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise PoseFileError(f"{path}: not UTF-8 text (byte {exc.start}); JSON pose files are text") from None
     except json.JSONDecodeError as exc:
         raise PoseFileError(f"{path}: invalid JSON ({exc})") from None
+    except RecursionError:
+        raise PoseFileError(f"{path}: not a pose file: lists nested too deeply") from None
+    except ValueError:  # an integer beyond Python's int-string conversion limit
+        raise PoseFileError(f"{path}: not a pose file: a number with thousands of digits") from None
+    except OSError as exc:
+        raise PoseFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
     if isinstance(data, dict) and "poses" in data:
         data = data["poses"]
     if not isinstance(data, list) or not data:
