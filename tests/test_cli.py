@@ -253,3 +253,24 @@ def test_unreadable_robot_file_is_one_line(capsys: pytest.CaptureFixture[str], t
     code, out, err = run(capsys, "fk", str(f), "0")
     assert code in (1, 2) and out == ""
     assert len(err.splitlines()) == 1 and err.startswith("sweepik: error:")
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["verify", "--seed", "-1"],
+        ["verify", "--offgrid", "-5"],
+        ["solve", "carm", "--xyz", "500", "0", "500", "--zyz", "0", "0", "0", "0"],
+        ["path", "carm"],
+        ["path", "carm", "poses.csv", "-o", "/nonexistent-dir/out.csv"],
+        ["verify", "--json", "/nonexistent-dir/r.json"],
+        ["verify", "--report", "/nonexistent-dir/sub/report"],
+    ],
+)
+def test_cli_refuses_at_once(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """Bad options and unwritable outputs fail before any computation: one stderr line, exit status 2."""
+    from sweepik.cli import main
+
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err

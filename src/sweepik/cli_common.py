@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -171,3 +173,31 @@ def _verbose_parent() -> argparse.ArgumentParser:
 # --------------------------------------------------------------------------------------------------
 # fk
 # --------------------------------------------------------------------------------------------------
+
+
+def _nonnegative_int(text: str) -> int:
+    """argparse type: an integer >= 0 (a seed, a count)."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {text!r}") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {v}")
+    return v
+
+
+def _check_output_path(path: str, directory: bool = False) -> None:
+    """Fail before any computation if ``path`` (a file, or a directory to create with ``directory``) cannot be
+    written: its parent must be an existing writable directory; a file path must not be a directory."""
+    p = Path(path)
+    parent = p.parent if str(p.parent) else Path(".")
+    if directory and p.is_dir():
+        parent = p
+    elif p.is_dir():
+        raise CliInputError(f"{path}: is a directory, expected an output file")
+    elif directory and p.exists():
+        raise CliInputError(f"{path}: exists and is not a directory")
+    if not parent.is_dir():
+        raise CliInputError(f"{path}: cannot write there: directory {str(parent)!r} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise CliInputError(f"{path}: cannot write there: directory {str(parent)!r} is not writable")

@@ -13,8 +13,10 @@ from .cli_common import (
     CliInputError,
     _add_json,
     _add_precision,
+    _check_output_path,
     _config_from_cli,
     _format_table,
+    _is_number,
     _joint_units,
     _parse_numbers,
     _print_json,
@@ -24,7 +26,7 @@ from .cli_common import (
 from .pose import pose_from_xyz_zyz
 from .reductions import REDUCTIONS
 from .robot import Robot
-from .robot_file import load_robot
+from .robot_file import bundled_robots, load_robot
 from .solutions import Solutions
 from .solver import STRATEGIES, solve_many
 
@@ -100,6 +102,11 @@ def _solution_json(robot: Robot, sol: Solutions, nearest: Array | None) -> dict[
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
+    if _is_number(args.robot):
+        raise CliInputError(
+            f"unexpected number {args.robot!r} where the robot goes: --xyz takes 3 numbers, --zyz 3 angles, "
+            "--matrix 16 numbers"
+        )
     robot = load_robot(args.robot)
     poses = _poses_from_args(args)
     nearest = None if args.nearest is None else _config_from_cli(robot, args.nearest, args.rad)
@@ -132,7 +139,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
             if args.no_limits:
                 row.append("yes" if ok else "no")
             rows.append(row)
-        print(f"  {len(sol)} solution(s) ({args.strategy} strategy):")
+        fams = f" and {len(sol.families)} self-motion family(ies)" if sol.families else ""
+        print(f"  {len(sol)} solution(s){fams} ({args.strategy} strategy):")
         if rows:
             print(_format_table(header, rows, indent="  "))
         for f in sol.families:
@@ -171,6 +179,10 @@ def cmd_path(args: argparse.Namespace) -> int:
     if len(args.args) > 2:
         raise CliInputError(f"expected [ROBOT] POSES_FILE, got {len(args.args)} arguments")
     robot_name, path = (DEFAULT_ROBOT, args.args[0]) if len(args.args) == 1 else args.args
+    if len(args.args) == 1 and path in bundled_robots():
+        raise CliInputError(f"path: missing POSES_FILE after robot {path!r} (usage: sweepik path [ROBOT] POSES_FILE)")
+    if args.output:
+        _check_output_path(args.output)
     robot = load_robot(robot_name)
     poses = load_poses(path)
     start = None if args.start is None else _config_from_cli(robot, args.start, args.rad)

@@ -8,7 +8,15 @@ import sys
 import time
 from pathlib import Path
 
-from .cli_common import DEFAULT_ROBOT, _add_json, _print_json, _subparser, _SubParsers
+from .cli_common import (
+    DEFAULT_ROBOT,
+    _add_json,
+    _check_output_path,
+    _nonnegative_int,
+    _print_json,
+    _subparser,
+    _SubParsers,
+)
 from .robot_file import load_robot
 
 #: Show progress only for runs longer than this (seconds), and only on a terminal.
@@ -49,8 +57,10 @@ def add_verify_parser(sub: _SubParsers) -> None:
     )
     p.add_argument("robot", nargs="?", default=DEFAULT_ROBOT, help=f"C-Arm-like robot (default: {DEFAULT_ROBOT})")
     p.add_argument("--strategy", choices=("paper", "precise", "both"), default="both", help="default: both")
-    p.add_argument("--offgrid", type=int, default=2000, metavar="N", help="random off-grid poses (default 2000)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the off-grid poses (default 0)")
+    p.add_argument(
+        "--offgrid", type=_nonnegative_int, default=2000, metavar="N", help="random off-grid poses (default 2000)"
+    )
+    p.add_argument("--seed", type=_nonnegative_int, default=0, help="seed of the off-grid poses (default 0)")
     p.add_argument("--report", metavar="DIR", help="write a Markdown report with PNG figures into DIR")
     p.add_argument("--json", metavar="FILE", help="write the results as JSON to FILE ('-' for standard output)")
 
@@ -59,6 +69,10 @@ def cmd_verify(args: argparse.Namespace) -> int:
     from .verify import format_table, run_verify, write_report
 
     robot = load_robot(args.robot)
+    if args.report:
+        _check_output_path(args.report, directory=True)
+    if args.json and args.json != "-":
+        _check_output_path(args.json)
     result = run_verify(robot, args.strategy, offgrid=args.offgrid, seed=args.seed, progress=_Progress())
     if args.json == "-":
         _print_json(result)
