@@ -24,7 +24,8 @@ class RobotDefinitionError(SweepikError):
 
 
 class RobotFileError(RobotDefinitionError):
-    """A robot file is malformed or incomplete; the message names the file, the joint and the field."""
+    """A robot file is malformed, incomplete, unreadable (a directory, no permission, over 1 MiB, not UTF-8) or
+    out of bounds; the message names the file, and the joint and field where there is one."""
 
 
 class UnknownRobotError(SweepikError, LookupError):
@@ -40,12 +41,15 @@ class NonFiniteError(SweepikError):
 
 
 class InvalidPoseError(SweepikError):
-    """A pose is not a rigid transform (rotation not orthonormal, bottom row not (0, 0, 0, 1))."""
+    """A pose is not a rigid transform (rotation not orthonormal, bottom row not (0, 0, 0, 1)) or lies absurdly
+    far (a translation coordinate beyond ``_validate.MAX_TRANSLATION``, 1e30)."""
 
 
 class UnknownOptionError(SweepikError):
-    """An option takes one of a fixed set of values (strategy, reduction, ...) and got another."""
+    """An option got a value of the wrong type or outside its set or range (strategy, reduction, ``limits``,
+    ``n_samples``, ``chunk_size``, the robot argument)."""
 
 
 class PoseFileError(SweepikError):
-    """A pose file cannot be read: missing, unknown extension, or content not in a supported layout."""
+    """A pose file cannot be read: missing, a directory, unreadable, too large, unknown extension, not UTF-8, or
+    content not in a supported layout; the message names the file."""

@@ -13,10 +13,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import fastcertify, fastsweep
-from ._validate import check_bool, check_int, check_poses
+from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .errors import ShapeError, UnknownOptionError
 from .families import collapse_continua, families_of, off_families, unique_families
-from .paper_sweep import paper_candidates
+from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
 from .polish import polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, get_reduction
@@ -369,11 +369,37 @@ def _errors(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array
 
 #: Largest ``n_samples`` accepted: a grid that fine costs seconds per pose and finds nothing the default misses.
 MAX_SAMPLES = 100_000
+#: Largest ``chunk_size`` accepted (any larger value behaves like this one).
+MAX_CHUNK = 2**31
+#: Pose-samples per chunk (chunk x ``n_samples``): a larger ``n_samples`` runs in smaller chunks, so memory stays
+#: that of the defaults (2048 poses x 64 samples). Chunking does not change results.
+SAMPLE_BUDGET = CHUNK * N_SAMPLES
+#: The paper's strategy sweeps theta* in 10 mm (or 1 degree) steps over its whole range: a range needing more
+#: coarse samples than this (2 km of rail in mm) is refused, as its memory (~2 kB per pose-sample) and time grow
+#: with the range. Chunks are kept to ``PAPER_SAMPLE_BUDGET`` pose-samples (the C-Arm's 201 samples x 2048).
+MAX_PAPER_SAMPLES = 200_000
+PAPER_SAMPLE_BUDGET = CHUNK * 256
 
 
-def _check_strategy(strategy: str) -> None:
-    if strategy not in STRATEGIES:
-        raise UnknownOptionError(f"unknown strategy {strategy!r}; choose one of {', '.join(STRATEGIES)}")
+def _check_strategy(strategy: object) -> str:
+    return check_choice(strategy, "strategy", STRATEGIES)
+
+
+def _paper_samples(robot: Robot, red: Reduction, P: Array, limits: bool) -> int:
+    """Coarse samples per pose of the paper's strategy (the most over ``P``); refused above MAX_PAPER_SAMPLES."""
+    if red.periodic or P.shape[0] == 0:
+        return int(np.ceil(360.0 / COARSE_STEP_DEG)) + 1
+    lo, hi = _theta_range(robot, red, _chain_poses(robot, P), paper_limits=limits)
+    step = COARSE_STEP_MM / mm_per_unit(robot.length_unit)
+    m = float(np.max(hi - lo)) / step + 1.0
+    if m > MAX_PAPER_SAMPLES:
+        name = robot.joint_names[red.free_joint]
+        raise UnknownOptionError(
+            f"strategy 'paper' would sweep {name} over {float(np.max(hi - lo)):.6g} {robot.length_unit} in "
+            f"{COARSE_STEP_MM:g} mm steps ({m:.3g} samples per pose, at most {MAX_PAPER_SAMPLES}); "
+            f"use strategy='precise'"
+        )
+    return int(m)
 
 
 def solve_many(
@@ -388,13 +414,15 @@ def solve_many(
 ) -> list[Solutions]:
     """All IK solutions of each pose in ``poses (N, 4, 4)`` (world frame, robot's length unit).
 
-    Vectorised over poses, samples and branches, in chunks of ``chunk_size`` poses (bounded memory).
-    Results are identical to calling :func:`solve` on each pose.
+    Vectorised over poses, samples and branches, in chunks of at most ``chunk_size`` poses (an integer in
+    [1, ``MAX_CHUNK``]; a large ``n_samples`` or the paper's strategy on a long range use smaller chunks, so that
+    memory stays bounded). Results are identical to calling :func:`solve` on each pose. An empty batch (``[]``
+    or an array ``(0, 4, 4)``) gives ``[]``, after the other arguments are checked. Other arguments and errors:
+    see :func:`solve`.
     """
     _check_strategy(strategy)
-    if np.size(np.asarray(poses, dtype=object) if not isinstance(poses, np.ndarray) else poses) == 0:
-        return []  # an empty batch (e.g. [] or an array (0, 4, 4))
-    P = check_poses(poses, "poses")
+    arr = as_float_array(poses, "poses")
+    P = np.zeros((0, 4, 4)) if arr.size == 0 else check_poses(arr, "poses")
     if P.ndim != 3:
         raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
     return _solve_checked(robot, P, reduction, strategy, limits, n_samples, chunk_size)
@@ -410,10 +438,14 @@ def _solve_checked(
     chunk_size: int = CHUNK,
 ) -> list[Solutions]:
     if not isinstance(robot, Robot):
-        raise UnknownOptionError(f"robot must be a sweepik.Robot (see load_robot), got {type(robot).__name__}")
+        hint = f"; load it with sweepik.load_robot({short_repr(robot, 40)})" if isinstance(robot, str) else ""
+        raise UnknownOptionError(
+            f"robot must be a sweepik.Robot (see load_robot), got {type(robot).__name__} {short_repr(robot, 40)}{hint}"
+        )
     n_samples = check_int(n_samples, "n_samples", 8, MAX_SAMPLES)
-    chunk_size = check_int(chunk_size, "chunk_size", 1, 2**31)
+    chunk_size = check_int(chunk_size, "chunk_size", 1, MAX_CHUNK)
     limits = check_bool(limits, "limits")
+    strategy = _check_strategy(strategy)
     if reduction is not None and not isinstance(reduction, str | Reduction):
         raise UnknownOptionError(
             f"reduction must be a name, a Reduction instance or None, got {type(reduction).__name__}"
@@ -423,6 +455,10 @@ def _solve_checked(
         raise UnknownOptionError(
             f"the reduction {red.name!r} was built for robot {red.robot.name!r}, not for {robot.name!r}"
         )
+    if strategy == "paper":
+        chunk_size = min(chunk_size, max(1, PAPER_SAMPLE_BUDGET // _paper_samples(robot, red, P, limits)))
+    else:
+        chunk_size = min(chunk_size, max(1, SAMPLE_BUDGET // n_samples))
     out: list[Solutions] = []
     for s in range(0, P.shape[0], chunk_size):
         out.extend(_solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples))
@@ -447,12 +483,16 @@ def solve(
             robot's default.
         strategy: ``"precise"`` (every root to full precision, double roots and close roots included) or
             ``"paper"`` (the paper's 10 mm sweep refined to 0.001 mm, J < 1e-5 mm).
-        limits: drop solutions outside the joint limits (True) or keep and flag them (False).
-        n_samples: uniform theta* samples before refinement, an integer in [8, ``MAX_SAMPLES``].
+        limits: drop solutions outside the joint limits (True) or keep and flag them (False); a bool (or NumPy
+            bool), not a string or a number.
+        n_samples: uniform theta* samples before refinement, an integer in [8, ``MAX_SAMPLES``] (100,000;
+            not a bool or a float). The paper's strategy ignores it, and refuses a theta* range needing more
+            than ``MAX_PAPER_SAMPLES`` (200,000) of its 10 mm samples.
 
     Raises:
-        SweepikError subclasses: a pose that is not a rigid transform (ShapeError, InvalidPoseError,
-        NonFiniteError), an unknown or ill-typed option (UnknownOptionError), a reduction that does not fit.
+        SweepikError subclasses: a pose that is not a rigid transform or not real numbers (ShapeError,
+        InvalidPoseError, NonFiniteError), ``robot`` not a :class:`~sweepik.robot.Robot`, an unknown or ill-typed
+        option (UnknownOptionError), a reduction that does not fit.
 
     >>> import numpy as np
     >>> from sweepik import load_robot, solve
@@ -465,5 +505,4 @@ def solve(
     P = check_poses(pose, "pose")
     if P.shape != (4, 4):
         raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
-    _check_strategy(strategy)
     return _solve_checked(robot, P[None], reduction, strategy, limits, n_samples)[0]

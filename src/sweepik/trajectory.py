@@ -15,16 +15,20 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
+import tokenize
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, BinaryIO, Literal
 
 import numpy as np
+from numpy.lib import format as npy_format
 from numpy.typing import ArrayLike, NDArray
 
-from ._validate import check_configuration, check_poses
+from ._validate import as_path, check_configuration, check_poses, decode_text, file_status, read_file_bytes, short_repr
 from .errors import PoseFileError, ShapeError, UnknownOptionError
 from .pose import pose_error_paper, pose_from_xyz_zyz
 from .reductions import Reduction
@@ -165,6 +169,12 @@ _POSE_LAYOUTS = (
     "(Z-Y-Z Euler angles in degrees); NPY: array (N, 4, 4); JSON: a list of 4x4 nested lists or of "
     '{"xyz": [x, y, z], "zyz_deg": [alpha, beta, gamma]} objects'
 )
+#: Text pose files (CSV, JSON) larger than this are refused before they are read: 128 MiB, about 400,000 poses
+#: of 16 numbers (a bigger set fits an .npy file, or call ``solve_many`` on an array).
+MAX_POSE_TEXT_BYTES = 128 << 20
+#: An .npy pose file may hold at most this many poses: 2**23 = 8,388,608 (1 GiB of float64), checked against
+#: the header before any data is read.
+MAX_NPY_POSES = 1 << 23
 
 
 def _poses_from_rows(rows: Array, where: str) -> Array:
@@ -184,84 +194,126 @@ def _is_number(text: str) -> bool:
     return True
 
 
+def _read_text(path: Path, what: str) -> str:
+    return decode_text(
+        read_file_bytes(path, MAX_POSE_TEXT_BYTES, PoseFileError, "pose file"), path, PoseFileError, what
+    )
+
+
 def _read_csv(path: Path) -> Array:
-    rows: list[list[float]] = []
-    try:
-        with path.open(newline="", encoding="utf-8") as fh:
-            lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
-    except UnicodeDecodeError as exc:
-        raise PoseFileError(f"{path}: not UTF-8 text (byte {exc.start}); pose files are text CSV") from None
-    except OSError as exc:
-        raise PoseFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    text = _read_text(path, "CSV pose file")
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     dialect_delim = "," if any("," in ln for ln in lines) else None
+    rows: list[list[float]] = []
     for lineno, line in enumerate(lines, start=1):
         fields = [f.strip() for f in (line.split(dialect_delim) if dialect_delim else line.split())]
         fields = [f for f in fields if f != ""]
-        if lineno == 1 and fields and not all(_is_number(f) for f in fields):
-            continue  # a header row of column names
+        if lineno == 1 and fields and not any(_is_number(f) for f in fields):
+            continue  # a header row of column names (a first row with some numbers is data, checked below)
         try:
             rows.append([float(f) for f in fields])
         except ValueError:
-            raise PoseFileError(f"{path}: data row {lineno} holds a non-numeric field: {line.strip()!r}") from None
+            shown = line.strip() if len(line.strip()) <= 80 else line.strip()[:77] + "..."
+            raise PoseFileError(f"{path}: data row {lineno} holds a non-numeric field: {shown!r}") from None
     if not rows:
         raise PoseFileError(f"{path}: no poses found. Layouts: {_POSE_LAYOUTS}")
     widths = {len(r) for r in rows}
     if len(widths) != 1:
-        raise PoseFileError(f"{path}: rows have different numbers of fields {sorted(widths)}; expected all 16 or all 6")
+        shown_widths = sorted(widths)[:10]
+        raise PoseFileError(f"{path}: rows have different numbers of fields {shown_widths}; expected all 16 or all 6")
     return _poses_from_rows(np.array(rows, dtype=np.float64), str(path))
 
 
-def _read_npy(path: Path) -> Array:
+#: What NumPy's .npy header parser (``ast.literal_eval`` after a ``tokenize`` pass) raises on a malformed header.
+_NPY_HEADER_ERRORS = (ValueError, TypeError, SyntaxError, EOFError, OSError, tokenize.TokenError, RecursionError)
+
+
+def _npy_header(fh: BinaryIO, path: Path) -> tuple[tuple[int, ...], bool, np.dtype[Any]]:
+    """Shape, Fortran order and dtype from an .npy header (bounded: NumPy refuses headers over 10,000 bytes).
+    The parser's warnings on odd headers are silenced: the header is either accepted or refused here."""
     try:
-        # memory-mapped: a header declaring more data than the file holds fails here, before any allocation
-        arr = np.load(path, allow_pickle=False, mmap_mode="r")
-    except (ValueError, OSError, EOFError, MemoryError, OverflowError) as exc:
-        raise PoseFileError(f"{path}: not a readable .npy array ({str(exc)[:200]})") from None
-    if not isinstance(arr, np.ndarray) or not (
-        np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)
-    ):
-        raise PoseFileError(f"{path}: expected a real numeric array, got dtype {getattr(arr, 'dtype', type(arr))}")
-    if arr.shape == (4, 4):
-        arr = arr[None]
-    if arr.ndim != 3 or arr.shape[1:] != (4, 4):
-        raise PoseFileError(f"{path}: expected an array of shape (N, 4, 4), got {arr.shape}")
-    return np.array(arr, dtype=np.float64)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            version = npy_format.read_magic(fh)
+            if version == (1, 0):
+                return npy_format.read_array_header_1_0(fh)
+            if version == (2, 0):
+                return npy_format.read_array_header_2_0(fh)
+    except _NPY_HEADER_ERRORS as exc:
+        raise PoseFileError(f"{path}: not an .npy array file ({type(exc).__name__}: {str(exc)[:160]})") from None
+    raise PoseFileError(f"{path}: .npy format version {version[0]}.{version[1]} is not supported for poses")
+
+
+def _read_npy(path: Path) -> Array:
+    """Poses from an .npy file: the header (magic, dtype, shape) is checked against the file size and the
+    ``MAX_NPY_POSES`` bound before the data is read; pickled objects are never loaded."""
+    try:
+        with path.open("rb") as fh:
+            shape, fortran, dtype = _npy_header(fh, path)
+            if dtype.kind not in "fiu":
+                raise PoseFileError(f"{path}: expected an array of real numbers, got dtype {str(dtype)[:80]}")
+            if shape == (4, 4):
+                shape = (1, 4, 4)
+            if len(shape) != 3 or shape[1:] != (4, 4):
+                raise PoseFileError(f"{path}: expected an array of shape (N, 4, 4), got {shape}")
+            if not 1 <= shape[0] <= MAX_NPY_POSES:
+                raise PoseFileError(f"{path}: holds {shape[0]} poses; a pose file holds 1 to {MAX_NPY_POSES}")
+            needed = shape[0] * 16 * dtype.itemsize
+            available = os.fstat(fh.fileno()).st_size - fh.tell()
+            if available < needed:
+                raise PoseFileError(
+                    f"{path}: truncated: the header declares shape {shape} ({needed} bytes of data), "
+                    f"the file holds {available}"
+                )
+            data = np.fromfile(fh, dtype=dtype, count=shape[0] * 16)
+            if data.size != shape[0] * 16:
+                raise PoseFileError(f"{path}: truncated while reading the data of shape {shape}")
+    except OSError as exc:
+        raise PoseFileError(f"{path}: cannot read pose file: {exc.strerror or exc}") from None
+    order: Literal["C", "F"] = "F" if fortran else "C"
+    return data.reshape(shape, order=order).astype(np.float64, copy=False)
+
+
+def _json_number(value: Any, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise PoseFileError(f"{where}: expected a number, got {short_repr(value, 40)}")
+    try:
+        return float(value)
+    except OverflowError:
+        raise PoseFileError(f"{where}: {short_repr(value)} is beyond the floating-point range") from None
+
+
+def _json_vector(value: Any, n: int, where: str) -> list[float]:
+    if not isinstance(value, list) or len(value) != n:
+        raise PoseFileError(f"{where}: expected a list of {n} numbers, got {short_repr(value, 40)}")
+    return [_json_number(v, where) for v in value]
 
 
 def _json_item(item: Any, i: int, where: str) -> Array:
     if isinstance(item, dict):
         if "xyz" not in item or "zyz_deg" not in item:
-            raise PoseFileError(f"{where}: pose {i} is an object without 'xyz' and 'zyz_deg' keys: {sorted(item)}")
-        try:
-            xyz = np.array(item["xyz"], dtype=np.float64)
-            zyz = np.array(item["zyz_deg"], dtype=np.float64)
-        except (TypeError, ValueError):
-            raise PoseFileError(f"{where}: pose {i}: 'xyz' and 'zyz_deg' must be lists of 3 numbers") from None
-        if xyz.shape != (3,) or zyz.shape != (3,):
-            raise PoseFileError(f"{where}: pose {i}: 'xyz' and 'zyz_deg' must be lists of 3 numbers")
-        return pose_from_xyz_zyz(xyz, np.radians(zyz))
-    try:
-        T = np.array(item, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise PoseFileError(f"{where}: pose {i} is neither a 4x4 list of numbers nor an xyz/zyz_deg object") from None
-    if T.shape != (4, 4):
-        raise PoseFileError(f"{where}: pose {i} must be a 4x4 nested list, got shape {T.shape}")
-    return T
+            keys = short_repr(sorted(item), 80)
+            raise PoseFileError(f"{where}: pose {i} is an object without 'xyz' and 'zyz_deg' keys: {keys}")
+        xyz = _json_vector(item["xyz"], 3, f"{where}: pose {i}: 'xyz'")
+        zyz = _json_vector(item["zyz_deg"], 3, f"{where}: pose {i}: 'zyz_deg'")
+        return pose_from_xyz_zyz(np.array(xyz), np.radians(zyz))
+    if not isinstance(item, list):
+        raise PoseFileError(f"{where}: pose {i} is neither a 4x4 list of numbers nor an xyz/zyz_deg object")
+    if len(item) != 4:
+        raise PoseFileError(f"{where}: pose {i} must be a 4x4 nested list, got {len(item)} rows")
+    return np.array([_json_vector(row, 4, f"{where}: pose {i} row {r}") for r, row in enumerate(item)])
 
 
 def _read_json(path: Path) -> Array:
+    text = _read_text(path, "JSON pose file")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError as exc:
-        raise PoseFileError(f"{path}: not UTF-8 text (byte {exc.start}); JSON pose files are text") from None
+        data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise PoseFileError(f"{path}: invalid JSON ({exc})") from None
     except RecursionError:
         raise PoseFileError(f"{path}: not a pose file: lists nested too deeply") from None
     except ValueError:  # an integer beyond Python's int-string conversion limit
         raise PoseFileError(f"{path}: not a pose file: a number with thousands of digits") from None
-    except OSError as exc:
-        raise PoseFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
     if isinstance(data, dict) and "poses" in data:
         data = data["poses"]
     if not isinstance(data, list) or not data:
@@ -273,25 +325,31 @@ _READERS = {".csv": _read_csv, ".txt": _read_csv, ".npy": _read_npy, ".json": _r
 
 
 def load_poses(path: str | PathLike[str]) -> Array:
-    """Poses ``(N, 4, 4)`` read from a CSV, NPY or JSON file (chosen by extension).
+    """Poses ``(N, 4, 4)``, ``N >= 1``, read from a CSV, NPY or JSON file (chosen by extension).
 
     * CSV (``.csv``, ``.txt``): one pose per row; 16 numbers (a row-major 4x4 matrix) or 6 numbers
       ``x y z alpha beta gamma`` (position in the robot's length unit, Z-Y-Z Euler angles in **degrees**).
-      Separated by commas or whitespace; ``#`` comment lines and one header row of names are skipped.
-    * NPY: an array ``(N, 4, 4)`` (or a single ``(4, 4)``).
-    * JSON: a list (or ``{"poses": [...]}``) of 4x4 nested lists or of
-      ``{"xyz": [x, y, z], "zyz_deg": [alpha, beta, gamma]}`` objects.
+      Separated by commas or whitespace; ``#`` comment lines and one header row of names (a first row with no
+      number in it) are skipped. UTF-8 text (a byte-order mark is allowed).
+    * NPY: a real numeric array ``(N, 4, 4)`` (or a single ``(4, 4)``), ``N <= MAX_NPY_POSES`` (8,388,608);
+      the header is checked against the file size before any data is read, pickled objects are refused.
+    * JSON: a list (or ``{"poses": [...]}``) of 4x4 nested lists of numbers or of
+      ``{"xyz": [x, y, z], "zyz_deg": [alpha, beta, gamma]}`` objects (``true``/``false`` and strings are not
+      numbers). UTF-8 text.
+
+    CSV and JSON files larger than ``MAX_POSE_TEXT_BYTES`` (128 MiB) are refused before they are read.
 
     Raises:
-        PoseFileError: missing file, unknown extension, malformed content.
+        PoseFileError: not a str/path, missing file, a directory or device, unreadable, too large, unknown
+            extension, not UTF-8, malformed content, no pose (messages name the file).
         InvalidPoseError / NonFiniteError: a matrix that is not a rigid transform, NaN or inf values
             (messages name the file).
     """
-    p = Path(path)
+    p = as_path(path, PoseFileError, "pose file")
     reader = _READERS.get(p.suffix.lower())
     if reader is None:
         raise PoseFileError(f"{p}: unknown pose file extension {p.suffix!r}; use one of {', '.join(_READERS)}")
-    if not p.is_file():
+    if file_status(p, PoseFileError, "pose file") is None:
         raise PoseFileError(f"{p}: no such file")
     return check_poses(reader(p), f"{p}: poses")
 
