@@ -124,3 +124,29 @@ def test_save_verification_figures(fig4, traj, tmp_path) -> None:
     for path in written.values():
         assert path.exists() and path.stat().st_size > 1000
     assert plt.get_fignums() == []  # closed after saving
+
+
+def _legend_clear_of_axes(ax) -> None:
+    """The legend lies wholly below the axes (and below the x label of a 2D plot): it hides no data."""
+    fig = ax.get_figure()
+    fig.canvas.draw()
+    leg = ax.get_legend()
+    assert leg is not None
+    lb = leg.get_window_extent()
+    assert lb.y1 <= ax.get_window_extent().y0 + 1e-6
+    if ax.name != "3d":
+        assert lb.y1 <= ax.xaxis.label.get_window_extent().y0 + 1e-6
+
+
+def test_legends_hide_no_data(fig4, traj, tmp_path) -> None:
+    ax = plot_joints_along_path(np.array(traj["q"], dtype=np.float64), CARM)
+    _legend_clear_of_axes(ax)
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [*CARM.joint_names[1:], "d1"]
+    _legend_clear_of_axes(plot_trajectory_3d(traj["xyz"], traj["corners"], traj["achieved_xyz"]))
+    _legend_clear_of_axes(plot_figure4(fig4))
+    # saved figures keep the legend in view (bbox_inches="tight"): the bottom strip of the image, below the x
+    # label, holds the legend's lines and text
+    written = save_verification_figures({"strategy": "precise", "grid": {}, "trajectory": traj}, tmp_path)
+    img = plt.imread(written["trajectory_joints"])[..., :3]
+    bottom = img[int(0.93 * img.shape[0]) :]
+    assert np.any(bottom.min(axis=-1) < 0.5)

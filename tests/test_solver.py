@@ -17,6 +17,7 @@ from sweepik import (
     ShapeError,
     SweepikError,
     UnknownOptionError,
+    iter_solve,
     load_robot,
     solve,
     solve_many,
@@ -222,6 +223,26 @@ def test_solve_many_equals_solve(batch) -> None:  # type: ignore[no-untyped-def]
         single = solve(CARM, T[i])
         np.testing.assert_array_equal(single.q, sols[i].q)
         np.testing.assert_array_equal(single.error, sols[i].error)
+
+
+def test_iter_solve_streams_what_solve_many_returns(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    import sweepik.solver as solver_mod
+
+    T = CARM.fk(np.random.default_rng(11).uniform(CARM.lower, CARM.upper, (9, 6)))
+    ref = solve_many(CARM, T)
+    monkeypatch.setattr(solver_mod, "SAMPLE_BUDGET", 4 * solver_mod.N_SAMPLES)  # chunks of 4 poses
+    calls: list[tuple[str, int, int]] = []
+    it = iter_solve(CARM, T, progress=lambda *a: calls.append(a))
+    assert calls == []  # nothing solved before the first result is asked for
+    got = list(it)
+    assert len(got) == len(ref)
+    for a, b in zip(got, ref, strict=True):
+        np.testing.assert_array_equal(a.q, b.q)
+    assert calls == [("solve", 0, 9), ("solve", 4, 9), ("solve", 8, 9), ("solve", 9, 9)]
+    with pytest.raises(UnknownOptionError):  # bad arguments fail at the call, not at the first next()
+        iter_solve(CARM, T, n_samples=-1)
+    with pytest.raises(UnknownOptionError):
+        iter_solve(CARM, T, progress="yes")  # type: ignore[arg-type]
 
 
 def test_solutions_api() -> None:

@@ -12,7 +12,7 @@ import pytest
 import sweepik.verify as V
 from sweepik import load_robot
 from sweepik.errors import RobotDefinitionError, UnknownOptionError
-from sweepik.solver import solve_many
+from sweepik.solver import iter_solve, solve_many
 
 CARM = load_robot("carm")
 
@@ -120,9 +120,9 @@ def test_missed_configurations_are_reported(monkeypatch) -> None:
     import sweepik.verify as mod
 
     def nothing(robot, poses, **kw):
-        return solve_many(robot, poses + np.array([[0, 0, 0, 1e4], [0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0]]), **kw)
+        return iter_solve(robot, poses + np.array([[0, 0, 0, 1e4], [0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0]]), **kw)
 
-    monkeypatch.setattr(mod, "solve_many", nothing)
+    monkeypatch.setattr(mod, "iter_solve", nothing)
     q = _generic_subset(25)
     res = V.run_grid(CARM, q, "precise")
     assert res["recall"] == 0.0 and res["no_solution"] == 25

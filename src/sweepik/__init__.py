@@ -31,7 +31,7 @@ from .reductions import REDUCTIONS, CArmD1, CArmTheta2, Reduction, get_reduction
 from .robot import Joint, Robot
 from .robot_file import bundled_robots, load_robot, robot_from_dict
 from .solutions import Family, Solutions
-from .solver import STRATEGIES, solve, solve_many
+from .solver import STRATEGIES, iter_solve, solve, solve_many
 
 try:
     __version__ = version("sweepik")
@@ -47,6 +47,7 @@ __all__ = [
     "robot_from_dict",
     "solve",
     "solve_many",
+    "iter_solve",
     "Solutions",
     "Family",
     "STRATEGIES",

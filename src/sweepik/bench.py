@@ -19,8 +19,10 @@ from typing import Any
 import numpy as np
 
 from .robot_file import load_robot
-from .solver import solve, solve_many
+from .solver import Progress, solve, solve_many
 from .verify import grid_configurations, random_configurations
+
+#: ``progress(stage, done, total)``, called as the benchmarks advance (as in :mod:`sweepik.verify`).
 
 #: The paper's figure: 0.098 s per pose in Matlab.
 PAPER_SECONDS_PER_POSE = 0.098
@@ -39,16 +41,22 @@ print(json.dumps({{"peak_rss_mib": peak / 1024, "before_solve_mib": base / 1024,
 """
 
 
-def bench_grid(repeats: int = 3) -> dict[str, Any]:
+def _no_progress(stage: str, done: int, total: int) -> None:
+    pass
+
+
+def bench_grid(repeats: int = 3, progress: Progress = _no_progress) -> dict[str, Any]:
     """(a) Best of ``repeats`` wall times of ``solve_many`` on the 15,900 grid poses (precise)."""
     robot = load_robot("carm")
     poses = robot.fk(grid_configurations(include_singular=False))
+    progress("bench: grid", 0, repeats)
     solve_many(robot, poses[:64])  # warm-up (imports, caches)
     times = []
-    for _ in range(repeats):
+    for r in range(repeats):
         t0 = time.perf_counter()
         solve_many(robot, poses)
         times.append(time.perf_counter() - t0)
+        progress("bench: grid", r + 1, repeats)
     best = min(times)
     return {
         "poses": len(poses),
@@ -58,7 +66,7 @@ def bench_grid(repeats: int = 3) -> dict[str, Any]:
     }
 
 
-def bench_single(count: int = 1000, seed: int = 0) -> dict[str, Any]:
+def bench_single(count: int = 1000, seed: int = 0, progress: Progress = _no_progress) -> dict[str, Any]:
     """(b) Latency of ``solve`` on ``count`` random in-limit poses: median and 95th percentile."""
     robot = load_robot("carm")
     poses = robot.fk(random_configurations(robot, count, np.random.default_rng(seed)))
@@ -68,6 +76,8 @@ def bench_single(count: int = 1000, seed: int = 0) -> dict[str, Any]:
         t0 = time.perf_counter()
         solve(robot, T)
         lat[i] = time.perf_counter() - t0
+        if (i + 1) % 100 == 0 or i + 1 == count:  # the progress call stays out of the timed region
+            progress("bench: single pose", i + 1, count)
     return {"poses": count, "median_us": float(np.median(lat) * 1e6), "p95_us": float(np.percentile(lat, 95) * 1e6)}
 
 
@@ -90,15 +100,28 @@ def bench_memory(count: int = 100_000) -> dict[str, Any]:
     return dict(json.loads(out.stdout.strip().splitlines()[-1]))
 
 
-def run_bench(single: int = 1000, paper: int = 500, memory: int = 100_000, repeats: int = 3) -> dict[str, Any]:
-    """All four benchmarks; sizes can be reduced for a quick look (0 skips a benchmark)."""
-    result: dict[str, Any] = {"grid_precise": bench_grid(repeats)}
+def run_bench(
+    single: int = 1000,
+    paper: int = 500,
+    memory: int = 100_000,
+    repeats: int = 3,
+    progress: Progress | None = None,
+) -> dict[str, Any]:
+    """All four benchmarks; sizes can be reduced for a quick look (0 skips a benchmark). ``progress(stage, done,
+    total)`` is called as they advance (the memory benchmark, one child process, reports only its start and end).
+    """
+    report = progress or _no_progress
+    result: dict[str, Any] = {"grid_precise": bench_grid(repeats, report)}
     if single:
-        result["single_pose"] = bench_single(single)
+        result["single_pose"] = bench_single(single, progress=report)
     if paper:
+        report("bench: paper strategy", 0, 1)
         result["paper_strategy"] = bench_paper(paper)
+        report("bench: paper strategy", 1, 1)
     if memory:
+        report("bench: memory", 0, 1)
         result["memory"] = bench_memory(memory)
+        report("bench: memory", 1, 1)
     return result
 
 

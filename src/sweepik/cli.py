@@ -7,9 +7,11 @@ status), registered in ``_COMMANDS``. To add a subcommand, write the pair and ad
 JSON output) are meant to be shared. Raise a :class:`SweepikError` (e.g. ``CliInputError``) for bad input:
 ``main`` turns it into the one-line error and exit status 2.
 
-Exit status: 0 on success, 2 on bad input (usage errors, bad numbers, any :class:`SweepikError`), 1 when
-a file cannot be read or decoded. Errors print one line ``sweepik: error: <message>`` on stderr, never a
-traceback.
+Exit status: 0 on success, 2 on bad input (usage errors, bad numbers or counts, a value too many after an
+option, an unwritable output path, any :class:`SweepikError`), all detected before any computation; 1 on an
+operating-system error while a file is read or written. Errors print one line ``sweepik: error: <message>`` on
+stderr, never a traceback. Output paths are checked with ``cli_common._check_output_path`` before the work
+starts; long runs report progress through ``cli_common._Progress`` (stderr, terminals only).
 
 >>> main(["fk", "carm", "500", "0", "0", "0", "0", "0", "--json"])  # doctest: +ELLIPSIS
 {
@@ -50,6 +52,7 @@ from .cli_common import (
     _config_from_cli,
     _format_matrix,
     _format_table,
+    _is_number,
     _joint_units,
     _num,
     _print_json,
@@ -255,6 +258,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _unrecognized(parser: argparse.ArgumentParser, command: str, tokens: Sequence[str], extras: Sequence[str]) -> str:
+    """The message for arguments no option took: a number right after an option's fixed count of values is named
+    as a surplus of that option (``--zyz 0 0 0 0``: --zyz takes 3 angles)."""
+    see = f"(see 'sweepik {command} --help')"
+    sub = _subparsers(parser).get(command)
+    fixed = {
+        opt: action
+        for action in (sub._actions if sub is not None else [])
+        for opt in action.option_strings
+        if isinstance(action.nargs, int) and action.nargs > 0
+    }
+    for i, tok in enumerate(tokens):
+        action = fixed.get(tok)
+        if action is None:
+            continue
+        n = int(action.nargs)  # type: ignore[arg-type]
+        after = list(tokens[i + 1 : i + n + 2])
+        if len(after) == n + 1 and all(_is_number(t) for t in after) and after[-1] in extras:
+            names = f" ({' '.join(action.metavar)})" if isinstance(action.metavar, tuple) else ""
+            return f"{tok} takes {n} values{names}, got one more: {after[-1].strip()!r} {see}"
+    return f"unrecognized arguments: {' '.join(t.strip() for t in extras)} {see}"
+
+
+def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    """Subcommand name -> its parser."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
 def _error(message: str) -> None:
     # One line, whatever the message holds.
     print(f"{PROG}: error: {' '.join(str(message).split())}", file=sys.stderr)
@@ -264,10 +298,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``sweepik`` command with ``argv`` (default: ``sys.argv[1:]``); return the exit status."""
     args_in = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
+    tokens = _protect_negative_numbers(args_in)
     try:
-        args = parser.parse_args(_protect_negative_numbers(args_in))
+        args, extras = parser.parse_known_args(tokens)
     except SystemExit as exc:  # --help, --version, usage errors: argparse has printed its message
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else EXIT_USAGE)
+    if extras:
+        _error(_unrecognized(parser, args.command, tokens, extras))
+        return EXIT_USAGE
     if args.verbose:
         logging.basicConfig(level=logging.INFO, format=f"{PROG}: %(message)s")
     _, run = _COMMANDS[args.command]

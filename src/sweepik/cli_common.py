@@ -6,7 +6,9 @@ import argparse
 import json
 import math
 import os
-from collections.abc import Sequence
+import sys
+import time
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -117,11 +119,20 @@ def _format_matrix(M: NDArray[np.float64], decimals: int, indent: str = "  ") ->
     return "\n".join(indent + "  ".join(c.rjust(width) for c in row) for row in cells)
 
 
-def _format_table(header: Sequence[str], rows: Sequence[Sequence[str]], indent: str = "  ") -> str:
-    """Columns padded to equal width; columns holding only numbers are right-aligned."""
+def _format_table(
+    header: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    indent: str = "  ",
+    numeric: Sequence[bool] | None = None,
+) -> str:
+    """Columns padded to equal width; columns holding only numbers are right-aligned. ``numeric`` (one bool per
+    column) says which columns hold only numbers, when the caller knows (it saves parsing every cell)."""
     table = [list(header), *(list(r) for r in rows)]
     widths = [max(len(r[i]) for r in table) for i in range(len(header))]
-    right = [bool(rows) and all(_is_number(r[i]) for r in rows) for i in range(len(header))]
+    if numeric is None:
+        right = [bool(rows) and all(_is_number(r[i]) for r in rows) for i in range(len(header))]
+    else:
+        right = [bool(rows) and bool(v) for v in numeric]
     lines = []
     for r in table:
         cells = [c.rjust(w) if rj else c.ljust(w) for c, w, rj in zip(r, widths, right, strict=True)]
@@ -131,6 +142,29 @@ def _format_table(header: Sequence[str], rows: Sequence[Sequence[str]], indent: 
 
 def _print_json(obj: Any) -> None:
     print(json.dumps(obj, indent=2, allow_nan=False))
+
+
+#: ``json.dumps(..., indent=2)`` of a dict whose last value is an empty list ends with this.
+_EMPTY_LIST_END = "[]\n}"
+
+
+def _print_json_stream(head: dict[str, Any], key: str, items: Iterable[Any]) -> None:
+    """Print ``{**head, key: list(items)}`` byte for byte as :func:`_print_json` would, but one item at a time:
+    the items are encoded and written as they come and never held together, so memory does not grow with
+    their number. ``key`` must not be in ``head`` (it comes last)."""
+    if key in head:
+        raise ValueError(f"{key!r} is already in the JSON header")
+    text = json.dumps({**head, key: []}, indent=2, allow_nan=False)
+    out = sys.stdout
+    out.write(text[: -len(_EMPTY_LIST_END)])
+    first = True
+    for item in items:
+        out.write("[\n" if first else ",\n")
+        # an item sits at depth 2 of the document: json.dumps(indent=2) indents each of its lines by 4 more spaces
+        # (strings are escaped, so every line break is one of the encoder's, and no line is blank)
+        out.write("    " + json.dumps(item, indent=2, allow_nan=False).replace("\n", "\n    "))
+        first = False
+    out.write(_EMPTY_LIST_END + "\n" if first else "\n  ]\n}\n")
 
 
 def _precision(text: str) -> int:
@@ -170,34 +204,115 @@ def _verbose_parent() -> argparse.ArgumentParser:
     return common
 
 
-# --------------------------------------------------------------------------------------------------
-# fk
-# --------------------------------------------------------------------------------------------------
-
-
 def _nonnegative_int(text: str) -> int:
-    """argparse type: an integer >= 0 (a seed, a count)."""
+    """argparse type: an integer >= 0 (a seed)."""
+    return _bounded_int(text, 0, None)
+
+
+def _bounded_int(text: str, lo: int, hi: int | None) -> int:
+    """An integer in ``[lo, hi]`` (no upper bound when ``hi`` is None) from a command-line token, for argparse."""
     try:
-        v = int(text)
+        v = int(text.strip())
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {text!r}") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {v}")
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text.strip()!r}") from None
+    if v < lo or (hi is not None and v > hi):
+        want = f"a whole number >= {lo}" if hi is None else f"a whole number from {lo:,} to {hi:,}"
+        raise argparse.ArgumentTypeError(f"expected {want}, got {v}")
     return v
 
 
-def _check_output_path(path: str, directory: bool = False) -> None:
-    """Fail before any computation if ``path`` (a file, or a directory to create with ``directory``) cannot be
-    written: its parent must be an existing writable directory; a file path must not be a directory."""
+def _count(lo: int, hi: int) -> Callable[[str], int]:
+    """argparse type of a count in ``[lo, hi]``: a negative or absurd count fails at parse time (exit status 2)."""
+
+    def parse(text: str) -> int:
+        return _bounded_int(text, lo, hi)
+
+    parse.__name__ = "count"  # argparse names the type in some messages
+    return parse
+
+
+# --------------------------------------------------------------------------------------------------
+# Output files: checked before any computation
+# --------------------------------------------------------------------------------------------------
+
+
+def _check_output_path(path: str, directory: bool = False, suffixes: Sequence[str] = ()) -> None:
+    """Fail (CliInputError, exit status 2) before any computation if ``path`` cannot be written.
+
+    A file path must not be a directory, an existing file must be writable, and its directory must exist and be
+    writable; with ``suffixes`` its extension must be one of them. A ``directory`` (created when missing, as
+    ``verify --report`` does) must not be a file and must be writable, or its parent must be an existing writable
+    directory: a mistyped path does not create a tree of directories.
+    """
     p = Path(path)
-    parent = p.parent if str(p.parent) else Path(".")
-    if directory and p.is_dir():
-        parent = p
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise CliInputError(f"{path}: unknown output file extension {p.suffix!r}; use {' or '.join(suffixes)}")
+    if directory:
+        if p.exists() and not p.is_dir():
+            raise CliInputError(f"{path}: exists and is not a directory")
+        parent = p if p.is_dir() else p.parent
     elif p.is_dir():
         raise CliInputError(f"{path}: is a directory, expected an output file")
-    elif directory and p.exists():
-        raise CliInputError(f"{path}: exists and is not a directory")
+    else:
+        parent = p.parent
     if not parent.is_dir():
-        raise CliInputError(f"{path}: cannot write there: directory {str(parent)!r} does not exist")
+        why = "does not exist" if not parent.exists() else "is not a directory"
+        raise CliInputError(f"{path}: cannot write there: directory {str(parent)!r} {why}")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise CliInputError(f"{path}: cannot write there: directory {str(parent)!r} is not writable")
+    if not directory and p.exists() and not os.access(p, os.W_OK):
+        raise CliInputError(f"{path}: file exists and is not writable")
+
+
+# --------------------------------------------------------------------------------------------------
+# Progress on stderr
+# --------------------------------------------------------------------------------------------------
+
+#: Show progress only for runs longer than this (seconds), and only on a terminal.
+PROGRESS_AFTER_S = 2.0
+#: Least time between two redraws of the progress line (seconds).
+PROGRESS_EVERY_S = 0.2
+
+
+class _Progress:
+    """A one-line progress indicator on stderr, shown only when stderr is a terminal and once a run exceeds
+    ``PROGRESS_AFTER_S``; a callable ``progress(stage, done, total)`` as :mod:`sweepik.verify` expects.
+
+    ``enabled=False`` turns it off whatever stderr is (e.g. when the output itself streams to the terminal).
+    :meth:`close` ends a line left unfinished (an error or an interruption mid-run).
+    """
+
+    def __init__(self, enabled: bool = True) -> None:
+        self.start = time.monotonic()
+        self.last = 0.0
+        self.stream = sys.stderr
+        self.enabled = enabled and _isatty(self.stream)
+        self.open = False  # a progress line is on screen without its newline
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        now = time.monotonic()
+        if not self.enabled or now - self.start < PROGRESS_AFTER_S:
+            return
+        if now - self.last < PROGRESS_EVERY_S and done < total:
+            return
+        self.last = now
+        width = 30
+        filled = int(width * min(done, total) / max(total, 1))
+        self.stream.write(f"\r{stage:<22} [{'#' * filled}{'.' * (width - filled)}] {done:,}/{total:,}")
+        self.open = done < total
+        if not self.open:
+            self.stream.write("\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.open:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.open = False
+
+
+def _isatty(stream: Any) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):  # no isatty, or a closed stream
+        return False

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -17,9 +19,11 @@ from .cli_common import (
     _config_from_cli,
     _format_table,
     _is_number,
+    _isatty,
     _joint_units,
     _parse_numbers,
-    _print_json,
+    _print_json_stream,
+    _Progress,
     _subparser,
     _SubParsers,
 )
@@ -28,7 +32,7 @@ from .reductions import REDUCTIONS
 from .robot import Robot
 from .robot_file import bundled_robots, load_robot
 from .solutions import Solutions
-from .solver import STRATEGIES, solve_many
+from .solver import STRATEGIES, iter_solve
 
 Array = NDArray[np.float64]
 
@@ -91,6 +95,7 @@ def _solution_json(robot: Robot, sol: Solutions, nearest: Array | None) -> dict[
         "error_J": sol.error.tolist(),
         "error_geodesic": sol.error_geodesic.tolist(),
         "within_limits": sol.within_limits.tolist(),
+        "multiplicity": sol.multiplicity.tolist(),
         "families": [
             {"free_joint": robot.joint_names[f.free_joint], "interval": list(f.interval)} for f in sol.families
         ],
@@ -101,55 +106,104 @@ def _solution_json(robot: Robot, sol: Solutions, nearest: Array | None) -> dict[
     return out
 
 
+def _plural(count: int, one: str, many: str) -> str:
+    return f"{count} {one if count == 1 else many}"
+
+
+def _print_solutions(
+    robot: Robot, sol: Solutions, args: argparse.Namespace, header: list[str], nearest: Array | None
+) -> None:
+    """The text block of one pose (without its ``pose k:`` line)."""
+    dec = args.precision
+    if not sol:
+        print(f"  no solution: {sol.reason}")
+        return
+    show_mult = bool(np.any(sol.multiplicity > 1))  # a column only where some root is multiple (singular)
+    rows = []
+    for i, (q, e, ok, m) in enumerate(zip(sol.q, sol.error, sol.within_limits, sol.multiplicity, strict=True)):
+        row = [str(i + 1), *(f"{v:.{dec}f}" for v in _display(robot, q, args.rad)), f"{e:.2e}"]
+        if args.no_limits:
+            row.append("yes" if ok else "no")
+        if show_mult:
+            row.append(str(int(m)))
+        rows.append(row)
+    if sol.families:
+        count = _plural(len(sol), "isolated solution", "isolated solutions")
+        fams = _plural(len(sol.families), "self-motion family", "self-motion families")
+        print(f"  {count} and {fams} ({args.strategy} strategy):")
+    else:
+        print(f"  {len(sol)} solution(s) ({args.strategy} strategy):")
+    if rows:
+        # every column holds numbers but "in limits" (yes / no)
+        numeric = [h != "in limits" for h in header] + ([True] if show_mult else [])
+        print(_format_table([*header, "multiplicity"] if show_mult else header, rows, indent="  ", numeric=numeric))
+    if sol.families:
+        _print_families(robot, sol, args)
+    if nearest is not None:
+        qn = sol.nearest(nearest)
+        print("  nearest: " + "  ".join(f"{v:.{dec}f}" for v in _display(robot, qn, args.rad)))
+
+
+def _print_families(robot: Robot, sol: Solutions, args: argparse.Namespace) -> None:
+    """Each self-motion family: its free joint and interval, then a table of its members at both ends."""
+    dec = args.precision
+    units = _joint_units(robot, args.rad)
+    rows = []
+    for k, f in enumerate(sol.families):
+        j = f.free_joint
+        ends = np.array(f.interval, dtype=np.float64)
+        lo, hi = np.degrees(ends) if robot.is_revolute[j] and not args.rad else ends
+        print(
+            f"  self-motion family {k + 1}: every {robot.joint_names[j]} in [{lo:.{dec}f}, {hi:.{dec}f}] {units[j]} "
+            "gives a solution"
+        )
+        for end, q in zip(("from", "to"), f.at(ends), strict=True):
+            rows.append([f"{k + 1} {end}", *(f"{v:.{dec}f}" for v in _display(robot, q, args.rad))])
+    header = ["family", *(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))]
+    print("  members at both ends of the intervals:")
+    print(_format_table(header, rows, indent="  "))
+
+
 def cmd_solve(args: argparse.Namespace) -> int:
     if _is_number(args.robot):
         raise CliInputError(
-            f"unexpected number {args.robot!r} where the robot goes: --xyz takes 3 numbers, --zyz 3 angles, "
+            f"unexpected number {args.robot.strip()!r} where the robot goes: --xyz takes 3 numbers, --zyz 3 angles, "
             "--matrix 16 numbers"
         )
     robot = load_robot(args.robot)
-    poses = _poses_from_args(args)
     nearest = None if args.nearest is None else _config_from_cli(robot, args.nearest, args.rad)
-    sols = solve_many(robot, poses, reduction=args.reduction, strategy=args.strategy, limits=not args.no_limits)
-    if args.json:
-        _print_json(
-            {
+    poses = _poses_from_args(args)
+    # the output streaming to the terminal shows the progress by itself: no progress line mixed into it
+    progress = _Progress(enabled=not _isatty(sys.stdout))
+    try:
+        sols = iter_solve(
+            robot,
+            poses,
+            reduction=args.reduction,
+            strategy=args.strategy,
+            limits=not args.no_limits,
+            progress=progress,
+        )
+        if args.json:
+            head = {
                 "robot": robot.name,
                 "joint_names": robot.joint_names,
                 "units": "radians and " + robot.length_unit,
                 "strategy": args.strategy,
-                "poses": [_solution_json(robot, s, nearest) for s in sols],
             }
-        )
-        return 0
-    dec = args.precision
-    units = _joint_units(robot, args.rad)
-    header = ["#", *(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True)), f"J [{robot.length_unit}]"]
-    if args.no_limits:
-        header.append("in limits")
-    for k, sol in enumerate(sols):
-        if len(sols) > 1:
-            print(f"pose {k + 1}:")
-        if not sol:
-            print(f"  no solution: {sol.reason}")
-            continue
-        rows = []
-        for i, (q, e, ok) in enumerate(zip(sol.q, sol.error, sol.within_limits, strict=True)):
-            row = [str(i + 1), *(f"{v:.{dec}f}" for v in _display(robot, q, args.rad)), f"{e:.2e}"]
-            if args.no_limits:
-                row.append("yes" if ok else "no")
-            rows.append(row)
-        fams = f" and {len(sol.families)} self-motion family(ies)" if sol.families else ""
-        print(f"  {len(sol)} solution(s){fams} ({args.strategy} strategy):")
-        if rows:
-            print(_format_table(header, rows, indent="  "))
-        for f in sol.families:
-            name = robot.joint_names[f.free_joint]
-            lo, hi = _display(robot, np.array(f.interval), args.rad) if robot.is_revolute[f.free_joint] else f.interval
-            print(f"  self-motion family: every {name} in [{lo:.{dec}f}, {hi:.{dec}f}] gives a solution")
-        if nearest is not None:
-            qn = sol.nearest(nearest)
-            print("  nearest: " + "  ".join(f"{v:.{dec}f}" for v in _display(robot, qn, args.rad)))
+            _print_json_stream(head, "poses", (_solution_json(robot, s, nearest) for s in sols))
+            return 0
+        units = _joint_units(robot, args.rad)
+        header = ["#", *(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))]
+        header.append(f"J [{robot.length_unit}]")
+        if args.no_limits:
+            header.append("in limits")
+        for k, sol in enumerate(sols):
+            if poses.shape[0] > 1:
+                print(f"pose {k + 1}:")
+            _print_solutions(robot, sol, args, header, nearest)
+    finally:
+        progress.close()
     return 0
 
 
@@ -179,14 +233,28 @@ def cmd_path(args: argparse.Namespace) -> int:
     if len(args.args) > 2:
         raise CliInputError(f"expected [ROBOT] POSES_FILE, got {len(args.args)} arguments")
     robot_name, path = (DEFAULT_ROBOT, args.args[0]) if len(args.args) == 1 else args.args
-    if len(args.args) == 1 and path in bundled_robots():
-        raise CliInputError(f"path: missing POSES_FILE after robot {path!r} (usage: sweepik path [ROBOT] POSES_FILE)")
+    if len(args.args) == 1 and (path in bundled_robots() or Path(path).suffix.lower() == ".toml"):
+        raise CliInputError(
+            f"path: {path!r} is a robot, the POSES_FILE is missing (usage: sweepik path [ROBOT] POSES_FILE)"
+        )
     if args.output:
-        _check_output_path(args.output)
+        _check_output_path(args.output, suffixes=(".csv", ".json"))
     robot = load_robot(robot_name)
-    poses = load_poses(path)
     start = None if args.start is None else _config_from_cli(robot, args.start, args.rad)
-    res = follow_path(robot, poses, start, reduction=args.reduction, strategy=args.strategy, limits=not args.no_limits)
+    poses = load_poses(path)
+    progress = _Progress()
+    try:
+        res = follow_path(
+            robot,
+            poses,
+            start,
+            reduction=args.reduction,
+            strategy=args.strategy,
+            limits=not args.no_limits,
+            progress=progress,
+        )
+    finally:
+        progress.close()
     if args.output:
         write_joint_path(args.output, res.q, robot)
     summary = {
@@ -199,8 +267,8 @@ def cmd_path(args: argparse.Namespace) -> int:
         "switch_steps": list(res.switch_steps),
     }
     if args.json:
-        q_rows = [[float(v) if np.isfinite(v) else None for v in row] for row in res.q]
-        _print_json({**summary, "q": q_rows})
+        q_rows = ([float(v) if np.isfinite(v) else None for v in row] for row in res.q)
+        _print_json_stream(summary, "q", q_rows)  # the rows are encoded one by one, never all held as text
     elif args.output:
         print(
             f"{summary['found']}/{summary['points']} poses solved, J_max = {summary['J_max']}, "

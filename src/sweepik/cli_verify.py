@@ -3,45 +3,31 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
-import sys
-import time
 from pathlib import Path
 
 from .cli_common import (
     DEFAULT_ROBOT,
+    CliInputError,
     _add_json,
     _check_output_path,
+    _count,
     _nonnegative_int,
     _print_json,
+    _Progress,
     _subparser,
     _SubParsers,
 )
 from .robot_file import load_robot
 
-#: Show progress only for runs longer than this (seconds), and only on a terminal.
-PROGRESS_AFTER_S = 2.0
-
-
-class _Progress:
-    """A one-line progress indicator on stderr (terminals only), shown once a run exceeds a couple of seconds."""
-
-    def __init__(self) -> None:
-        self.start = time.monotonic()
-        self.last = 0.0
-        self.enabled = sys.stderr.isatty()
-
-    def __call__(self, stage: str, done: int, total: int) -> None:
-        now = time.monotonic()
-        if not self.enabled or now - self.start < PROGRESS_AFTER_S or (now - self.last < 0.2 and done < total):
-            return
-        self.last = now
-        width = 30
-        filled = int(width * done / max(total, 1))
-        sys.stderr.write(f"\r{stage:<22} [{'#' * filled}{'.' * (width - filled)}] {done}/{total}")
-        if done >= total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
+#: Largest --offgrid: every off-grid pose's solutions are kept for the statistics (~8 kB each).
+MAX_OFFGRID = 1_000_000
+#: Largest pose counts of ``sweepik bench`` (latency, paper strategy, memory) and grid repeats.
+MAX_BENCH_SINGLE = 1_000_000
+MAX_BENCH_PAPER = 100_000
+MAX_BENCH_MEMORY = 1_000_000
+MAX_BENCH_REPEATS = 100
 
 
 def add_verify_parser(sub: _SubParsers) -> None:
@@ -58,7 +44,11 @@ def add_verify_parser(sub: _SubParsers) -> None:
     p.add_argument("robot", nargs="?", default=DEFAULT_ROBOT, help=f"C-Arm-like robot (default: {DEFAULT_ROBOT})")
     p.add_argument("--strategy", choices=("paper", "precise", "both"), default="both", help="default: both")
     p.add_argument(
-        "--offgrid", type=_nonnegative_int, default=2000, metavar="N", help="random off-grid poses (default 2000)"
+        "--offgrid",
+        type=_count(0, MAX_OFFGRID),
+        default=2000,
+        metavar="N",
+        help=f"random off-grid poses, 0 to {MAX_OFFGRID:,} (default 2000)",
     )
     p.add_argument("--seed", type=_nonnegative_int, default=0, help="seed of the off-grid poses (default 0)")
     p.add_argument("--report", metavar="DIR", help="write a Markdown report with PNG figures into DIR")
@@ -68,12 +58,18 @@ def add_verify_parser(sub: _SubParsers) -> None:
 def cmd_verify(args: argparse.Namespace) -> int:
     from .verify import format_table, run_verify, write_report
 
-    robot = load_robot(args.robot)
     if args.report:
         _check_output_path(args.report, directory=True)
+        if importlib.util.find_spec("matplotlib") is None:
+            raise CliInputError(f"--report {args.report}: the figures need matplotlib: pip install 'sweepik[plot]'")
     if args.json and args.json != "-":
         _check_output_path(args.json)
-    result = run_verify(robot, args.strategy, offgrid=args.offgrid, seed=args.seed, progress=_Progress())
+    robot = load_robot(args.robot)
+    progress = _Progress()
+    try:
+        result = run_verify(robot, args.strategy, offgrid=args.offgrid, seed=args.seed, progress=progress)
+    finally:
+        progress.close()
     if args.json == "-":
         _print_json(result)
     else:
@@ -94,17 +90,47 @@ def add_bench_parser(sub: _SubParsers) -> None:
         help="benchmarks: grid throughput, single-pose latency, paper strategy, peak memory",
         description="Measure sweepik on the bundled C-Arm (see docs/performance.md). Benchmarks are not tests.",
     )
-    p.add_argument("--single", type=int, default=1000, metavar="N", help="poses for the latency test (0: skip)")
-    p.add_argument("--paper", type=int, default=500, metavar="N", help="poses for the paper strategy (0: skip)")
-    p.add_argument("--memory", type=int, default=100_000, metavar="N", help="poses for peak memory (0: skip)")
-    p.add_argument("--repeats", type=int, default=3, metavar="N", help="repeats of the grid run (best is kept)")
+    p.add_argument(
+        "--single",
+        type=_count(0, MAX_BENCH_SINGLE),
+        default=1000,
+        metavar="N",
+        help=f"poses for the latency test, up to {MAX_BENCH_SINGLE:,} (0: skip; default 1000)",
+    )
+    p.add_argument(
+        "--paper",
+        type=_count(0, MAX_BENCH_PAPER),
+        default=500,
+        metavar="N",
+        help=f"poses for the paper strategy, up to {MAX_BENCH_PAPER:,} (0: skip; default 500)",
+    )
+    p.add_argument(
+        "--memory",
+        type=_count(0, MAX_BENCH_MEMORY),
+        default=100_000,
+        metavar="N",
+        help=f"poses for peak memory, up to {MAX_BENCH_MEMORY:,} (0: skip; default 100,000)",
+    )
+    p.add_argument(
+        "--repeats",
+        type=_count(1, MAX_BENCH_REPEATS),
+        default=3,
+        metavar="N",
+        help=f"repeats of the grid run, 1 to {MAX_BENCH_REPEATS} (best is kept; default 3)",
+    )
     _add_json(p, "")
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
     from .bench import format_bench, run_bench
 
-    result = run_bench(single=args.single, paper=args.paper, memory=args.memory, repeats=max(1, args.repeats))
+    progress = _Progress()
+    try:
+        result = run_bench(
+            single=args.single, paper=args.paper, memory=args.memory, repeats=args.repeats, progress=progress
+        )
+    finally:
+        progress.close()
     if args.json:
         _print_json(result)
     else:

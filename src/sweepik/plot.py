@@ -45,6 +45,33 @@ def _new_figure(projection: str | None = None, figsize: tuple[float, float] = (6
     return fig.add_subplot(projection=projection) if projection else fig.add_subplot()
 
 
+#: Gap between the bottom of a 2D Axes and a legend placed below it, in points: clears the tick labels and
+#: the x label (at the default font sizes).
+_LEGEND_BELOW_PT = 40.0
+
+
+def _legend_below(ax: Axes, handles: Sequence[Any] | None = None, labels: Sequence[str] | None = None) -> None:
+    """A legend in one row under ``ax`` (below its x label, or under the panes of a 3D Axes): outside the axes,
+    it hides no data, whatever the data. ``savefig(bbox_inches="tight")`` or ``tight_layout`` keep it in view."""
+    from matplotlib.transforms import ScaledTranslation
+
+    if handles is None or labels is None:
+        handles, labels = ax.get_legend_handles_labels()
+    gap_in = (0.0 if ax.name == "3d" else _LEGEND_BELOW_PT) / 72.0  # points to inches
+    fig = ax.get_figure()
+    below = ax.transAxes if fig is None else ax.transAxes + ScaledTranslation(0.0, -gap_in, fig.dpi_scale_trans)
+    ax.legend(
+        handles,
+        labels,
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.0),
+        bbox_transform=below,
+        ncol=max(len(labels), 1),
+        fontsize=8,
+        frameon=False,
+    )
+
+
 def plot_figure4(data: Mapping[str, Any], ax: Axes | None = None) -> Axes:
     """The paper's Figure 4 from :func:`sweepik.verify.figure4_data`.
 
@@ -80,7 +107,7 @@ def plot_figure4(data: Mapping[str, Any], ax: Axes | None = None) -> Axes:
     ax.set_xlim(-180, 180)
     ax.set_ylim(-190, 190)
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
+    _legend_below(ax)
     return ax
 
 
@@ -108,7 +135,7 @@ def plot_trajectory_3d(
     ax.set_xlabel(f"x ({length_unit})")
     ax.set_ylabel(f"y ({length_unit})")
     ax.set_zlabel(f"z ({length_unit})")  # type: ignore[union-attr]
-    ax.legend(loc="best", fontsize=8)
+    _legend_below(ax)
     return ax
 
 
@@ -156,7 +183,7 @@ def plot_joints_along_path(
         twin.set_ylabel(f"prismatic joints ({unit})")
         h2, l2 = twin.get_legend_handles_labels()
         handles, labels = handles + h2, labels + l2
-    ax.legend(handles, labels, loc="best", fontsize=8)
+    _legend_below(ax, handles, labels)
     return ax
 
 
@@ -179,7 +206,7 @@ def save_verification_figures(result: Mapping[str, Any], directory: str | PathLi
         fig = ax.get_figure()
         path = out_dir / f"{name}.png"
         fig.tight_layout()  # type: ignore[union-attr]
-        fig.savefig(path, dpi=120)  # type: ignore[union-attr]
+        fig.savefig(path, dpi=120, bbox_inches="tight")  # type: ignore[union-attr]
         plt.close(fig)
         written[name] = path
 

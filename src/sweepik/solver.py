@@ -6,6 +6,7 @@ configurations -> FK check against the target -> joint limits -> duplicates remo
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 from typing import Literal
 
@@ -25,7 +26,10 @@ from .solutions import Family, Solutions
 from .sweep import N_SAMPLES, Candidates, FamilySpan, find_candidates
 from .units import mm_per_unit, orientation_weight
 
-__all__ = ["solve", "solve_many", "STRATEGIES"]
+__all__ = ["solve", "solve_many", "iter_solve", "STRATEGIES"]
+
+#: A progress callback: ``progress(stage, done, total)``.
+Progress = Callable[[str, int, int], None]
 
 Array = NDArray[np.float64]
 Strategy = Literal["precise", "paper"]
@@ -418,17 +422,43 @@ def solve_many(
     [1, ``MAX_CHUNK``]; a large ``n_samples`` or the paper's strategy on a long range use smaller chunks, so that
     memory stays bounded). Results are identical to calling :func:`solve` on each pose. An empty batch (``[]``
     or an array ``(0, 4, 4)``) gives ``[]``, after the other arguments are checked. Other arguments and errors:
-    see :func:`solve`.
+    see :func:`solve`; :func:`iter_solve` yields the same results without holding them all.
+    """
+    it = iter_solve(
+        robot, poses, reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples, chunk_size=chunk_size
+    )
+    return list(it)
+
+
+def iter_solve(
+    robot: Robot,
+    poses: ArrayLike,
+    *,
+    reduction: str | Reduction | None = None,
+    strategy: Strategy = "precise",
+    limits: bool = True,
+    n_samples: int = N_SAMPLES,
+    chunk_size: int = CHUNK,
+    progress: Progress | None = None,
+) -> Iterator[Solutions]:
+    """The solutions of each pose in ``poses (N, 4, 4)``, yielded one pose after the other as
+    :func:`solve_many` computes them, a chunk of poses at a time: only one chunk's results are alive at once,
+    so memory stays bounded whatever ``N`` (for streaming millions of poses to a file).
+
+    Arguments are checked when it is called, before the first solution is asked for. ``progress(stage, done,
+    total)``, if given, is called with stage ``"solve"`` before the first chunk and after each one.
     """
     _check_strategy(strategy)
     arr = as_float_array(poses, "poses")
     P = np.zeros((0, 4, 4)) if arr.size == 0 else check_poses(arr, "poses")
     if P.ndim != 3:
         raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
-    return _solve_checked(robot, P, reduction, strategy, limits, n_samples, chunk_size)
+    if progress is not None and not callable(progress):
+        raise UnknownOptionError(f"progress must be callable or None, got {type(progress).__name__}")
+    return _iter_checked(robot, P, *_prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size), progress)
 
 
-def _solve_checked(
+def _prepare(
     robot: Robot,
     P: Array,
     reduction: str | Reduction | None,
@@ -436,7 +466,8 @@ def _solve_checked(
     limits: bool,
     n_samples: int,
     chunk_size: int = CHUNK,
-) -> list[Solutions]:
+) -> tuple[Reduction, str, bool, int, int]:
+    """Check the solver's arguments; the reduction and the checked (strategy, limits, n_samples, chunk size)."""
     if not isinstance(robot, Robot):
         hint = f"; load it with sweepik.load_robot({short_repr(robot, 40)})" if isinstance(robot, str) else ""
         raise UnknownOptionError(
@@ -459,10 +490,38 @@ def _solve_checked(
         chunk_size = min(chunk_size, max(1, PAPER_SAMPLE_BUDGET // _paper_samples(robot, red, P, limits)))
     else:
         chunk_size = min(chunk_size, max(1, SAMPLE_BUDGET // n_samples))
-    out: list[Solutions] = []
-    for s in range(0, P.shape[0], chunk_size):
-        out.extend(_solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples))
-    return out
+    return red, strategy, limits, n_samples, chunk_size
+
+
+def _iter_checked(
+    robot: Robot,
+    P: Array,
+    red: Reduction,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    chunk_size: int,
+    progress: Progress | None = None,
+) -> Iterator[Solutions]:
+    total = P.shape[0]
+    if progress is not None:
+        progress("solve", 0, total)
+    for s in range(0, total, chunk_size):
+        yield from _solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples)
+        if progress is not None:
+            progress("solve", min(s + chunk_size, total), total)
+
+
+def _solve_checked(
+    robot: Robot,
+    P: Array,
+    reduction: str | Reduction | None,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    chunk_size: int = CHUNK,
+) -> list[Solutions]:
+    return list(_iter_checked(robot, P, *_prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size)))
 
 
 def solve(

@@ -34,7 +34,7 @@ from .pose import pose_error_paper, pose_from_xyz_zyz
 from .reductions import Reduction
 from .robot import Robot
 from .solutions import Solutions, joint_distance, weighted_joint_distance
-from .solver import solve_many
+from .solver import Progress, iter_solve
 from .units import orientation_weight
 
 __all__ = [
@@ -119,6 +119,7 @@ def follow_path(
     reduction: str | Reduction | None = None,
     strategy: Literal["precise", "paper"] = "precise",
     limits: bool = True,
+    progress: Progress | None = None,
 ) -> PathResult:
     """Joint path along ``poses (N, 4, 4)`` (world frame, robot's length unit), keeping to one IK branch.
 
@@ -126,7 +127,8 @@ def follow_path(
     (``(n,)``, radians / length unit), or the first solution reported when ``q_start`` is None; every later
     point takes the solution nearest the previous chosen configuration (see :func:`weighted_joint_distance`;
     members of self-motion families count). A pose without solution gets a NaN row and the next point is
-    compared with the last configuration found.
+    compared with the last configuration found. The poses are solved a chunk at a time (:func:`iter_solve`), so
+    memory grows with the path's joint rows only; ``progress("path", done, total)`` follows the solves.
 
     >>> import numpy as np
     >>> from sweepik import load_robot
@@ -142,18 +144,20 @@ def follow_path(
     ref = None if q_start is None else check_configuration(q_start, robot.n_joints, "q_start")
     if ref is not None and ref.ndim != 1:
         raise ShapeError(f"q_start must have shape ({robot.n_joints},), got {ref.shape}")
-    sols = solve_many(robot, P, reduction=reduction, strategy=strategy, limits=limits)
+    report = None if progress is None else (lambda _stage, done, total: progress("path", done, total))
+    sols = iter_solve(robot, P, reduction=reduction, strategy=strategy, limits=limits, progress=report)
     weight = orientation_weight(robot.length_unit)
     N, n = P.shape[0], robot.n_joints
     q = np.full((N, n), np.nan)
     err = np.full(N, np.nan)
+    n_solutions = np.zeros(N, dtype=np.intp)
     for k, s in enumerate(sols):
+        n_solutions[k] = len(s)
         pick = _choose(robot, s, ref, weight)
         if pick is not None:
             q[k], err[k] = pick
             ref = q[k]
     found = np.all(np.isfinite(q), axis=-1)
-    n_solutions = np.array([len(s) for s in sols], dtype=np.intp)
     steps = joint_distance(robot, q[1:], q[:-1]) if N > 1 else np.zeros((0, n))
     valid = np.all(np.isfinite(steps), axis=-1)
     max_step = steps[valid].max(axis=0) if np.any(valid) else np.zeros(n)

@@ -23,7 +23,7 @@ import itertools
 import math
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from os import PathLike
 from pathlib import Path
 from typing import Any, Literal
@@ -37,7 +37,7 @@ from .pose import pose_error_paper
 from .reductions import Reduction
 from .robot import Robot
 from .solutions import Solutions, joint_distance
-from .solver import STRATEGIES, solve_many
+from .solver import STRATEGIES, Progress, iter_solve, solve_many
 from .trajectory import branch_switch_thresholds, follow_path, weighted_joint_distance
 from .units import orientation_weight
 
@@ -67,7 +67,6 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-Progress = Callable[[str, int, int], None]
 StrategyChoice = Literal["precise", "paper", "both"]
 
 #: Table 2 of the paper: the values of each joint in the verification grid (d1 in mm, angles in degrees).
@@ -171,19 +170,15 @@ def _solve_chunked(
     progress: Progress | None,
     stage: str,
 ) -> tuple[list[Solutions], float]:
-    """All solutions of ``poses`` in chunks (progress after each) and the wall time of the solves (s)."""
-    out: list[Solutions] = []
-    seconds = 0.0
-    total = poses.shape[0]
-    if progress is not None:
-        progress(stage, 0, total)
-    for s in range(0, total, _CHUNK):
-        t0 = time.perf_counter()
-        out.extend(solve_many(robot, poses[s : s + _CHUNK], reduction=reduction, strategy=strategy))  # type: ignore[arg-type]
-        seconds += time.perf_counter() - t0
+    """All solutions of ``poses`` (progress after each chunk) and the wall time of the solves (s)."""
+
+    def report(_: str, done: int, total: int) -> None:
         if progress is not None:
-            progress(stage, min(s + _CHUNK, total), total)
-    return out, seconds
+            progress(stage, done, total)
+
+    t0 = time.perf_counter()
+    out = list(iter_solve(robot, poses, reduction=reduction, strategy=strategy, chunk_size=_CHUNK, progress=report))  # type: ignore[arg-type]
+    return out, time.perf_counter() - t0
 
 
 def _count_distinct(values: Array, tol: float) -> int:
