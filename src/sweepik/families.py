@@ -10,9 +10,7 @@ from numpy.typing import NDArray
 from . import fastcertify, fastsweep
 from .pose import pose_error_geodesic
 from .reductions import Reduction
-from .reductions.base import IntArray
 from .robot import Robot
-from .rootfind import find_roots
 from .solutions import Family
 from .sweep import CLUSTER_FAMILY_REL, FamilySpan
 from .units import orientation_weight
@@ -21,8 +19,6 @@ Array = NDArray[np.float64]
 
 #: Samples along a family span to certify its members and cut it to the joint limits.
 _FAMILY_SAMPLES = 33
-#: Every this many samples of a family span is certified by FK (all of them if one fails).
-_FAMILY_CERTIFY_EVERY = 8
 
 
 def family_members(
@@ -52,22 +48,11 @@ def _members_ok(
         M = theta.shape[1]
         flat_p = np.repeat(pose, M)
         flat_b = np.repeat(branch, M)
-        q = fastcertify.configurations(robot, red, chain, flat_p, theta.ravel(), flat_b)
+        # every member certified by FK: a family from a vanishing residual can still hold a point where the
+        # branch's closed form breaks down (e.g. the wrist crossing joint 2's axis on the C-Arm)
+        q, err, _ = fastcertify.certify(robot, red, chain, world, flat_p, theta.ravel(), flat_b)
         q = q.reshape(*theta.shape, robot.n_joints)
-        ok = np.all(np.isfinite(q), axis=-1)
-        # FK certification of every _FAMILY_CERTIFY_EVERY-th member (the family came from a vanishing
-        # residual); a span with a failing member is certified member by member
-        sub = np.arange(0, M, _FAMILY_CERTIFY_EVERY)
-        Ms = sub.size
-        _, err, _ = fastcertify.certify(
-            robot, red, chain, world, np.repeat(pose, Ms), theta[:, sub].ravel(), np.repeat(branch, Ms)
-        )
-        bad = np.nonzero(np.any(err.reshape(-1, Ms) > tol, axis=1))[0]
-        if bad.size:
-            _, err_b, _ = fastcertify.certify(
-                robot, red, chain, world, np.repeat(pose[bad], M), theta[bad].ravel(), np.repeat(branch[bad], M)
-            )
-            ok[bad] &= (err_b <= tol).reshape(bad.size, M)
+        ok = np.all(np.isfinite(q), axis=-1) & (err <= tol).reshape(theta.shape)
         qz = np.nan_to_num(q)
     else:
         q = red.solve_rest(chain[pose], theta, np.broadcast_to(branch[:, None], theta.shape))
@@ -79,6 +64,68 @@ def _members_ok(
     if limits:
         ok &= robot.within_limits(qz)
     return np.asarray(ok)
+
+
+#: Bisection steps locating where a family piece ends between its samples (1/32 of the span apart): the end is
+#: located to 2**-32 of that, ~1e-8 mm on the C-Arm's rail.
+_CUT_BISECT = 32
+#: Golden-section steps locating the least limit excess between samples (the bracket shrinks 0.618x a step;
+#: the search stops once every bracket has a point inside the limits).
+_DIP_STEPS = 50
+_GOLDEN = 0.5 * (np.sqrt(5.0) - 1.0)
+
+
+def _limit_excess(
+    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], x: Array
+) -> Array:
+    """How far the family member at ``x (K,)`` lies outside the joint limits (its largest excess; <= 0 inside,
+    inf where the member does not exist)."""
+    q = family_members(robot, red, chain, pose, branch, x)
+    w = robot.wrap(np.nan_to_num(q, nan=np.inf))
+    return np.asarray(np.max(np.maximum(robot.lower - w, w - robot.upper), axis=-1))
+
+
+def _limit_dips(
+    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], grid: Array
+) -> Array:
+    """``(K, M)`` extra samples for the family spans sampled at ``grid (K, M)``: where the limit excess has a
+    local minimum above zero among the samples, the least excess between the neighbouring samples is located
+    (golden section); where it is inside the limits, that point is returned, elsewhere the span's first sample
+    (a harmless repeat)."""
+    K, M = grid.shape
+    e = _limit_excess(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel()).reshape(K, M)
+    big = np.where(np.isfinite(e), e, np.inf)
+    left = np.concatenate([np.full((K, 1), np.inf), big[:, :-1]], axis=1)
+    right = np.concatenate([big[:, 1:], np.full((K, 1), np.inf)], axis=1)
+    k, i = np.nonzero((big > 0) & np.isfinite(big) & (big <= left) & (big <= right))
+    extra = np.repeat(grid[:, :1], M, axis=1)
+    if k.size == 0:
+        return extra
+    a, b = grid[k, np.maximum(i - 1, 0)], grid[k, np.minimum(i + 1, M - 1)]
+    best_x, best_e = grid[k, i], big[k, i]
+
+    def excess(x: Array) -> Array:
+        return _limit_excess(robot, red, chain, pose[k], branch[k], x)
+
+    c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
+    ec, ed = excess(c), excess(d)
+    for _ in range(_DIP_STEPS):
+        for x, ex in ((c, ec), (d, ed)):
+            better = ex < best_e
+            best_x, best_e = np.where(better, x, best_x), np.where(better, ex, best_e)
+        if np.all(best_e <= 0.0):
+            break
+        left = ec < ed  # the least excess lies in [a, d]: d becomes the new right end, c the new inner right point
+        a, b = np.where(left, a, c), np.where(left, d, b)
+        new_c = np.where(left, b - _GOLDEN * (b - a), d)
+        new_d = np.where(left, c, a + _GOLDEN * (b - a))
+        fresh = np.where(left, new_c, new_d)  # the one inner point not evaluated yet
+        e_fresh = excess(fresh)
+        ec, ed = np.where(left, e_fresh, ed), np.where(left, ec, e_fresh)
+        c, d = new_c, new_d
+    found = best_e <= 0.0
+    extra[k[found], i[found]] = best_x[found]
+    return extra
 
 
 def merge_spans(spans: list[FamilySpan]) -> list[FamilySpan]:
@@ -98,16 +145,22 @@ def families_of(
     robot: Robot, red: Reduction, chain: Array, world: Array, spans: list[FamilySpan], limits: bool, tol: float
 ) -> tuple[dict[int, list[Family]], NDArray[np.intp], Array]:
     """Family objects per pose: each span cut to the sub-intervals whose members are certified by FK
-    (and, with limits, inside the limits): sampled, then each cut at a limit located by root finding.
+    (and, with limits, inside the limits): sampled, then each cut located by bisection.
     Pieces that shrink to a point are returned as isolated members ``(pose index, q)``."""
     out: dict[int, list[Family]] = {}
     spans = merge_spans(spans)
     if not spans:
         return out, np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
-    pose = np.array([sp.pose for sp in spans])
+    # only the poses with a family are worked on (the compiled kernels take every pose's parameters)
+    used, pose = np.unique(np.array([sp.pose for sp in spans]), return_inverse=True)
+    chain_all, chain, world = chain, chain[used], world[used]
     branch = np.array([sp.branch for sp in spans])
     u = np.linspace(0.0, 1.0, _FAMILY_SAMPLES)
     grid = np.array([sp.lo for sp in spans])[:, None] + np.array([sp.hi - sp.lo for sp in spans])[:, None] * u
+    if limits:
+        # a stretch inside the limits narrower than the sampling (a joint dipping just under its limit between
+        # samples) gets a sample of its own
+        grid = np.sort(np.concatenate([grid, _limit_dips(robot, red, chain, pose, branch, grid)], axis=1), axis=1)
     ok = _members_ok(robot, red, chain, world, pose, branch, grid, limits, tol)
     pad = np.zeros((len(spans), 1), np.int8)
     edges = np.diff(np.concatenate([pad, ok.astype(np.int8), pad], axis=1), axis=1)
@@ -123,33 +176,22 @@ def families_of(
     inside = np.concatenate([grid[K, S], grid[K, E]])
     outside = np.concatenate([grid[K, np.maximum(S - 1, 0)], grid[K, np.minimum(E + 1, M - 1)]])
     cut = np.nonzero(np.concatenate([S > 0, E < M - 1]))[0]  # only cuts inside a span need locating
-    which = np.concatenate([K, K])[cut]
-    if cut.size and limits:
-        # members between certified samples are solutions too: the cut is where they leave the limits, i.e.
-        # a root of the largest limit excess (continuous along the family): bracketed root finding
-        def limit_excess(x: Array, sel: IntArray) -> Array:
-            qx = family_members(robot, red, chain, pose[which[sel]], branch[which[sel]], x)
-            w = robot.wrap(np.nan_to_num(qx, nan=np.inf))
-            return np.max(np.maximum(robot.lower - w, w - robot.upper), axis=-1)
-
-        idx = np.arange(cut.size)
-        e_in, e_out = limit_excess(inside[cut], idx), limit_excess(outside[cut], idx)
-        ok = (e_in <= 0) & (e_out > 0) & np.isfinite(e_out)
-        kk = np.nonzero(ok)[0]
-        if kk.size:
-            root = find_roots(
-                lambda x, sel: limit_excess(x, kk[sel]),
-                inside[cut][kk],
-                outside[cut][kk],
-                e_in[kk],
-                e_out[kk],
-                1e-9 * robot.length_scale,
-            )
-            # keep the side that is inside (the root finder may end on either side of the crossing)
-            good = limit_excess(root, kk) <= robot.limit_tol.min()
-            inside[cut[kk]] = np.where(good, root, inside[cut[kk]])
+    if cut.size:
+        # members between certified samples are solutions too: each cut lies where members stop being
+        # solutions (a limit crossed, a singular point where the branch's closed form breaks down, ...): bisect
+        # between the last sample inside and the first outside, all cuts at once
+        which = np.concatenate([K, K])[cut]
+        a, b = inside[cut], outside[cut]
+        for _ in range(_CUT_BISECT):
+            mid = 0.5 * (a + b)
+            on = _members_ok(robot, red, chain, world, pose[which], branch[which], mid[:, None], limits, tol)[:, 0]
+            a, b = np.where(on, mid, a), np.where(on, b, mid)
+        inside[cut] = a
     n = len(pieces)
     lo, hi = inside[:n], inside[n:]
+    if limits and not red.periodic:  # within the limit tolerance, but reported inside theta*'s own limits
+        j = red.free_joint
+        lo, hi = np.clip(lo, robot.lower[j], robot.upper[j]), np.clip(hi, robot.lower[j], robot.upper[j])
     # a piece that shrinks to a point (the family touches the limits there) is an isolated solution
     point = hi - lo <= CLUSTER_FAMILY_REL * (grid[K, -1] - grid[K, 0] + 1.0)
     duplicate = _repeated_pieces(robot, red, chain, pose[K], branch[K], lo, hi) & ~point
@@ -157,7 +199,7 @@ def families_of(
         if not point[j] and not duplicate[j]:
             sp = spans[k]
             out.setdefault(sp.pose, []).append(
-                Family(red.free_joint, (float(lo[j]), float(hi[j])), red, chain[sp.pose], sp.branch)
+                Family(red.free_joint, (float(lo[j]), float(hi[j])), red, chain_all[sp.pose], sp.branch)
             )
     pk = K[point]
     # its member: of the piece's ends and middle, the one deepest inside the limits
@@ -171,7 +213,7 @@ def families_of(
         if pk.size
         else np.zeros((0, robot.n_joints))
     )
-    return out, pose[pk].astype(np.intp), q_pts
+    return out, used[pose[pk]].astype(np.intp), q_pts
 
 
 #: Two points are the same member when every joint agrees within this (radians modulo 2 pi / relative length).
@@ -222,7 +264,9 @@ def off_families(robot: Robot, q: Array, families: tuple[Family, ...]) -> NDArra
         return ~on
     for f in families:
         th = q[:, f.free_joint]
-        inn = (th >= f.interval[0]) & (th <= f.interval[1])
+        lo, hi = f.interval
+        slack = _MEMBER_TOL * np.maximum(1.0, np.abs(th))  # a configuration at an end of the interval is on it
+        inn = (th >= lo - slack) & (th <= hi + slack)
         if inn.any():
             on |= inn & _same_configuration(robot, f.at(np.clip(th, *f.interval)), q)
     return ~on

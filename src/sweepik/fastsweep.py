@@ -11,6 +11,9 @@ A kernel is ``residual(params, theta, branch) -> float`` compiled with ``numba.n
 ``reductions.kernels.RESIDUAL_SIG``, where ``params`` is one row of ``Reduction.kernel_params(poses)``; the
 engine takes it as a first-class function (``Reduction.kernel[0]``), so one compiled engine serves every
 reduction.
+
+The constants below are frozen into the compiled code, and Numba's on-disk cache is keyed on this file's time
+stamp only: after changing one of them in :mod:`sweepik.sweep`, touch this file (or delete its ``*.nbi`` cache).
 """
 
 from __future__ import annotations

@@ -2,7 +2,8 @@
 
 A reduction can be badly conditioned where theta* barely moves the pose (e.g. the C-Arm's d1 reduction
 while theta2 swings through pi within |Pz - d1| ~ |Px|): there a root in theta* at full precision still
-leaves ~1e-10 mm of pose error. One or two Newton steps on all six joints remove it.
+leaves ~1e-10 mm of pose error. One or two Newton steps on all six joints remove it. Next to a singular
+configuration (an elbow almost straight) the step is damped: halved until it lowers the error.
 """
 
 from __future__ import annotations
@@ -22,36 +23,65 @@ PINV_RCOND = 1e-10
 
 
 def _pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:
-    frames = kinematics.chain_frames(robot, q)
-    T = frames[:, -1] @ robot.T_flange_tool
-    return T, kinematics.geometric_jacobian(robot, q)
+    return _pose(robot, q), kinematics.geometric_jacobian(robot, q)
+
+
+#: Newton steps at most (a step that does not lower the error ends a configuration's polish).
+ITERATIONS = 8
+#: A Newton step that raises the error is halved up to this many times (backtracking): next to a fold of the
+#: arm's workspace (an elbow nearly straight) the full step overshoots, a shorter one converges.
+BACKTRACK = 8
 
 
 def polish(
-    robot: Robot, q: Array, target: Array, weight: float, iterations: int = 2, fixed: NDArray[np.bool_] | None = None
+    robot: Robot,
+    q: Array,
+    target: Array,
+    weight: float,
+    iterations: int = ITERATIONS,
+    fixed: NDArray[np.bool_] | None = None,
+    floor: float = 0.0,
 ) -> Array:
-    """Improve configurations ``q (K, n)`` towards poses ``target (K, 4, 4)``; keeps a step only if the
-    geodesic error (position + ``weight`` x angle) decreases. ``fixed (K, n)``: joints held where True."""
+    """Improve configurations ``q (K, n)`` towards poses ``target (K, 4, 4)`` by damped Newton steps on the full
+    pose; a step is kept only if the geodesic error (position + ``weight`` x angle) decreases, else it is halved
+    (up to ``BACKTRACK`` times), and a configuration no step improves is left as it is. A configuration stops
+    once its error is at most ``floor`` (after one step at least). ``fixed (K, n)``: joints held where True."""
     if q.shape[0] == 0:
         return q
     q = q.copy()
-    T = kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool
-    err = pose_error_geodesic(T, target, weight)
+    err = pose_error_geodesic(_pose(robot, q), target, weight)
     scale = np.array([1.0, 1.0, 1.0, weight, weight, weight])
+    active = np.arange(q.shape[0])
     for _ in range(iterations):
-        T, J = _pose_and_jacobian(robot, q)
-        dp = target[:, :3, 3] - T[:, :3, 3]
-        dR = target[:, :3, :3] @ np.swapaxes(T[:, :3, :3], -1, -2)
+        qa, ta = q[active], target[active]
+        T, J = _pose_and_jacobian(robot, qa)
+        dp = ta[:, :3, 3] - T[:, :3, 3]
+        dR = ta[:, :3, :3] @ np.swapaxes(T[:, :3, :3], -1, -2)
         w = 0.5 * np.stack([dR[:, 2, 1] - dR[:, 1, 2], dR[:, 0, 2] - dR[:, 2, 0], dR[:, 1, 0] - dR[:, 0, 1]], -1)
         e = np.concatenate([dp, w], axis=-1) * scale
         Js = J * scale[:, None]
         if fixed is not None:
-            Js = np.where(fixed[:, None, :], 0.0, Js)
+            Js = np.where(fixed[active][:, None, :], 0.0, Js)
         # pseudo-inverse per candidate: singular Jacobians (rank-deficient arms poses) stay bounded
-        q_new = q + np.einsum("kij,kj->ki", np.linalg.pinv(Js, rcond=PINV_RCOND), e)
-        T_new = kinematics.chain_frames(robot, q_new)[:, -1] @ robot.T_flange_tool
-        err_new = pose_error_geodesic(T_new, target, weight)
-        better = np.isfinite(err_new) & (err_new < err)
-        q[better] = q_new[better]
-        err = np.where(better, err_new, err)
+        step = np.einsum("kij,kj->ki", np.linalg.pinv(Js, rcond=PINV_RCOND), e)
+        improved = np.zeros(active.size, dtype=bool)
+        todo = np.arange(active.size)
+        for _ in range(BACKTRACK + 1):
+            q_new = qa[todo] + step[todo]
+            err_new = pose_error_geodesic(_pose(robot, q_new), ta[todo], weight)
+            better = np.isfinite(err_new) & (err_new < err[active[todo]])
+            rows = active[todo[better]]
+            q[rows], err[rows] = q_new[better], err_new[better]
+            improved[todo[better]] = True
+            todo = todo[~better]
+            if todo.size == 0:
+                break
+            step[todo] *= 0.5
+        active = active[improved & (err[active] > floor)]
+        if active.size == 0:
+            break
     return q
+
+
+def _pose(robot: Robot, q: Array) -> Array:
+    return kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool

@@ -222,6 +222,12 @@ def _solve_chunk(
             q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
             mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp) if sp_mult is None else sp_mult[sp_p, sp_k]])
+        # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
+        spans = [
+            FamilySpan(sp.pose, sp.branch, max(sp.lo, float(lo[sp.pose])), min(sp.hi, float(hi[sp.pose])))
+            for sp in spans
+            if min(sp.hi, hi[sp.pose]) > max(sp.lo, lo[sp.pose])
+        ]
         fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, ACCEPT_TOL_REL * robot.length_scale)
         if fam_p.size:
             if err_geo is not None and err_paper is not None:
@@ -248,7 +254,7 @@ def _solve_chunk(
             & ((err_geo > POLISH_ABOVE_REL * scale) | (err_paper > POLISH_PAPER_ABOVE_REL * scale))
         )[0]
         if near.size:
-            polished = polish(robot, q[near], target[near], weight)
+            polished = polish(robot, q[near], target[near], weight, floor=POLISH_ABOVE_REL * scale)
             eg, ep = _errors(robot, polished, target[near], weight)
             # at a singular configuration the step can drift along the near-null space: never out of the limits
             # for a configuration that was inside them and already certified

@@ -53,8 +53,11 @@ EXTREMUM_REACH = 4.0
 _U_UNIFORM = np.linspace(0.0, 1.0, SUB_SAMPLES + 2)
 _U_EDGE = 0.5 * (1.0 - np.cos(np.pi * _U_UNIFORM))
 #: |residual| at or below which a sample counts as lying on a self-motion family (residuals are computed to
-#: ~1e-15; an isolated root makes three consecutive samples this small only with probability ~0).
-FAMILY_TOL = 1e-10
+#: ~1e-15; an isolated root makes three consecutive samples this small only with probability ~0). No looser: a
+#: pose a hair off a self-motion (theta5 = 1e-9 at theta2 = 90 deg on the C-Arm) has a residual of that hair's
+#: size along the whole former family, with isolated roots in it that a looser threshold would hide, while its
+#: members miss the pose by more than the FK acceptance (about 1e-12 rad of orientation).
+FAMILY_TOL = 1e-12
 #: Roots of one branch joined by a stretch where the residual stays at rounding noise form a cluster; a
 #: cluster longer than this fraction of the theta* range is reported as a family (a numerical continuum:
 #: every point of it solves the pose to rounding precision), a shorter one as its midpoint. A double root
