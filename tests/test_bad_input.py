@@ -691,3 +691,14 @@ def test_absurdly_far_poses_are_refused(coordinate: float, capsys: pytest.Captur
     _assert_one_error_line(code, err, None)
     T[1, 3] = 1e29  # within the bound: simply out of reach
     assert sweepik.solve(CARM, T).reason.startswith("unreachable")
+
+
+@pytest.mark.parametrize("value", [1e308, -1e31])
+def test_absurd_joint_values_refused(value: float, capsys: pytest.CaptureFixture[str]) -> None:
+    q = np.array([value, 0.0, 0.0, 0.0, 0.0, 0.0])
+    with pytest.raises(sweepik.NonFiniteError, match="at most 1e"):
+        CARM.fk(q)
+    with pytest.raises(sweepik.NonFiniteError):
+        CARM.fk(q[[1, 0, 2, 3, 4, 5]])  # an angle too
+    code, err = _cli(["fk", "carm", repr(value), "0", "0", "0", "0", "0"], capsys)
+    assert code == 2 and "at most 1e+30" in err

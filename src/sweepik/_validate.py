@@ -26,6 +26,8 @@ ORTHONORMAL_TOL = 1e-6
 #: Largest pose translation coordinate accepted (length unit): far beyond any arm (robot files bound lengths at
 #: 1e12), and the solver's products of a few coordinates stay finite (at 1e150 they overflow).
 MAX_TRANSLATION = 1e30
+#: Joint values beyond this magnitude (radians or length unit) are refused: their poses would overflow.
+MAX_JOINT_VALUE = 1e30
 
 #: dtype kinds taken as real numbers: floats, signed and unsigned integers (object arrays: checked per element).
 _REAL_KINDS = "fiu"
@@ -110,12 +112,18 @@ def check_finite(arr: NDArray[np.float64], what: str) -> None:
 
 
 def check_configuration(q: ArrayLike, n: int, what: str = "q", finite: bool = True) -> NDArray[np.float64]:
-    """Return ``q`` as float array of shape (..., n), finite unless ``finite=False``."""
+    """Return ``q`` as float array of shape (..., n), finite and at most ``MAX_JOINT_VALUE`` in magnitude unless
+    ``finite=False``."""
     arr = as_float_array(q, what)
     if arr.ndim == 0 or arr.shape[-1] != n:
         raise ShapeError(f"{what} must have shape (..., {n}) for this {n}-joint robot, got shape {arr.shape}")
     if finite:
         check_finite(arr, what)
+        if arr.size and np.abs(arr).max() > MAX_JOINT_VALUE:
+            raise NonFiniteError(
+                f"{what}: joint values must be at most {MAX_JOINT_VALUE:g} in magnitude (radians or length unit), "
+                f"got {arr.ravel()[np.argmax(np.abs(arr))]:g}"
+            )
     return arr
 
 

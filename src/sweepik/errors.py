@@ -37,7 +37,7 @@ class ShapeError(SweepikError):
 
 
 class NonFiniteError(SweepikError):
-    """An input holds NaN or infinite values."""
+    """An input holds NaN or infinite values (or joint values beyond ``_validate.MAX_JOINT_VALUE``, 1e30)."""
 
 
 class InvalidPoseError(SweepikError):

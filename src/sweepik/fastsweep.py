@@ -56,7 +56,7 @@ FLAT_BISECT = _ref.FLAT_BISECT
 JUMP_NOISE = _ref.JUMP_NOISE
 MULT_LEVEL = _ref.MULT_LEVEL
 MULT_MAX = _ref.MULT_MAX
-#: Candidates and family spans kept per pose (the C-Arm has at most 8 solutions; edges and near misses add
+#: Candidates and family spans kept per pose (the C-Arm has at most 8 rail positions; edges and near misses add
 #: candidates). Overflow is reported and the pose is redone by the NumPy engine.
 MAX_CAND = 256
 MAX_FAM = 16
