@@ -17,7 +17,7 @@ import sweepik.cli_solve as cli_solve
 import sweepik.solver as solver
 from sweepik import load_robot, solve_many
 from sweepik.cli import main
-from sweepik.cli_common import _print_json, _print_json_stream, _Progress
+from sweepik.cli_common import _is_number, _print_json, _print_json_stream, _Progress
 from sweepik.trajectory import follow_path
 
 CARM = load_robot("carm")
@@ -50,14 +50,6 @@ def poses_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
 class _FakeTTY(io.StringIO):
     def isatty(self) -> bool:
         return True
-
-
-def _number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _set_chunk(monkeypatch: pytest.MonkeyPatch, chunk: int) -> None:
@@ -114,7 +106,7 @@ def test_solve_text_streamed_is_identical_whatever_the_chunk(
     assert [b.split(":")[0] for b in blocks] == [str(k) for k in range(1, 7)]
     sols = solve_many(CARM, _poses(), limits=False)
     for block, sol in zip(blocks, sols, strict=True):
-        rows = [r for r in map(str.split, block.splitlines()) if len(r) >= 8 and r[0].isdigit() and _number(r[1])]
+        rows = [r for r in map(str.split, block.splitlines()) if len(r) >= 8 and r[0].isdigit() and _is_number(r[1])]
         assert len(rows) == len(sol)
         shown = np.array([r[1:7] for r in rows], dtype=float).reshape(-1, 6)
         np.testing.assert_allclose(shown, np.where(CARM.is_revolute, np.degrees(sol.q), sol.q), atol=1e-9)

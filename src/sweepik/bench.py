@@ -22,8 +22,6 @@ from .robot_file import load_robot
 from .solver import Progress, solve, solve_many
 from .verify import grid_configurations, random_configurations
 
-#: ``progress(stage, done, total)``, called as the benchmarks advance (as in :mod:`sweepik.verify`).
-
 #: The paper's figure: 0.098 s per pose in Matlab.
 PAPER_SECONDS_PER_POSE = 0.098
 

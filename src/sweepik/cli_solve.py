@@ -37,6 +37,11 @@ from .solver import STRATEGIES, iter_solve
 Array = NDArray[np.float64]
 
 
+def _ik_kwargs(args: argparse.Namespace) -> dict[str, Any]:
+    """The solver's keyword arguments from the options of :func:`_add_ik_options`."""
+    return {"reduction": args.reduction, "strategy": args.strategy, "limits": not args.no_limits}
+
+
 def _add_ik_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--strategy", choices=STRATEGIES, default="precise", help="search strategy (default: precise)")
     p.add_argument(
@@ -176,14 +181,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     # the output streaming to the terminal shows the progress by itself: no progress line mixed into it
     progress = _Progress(enabled=not _isatty(sys.stdout))
     try:
-        sols = iter_solve(
-            robot,
-            poses,
-            reduction=args.reduction,
-            strategy=args.strategy,
-            limits=not args.no_limits,
-            progress=progress,
-        )
+        sols = iter_solve(robot, poses, progress=progress, **_ik_kwargs(args))
         if args.json:
             head = {
                 "robot": robot.name,
@@ -244,15 +242,7 @@ def cmd_path(args: argparse.Namespace) -> int:
     poses = load_poses(path)
     progress = _Progress()
     try:
-        res = follow_path(
-            robot,
-            poses,
-            start,
-            reduction=args.reduction,
-            strategy=args.strategy,
-            limits=not args.no_limits,
-            progress=progress,
-        )
+        res = follow_path(robot, poses, start, progress=progress, **_ik_kwargs(args))
     finally:
         progress.close()
     if args.output:

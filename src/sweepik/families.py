@@ -88,19 +88,18 @@ def _limit_excess(
 def _limit_dips(
     robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], grid: Array
 ) -> Array:
-    """``(K, M)`` extra samples for the family spans sampled at ``grid (K, M)``: where the limit excess has a
+    """``(K, D)`` extra samples for the family spans sampled at ``grid (K, M)``: where the limit excess has a
     local minimum above zero among the samples, the least excess between the neighbouring samples is located
-    (golden section); where it is inside the limits, that point is returned, elsewhere the span's first sample
-    (a harmless repeat)."""
+    (golden section); where it is inside the limits, that point is an extra sample. ``D`` is the most extra
+    samples of one span (0 in the common case); shorter rows repeat the span's first sample."""
     K, M = grid.shape
     e = _limit_excess(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel()).reshape(K, M)
     big = np.where(np.isfinite(e), e, np.inf)
     left = np.concatenate([np.full((K, 1), np.inf), big[:, :-1]], axis=1)
     right = np.concatenate([big[:, 1:], np.full((K, 1), np.inf)], axis=1)
     k, i = np.nonzero((big > 0) & np.isfinite(big) & (big <= left) & (big <= right))
-    extra = np.repeat(grid[:, :1], M, axis=1)
     if k.size == 0:
-        return extra
+        return np.zeros((K, 0))
     a, b = grid[k, np.maximum(i - 1, 0)], grid[k, np.minimum(i + 1, M - 1)]
     best_x, best_e = grid[k, i], big[k, i]
 
@@ -124,7 +123,12 @@ def _limit_dips(
         ec, ed = np.where(left, e_fresh, ed), np.where(left, ec, e_fresh)
         c, d = new_c, new_d
     found = best_e <= 0.0
-    extra[k[found], i[found]] = best_x[found]
+    rows = k[found]
+    width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
+    extra = np.repeat(grid[:, :1], width, axis=1)
+    # the j-th dip of a span goes to column j (rows are sorted: k comes from np.nonzero)
+    col = np.arange(rows.size) - np.searchsorted(rows, rows)
+    extra[rows, col] = best_x[found]
     return extra
 
 
