@@ -27,6 +27,12 @@ Q_GOOD = np.array([700.0, 0.4, 0.3, -0.5, 0.6, 0.2])
 GOOD_POSE = CARM.fk(Q_GOOD)
 MATRIX_ARGS = [repr(float(v)) for v in GOOD_POSE.ravel()]
 
+def _offset_last_joint(text: str) -> str:
+    """The C-Arm text with the last joint's axis 30 mm off joint 5's (its DH row ``a = 30``)."""
+    head, sep, tail = text.rpartition("a = 0.0\nalpha = 90.0")
+    return head + "a = 30.0\nalpha = 90.0" + tail
+
+
 
 def _cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
     code = main(argv)
@@ -119,7 +125,8 @@ def _robot_corpus() -> dict[str, tuple[bytes, bool]]:
         "negative_length_solve": CARM_TOML.replace("a = 350.0", "a = -350.0").encode(),
         "zero_d_solve": CARM_TOML.replace("d = 402.0", "d = 0.0").encode(),
         "unknown_reduction_solve": _field(CARM_TOML, "default_reduction", '"nope"').encode(),
-        "no_reduction_solve": CARM_TOML.replace('default_reduction = "carm-d1"\n', "").encode(),
+        # no default reduction and joints 5, 6 offset (no two axes meeting at either end): outside the catalogue
+        "no_reduction_solve": _offset_last_joint(CARM_TOML.replace('default_reduction = "carm-d1"\n', "")).encode(),
         "huge_alpha_solve": _field(CARM_TOML, "alpha", "45.0", 1).encode(),
     }
     for key in _TEXT_FIELDS:

@@ -12,6 +12,7 @@ __all__ = [
     "InvalidPoseError",
     "UnknownOptionError",
     "PoseFileError",
+    "NoReductionError",
 ]
 
 
@@ -53,3 +54,8 @@ class UnknownOptionError(SweepikError):
 class PoseFileError(SweepikError):
     """A pose file cannot be read: missing, a directory, unreadable, too large, unknown extension, not UTF-8, or
     content not in a supported layout; the message names the file."""
+
+
+class NoReductionError(SweepikError):
+    """No decomposition in sweepik's catalogue solves this arm (or not with the joint asked for as theta*); the
+    message names the structure found and what a decomposition would need."""

@@ -180,6 +180,16 @@ _DEDUPE_WINDOW = 16
 _DEDUPE_PAIRWISE = 48
 
 
+def _every_branch(n_poses: int, n_branches: int) -> Candidates:
+    """Candidates of a closed form: every branch of every pose (theta* unused: 0)."""
+    return Candidates(
+        pose=np.repeat(np.arange(n_poses), n_branches).astype(np.intp),
+        branch=np.tile(np.arange(n_branches), n_poses).astype(np.intp),
+        theta=np.zeros(n_poses * n_branches),
+        mult=np.ones(n_poses * n_branches, dtype=np.intp),
+    )
+
+
 def _solve_chunk(
     robot: Robot,
     red: Reduction,
@@ -196,8 +206,18 @@ def _solve_chunk(
     fams: dict[int, list[Family]]
     compiled = red.uses_kernel and fastsweep.AVAILABLE
     err_geo = err_paper = None
-    if strategy == "precise":
-        if compiled:
+    closed = red.closed_form
+    if strategy == "precise" or closed:
+        if closed:  # no sweep: every branch of the closed form is a candidate
+            params = red.kernel_params(chain) if compiled else None
+            cand = _every_branch(chain.shape[0], red.n_branches)
+            if compiled:
+                q, err_geo, err_paper = fastcertify.certify(
+                    robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
+                )
+            else:
+                q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+        elif compiled:
             params = red.kernel_params(chain)
             cand, spans = fastsweep.search(red, chain, lo, hi, n_samples, params)
             cand = _limit_copies(robot, red, cand, hi - lo)
@@ -417,6 +437,7 @@ def solve_many(
     poses: ArrayLike,
     *,
     reduction: str | Reduction | None = None,
+    free_joint: int | str | None = None,
     strategy: Strategy = "precise",
     limits: bool = True,
     n_samples: int = N_SAMPLES,
@@ -431,7 +452,14 @@ def solve_many(
     see :func:`solve`; :func:`iter_solve` yields the same results without holding them all.
     """
     it = iter_solve(
-        robot, poses, reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples, chunk_size=chunk_size
+        robot,
+        poses,
+        reduction=reduction,
+        free_joint=free_joint,
+        strategy=strategy,
+        limits=limits,
+        n_samples=n_samples,
+        chunk_size=chunk_size,
     )
     return list(it)
 
@@ -441,6 +469,7 @@ def iter_solve(
     poses: ArrayLike,
     *,
     reduction: str | Reduction | None = None,
+    free_joint: int | str | None = None,
     strategy: Strategy = "precise",
     limits: bool = True,
     n_samples: int = N_SAMPLES,
@@ -461,7 +490,8 @@ def iter_solve(
         raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
     if progress is not None and not callable(progress):
         raise UnknownOptionError(f"progress must be callable or None, got {type(progress).__name__}")
-    return _iter_checked(robot, P, *_prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size), progress)
+    prepared = _prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size, free_joint)
+    return _iter_checked(robot, P, *prepared, progress)
 
 
 def _prepare(
@@ -472,6 +502,7 @@ def _prepare(
     limits: bool,
     n_samples: int,
     chunk_size: int = CHUNK,
+    free_joint: int | str | None = None,
 ) -> tuple[Reduction, str, bool, int, int]:
     """Check the solver's arguments; the reduction and the checked (strategy, limits, n_samples, chunk size)."""
     if not isinstance(robot, Robot):
@@ -487,7 +518,7 @@ def _prepare(
         raise UnknownOptionError(
             f"reduction must be a name, a Reduction instance or None, got {type(reduction).__name__}"
         )
-    red = get_reduction(robot, reduction)
+    red = get_reduction(robot, reduction, _free_joint_index(robot, free_joint, reduction))
     if red.robot != robot:
         raise UnknownOptionError(
             f"the reduction {red.name!r} was built for robot {red.robot.name!r}, not for {robot.name!r}"
@@ -497,6 +528,19 @@ def _prepare(
     else:
         chunk_size = min(chunk_size, max(1, SAMPLE_BUDGET // n_samples))
     return red, strategy, limits, n_samples, chunk_size
+
+
+def _free_joint_index(robot: Robot, free_joint: object, reduction: object) -> int | None:
+    """``free_joint`` (an index from 0, or a joint name) as an index; None if not given."""
+    if free_joint is None:
+        return None
+    if reduction is not None:
+        raise UnknownOptionError("give either reduction= or free_joint=, not both (a reduction fixes its theta*)")
+    if isinstance(free_joint, str):
+        if free_joint not in robot.joint_names:
+            raise UnknownOptionError(f"free_joint {free_joint!r} is not a joint of {robot.name!r}: {robot.joint_names}")
+        return robot.joint_names.index(free_joint)
+    return check_int(free_joint, "free_joint", 0, robot.n_joints - 1)
 
 
 def _iter_checked(
@@ -526,8 +570,10 @@ def _solve_checked(
     limits: bool,
     n_samples: int,
     chunk_size: int = CHUNK,
+    free_joint: int | str | None = None,
 ) -> list[Solutions]:
-    return list(_iter_checked(robot, P, *_prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size)))
+    prepared = _prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size, free_joint)
+    return list(_iter_checked(robot, P, *prepared))
 
 
 def solve(
@@ -535,6 +581,7 @@ def solve(
     pose: ArrayLike,
     *,
     reduction: str | Reduction | None = None,
+    free_joint: int | str | None = None,
     strategy: Strategy = "precise",
     limits: bool = True,
     n_samples: int = N_SAMPLES,
@@ -544,8 +591,11 @@ def solve(
     Args:
         robot: the arm (e.g. ``load_robot("carm")``).
         pose: target tool pose.
-        reduction: name (``"carm-d1"``, ``"carm-theta2"``), a Reduction instance, or None for the
-            robot's default.
+        reduction: name (``"auto"``, ``"carm-d1"``, ``"carm-theta2"``), a Reduction instance, or None: the
+            robot's ``default_reduction`` if its file names one, else ``"auto"``, the decomposition derived from
+            the arm's geometry (``sweepik.analyze`` shows it).
+        free_joint: with the automatic decomposition, the joint to sweep as theta* (index from 0, or name);
+            NoReductionError if no decomposition sweeps it. Not together with ``reduction``.
         strategy: ``"precise"`` (every root to full precision, double roots and close roots included) or
             ``"paper"`` (the paper's 10 mm sweep refined to 0.001 mm, J < 1e-5 mm).
         limits: drop solutions outside the joint limits (True) or keep and flag them (False); a bool (or NumPy
@@ -557,7 +607,8 @@ def solve(
     Raises:
         SweepikError subclasses: a pose that is not a rigid transform or not real numbers (ShapeError,
         InvalidPoseError, NonFiniteError), ``robot`` not a :class:`~sweepik.robot.Robot`, an unknown or ill-typed
-        option (UnknownOptionError), a reduction that does not fit.
+        option (UnknownOptionError), a reduction that does not fit, an arm outside the catalogue of
+        decompositions (NoReductionError, naming the structure found).
 
     >>> import numpy as np
     >>> from sweepik import load_robot, solve
@@ -570,4 +621,4 @@ def solve(
     P = check_poses(pose, "pose")
     if P.shape != (4, 4):
         raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
-    return _solve_checked(robot, P[None], reduction, strategy, limits, n_samples)[0]
+    return _solve_checked(robot, P[None], reduction, strategy, limits, n_samples, CHUNK, free_joint)[0]

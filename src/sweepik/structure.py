@@ -27,7 +27,7 @@ from .chain import Chain
 
 Array = NDArray[np.float64]
 
-__all__ = ["Structure", "structure_of", "PARALLEL_TOL", "INTERSECT_TOL_REL"]
+__all__ = ["Structure", "structure_of", "line_relation", "PARALLEL_TOL", "INTERSECT_TOL_REL"]
 
 #: Two axes are parallel when the sine of the angle between them is below this (radians). Published arm
 #: parameters are exact (90 degrees, 0 mm); rounding a right angle to 7 digits (1.570796) is 3e-7 off.
@@ -36,7 +36,7 @@ PARALLEL_TOL = 1e-9
 INTERSECT_TOL_REL = 1e-9
 
 
-def _line_relation(h1: Array, o1: Array, h2: Array, o2: Array, dist_tol: float) -> tuple[str, Array | None]:
+def line_relation(h1: Array, o1: Array, h2: Array, o2: Array, dist_tol: float) -> tuple[str, Array | None]:
     """('parallel' | 'coincident' | 'intersecting' | 'skew', meeting point or None) of two lines."""
     n = np.cross(h1, h2)
     s = float(np.linalg.norm(n))
@@ -131,7 +131,7 @@ def structure_of(chain: Chain, length_scale: float, tol_rel: float = INTERSECT_T
     points: dict[tuple[int, int], tuple[float, float, float]] = {}
     for i in range(n - 1):
         if rev[i] and rev[i + 1]:
-            rel, pt = _line_relation(H[i], pts[i], H[i + 1], pts[i + 1], tol)
+            rel, pt = line_relation(H[i], pts[i], H[i + 1], pts[i + 1], tol)
         else:
             rel, pt = ("parallel" if np.linalg.norm(np.cross(H[i], H[i + 1])) < PARALLEL_TOL else "skew"), None
         pairs.append(rel)

@@ -9,8 +9,13 @@ from ..errors import UnknownOptionError
 from ..robot import Robot
 from .base import Reduction
 from .carm import CArmD1, CArmTheta2
+from .decompose import choose
+from .generic import GeometricReduction, Plan
 
-__all__ = ["Reduction", "CArmD1", "CArmTheta2", "REDUCTIONS", "get_reduction"]
+__all__ = ["Reduction", "CArmD1", "CArmTheta2", "GeometricReduction", "Plan", "REDUCTIONS", "get_reduction", "AUTO"]
+
+#: Name of the reduction derived from the arm's geometry (``reductions.decompose``).
+AUTO = "auto"
 
 #: Registry: name -> factory(robot). Factories raise RobotDefinitionError for robots they do not fit.
 REDUCTIONS: dict[str, Callable[[Robot], Reduction]] = {
@@ -21,26 +26,30 @@ REDUCTIONS: dict[str, Callable[[Robot], Reduction]] = {
 _ALIASES = {"d1": "carm-d1", "theta2": "carm-theta2"}
 
 
-def get_reduction(robot: Robot, reduction: str | Reduction | None) -> Reduction:
-    """Resolve ``reduction`` (None: the robot's default; a name; or an instance) for ``robot``."""
+def get_reduction(robot: Robot, reduction: str | Reduction | None, free_joint: int | None = None) -> Reduction:
+    """Resolve ``reduction`` for ``robot``: an instance as is; a name (``"auto"``: derived from the arm's
+    geometry); None: the robot's ``default_reduction`` if it names one, else ``"auto"``. ``free_joint`` (a joint
+    index) asks the automatic decomposition for that theta*. NoReductionError when no decomposition applies."""
     if isinstance(reduction, Reduction):
         return reduction
     if reduction is None:
-        if robot.default_reduction is None:
-            raise UnknownOptionError(
-                f"robot {robot.name!r} names no default reduction; pass reduction= one of {sorted(REDUCTIONS)} "
-                "or a Reduction instance"
-            )
-        reduction = robot.default_reduction
+        reduction = AUTO if free_joint is not None else (robot.default_reduction or AUTO)
     name = _ALIASES.get(reduction, reduction)
+    if name == AUTO:
+        return _automatic(robot, free_joint)
     if name not in REDUCTIONS:
         raise UnknownOptionError(
-            f"unknown reduction {reduction!r}; choose one of {sorted(REDUCTIONS) + sorted(_ALIASES)}"
+            f"unknown reduction {reduction!r}; choose one of {sorted(REDUCTIONS) + sorted(_ALIASES) + [AUTO]}"
         )
     return _cached(robot, name)
 
 
 @lru_cache(maxsize=64)
 def _cached(robot: Robot, name: str) -> Reduction:
-    # Robots are immutable and hash by identity: one reduction instance per (robot, name).
+    # Robots are values (equal and hashed by content): one reduction instance per (robot, name).
     return REDUCTIONS[name](robot)
+
+
+@lru_cache(maxsize=64)
+def _automatic(robot: Robot, free_joint: int | None) -> Reduction:
+    return GeometricReduction(robot, choose(robot, free_joint))

@@ -57,6 +57,8 @@ class Reduction(ABC):
     #: Compiled scalar kernels ``(residual, configuration)`` with the signatures ``reductions.kernels.RESIDUAL_SIG``
     #: and ``CONFIGURATION_SIG`` over rows of ``kernel_params(poses)`` (None: the NumPy engine is used).
     kernel: tuple[Any, Any] | None = None
+    #: No sweep: every branch of ``solve_rest`` (at any theta*) is a candidate (a closed-form decomposition).
+    closed_form: bool = False
 
     @property
     def uses_kernel(self) -> bool:

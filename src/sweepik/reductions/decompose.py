@@ -1,0 +1,279 @@
+"""Automatic decomposition: from a robot's geometry to every plan that solves it, and the choice among them.
+
+Detect (``Robot.structure``), then choose (``plans``: every family, theta* and position case that applies, on
+the chain and on the reversed chain; ``choose``: the best), then solve (:class:`.generic.GeometricReduction`).
+
+A position case applies when its structural condition holds for **every** value of theta*: the reduced chain
+(:func:`.position.reduce_chain`) is checked at several theta* values. Distances are judged relative to the
+arm's length scale (``structure.INTERSECT_TOL_REL``), directions with ``structure.PARALLEL_TOL``.
+
+Ranking (``_rank``): a closed form before a sweep; a plan without a blind spot (``Plan.conditional``) before
+one with; fewer branches (less work per sample); the forward chain before the reversed; the lower theta*.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+
+from ..chain import Chain
+from ..errors import NoReductionError
+from ..robot import Robot
+from ..structure import INTERSECT_TOL_REL, PARALLEL_TOL, Structure, line_relation, structure_of
+from .generic import Plan
+from .position import BRANCHES, CASES, reduce_chain
+
+_reduce_chain: Any = reduce_chain
+
+__all__ = ["plans", "choose", "explain"]
+
+#: theta* values at which a case's condition is checked (revolute theta*; a prismatic one uses fractions of its
+#: range): generic angles, so that a relation holding at all of them holds for every angle.
+_ANGLES = (0.0, 0.9, 2.1, -1.3, -2.8)
+_FRACTIONS = (0.5, 0.1, 0.9, 0.3, 0.7)
+#: A dot product entering a division must exceed this (it is a cosine between unit vectors) ...
+MIN_DOT = 1e-6
+#: ... and is theta*-dependent (the plan has a blind spot) when it varies across the samples by more than this.
+VARY_TOL = 1e-9
+
+
+def _t(v: Any) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def _reduced(chain: Chain, W: np.ndarray, f: int, x: float) -> tuple[np.ndarray, ...]:
+    """``(ha, hb, hc, pab, pbc, pcw)`` of the reduced chain with joint f at x (see position.reduce_chain)."""
+    H, P, rev = chain.H, chain.P, chain.revolute
+    o3 = P[:4].sum(axis=0)
+    out = _reduce_chain(  # a compiled function of tuples
+        *(_t(H[i]) for i in range(4)),
+        *(bool(rev[i]) for i in range(4)),
+        *(_t(P[i]) for i in range(4)),
+        _t(W - o3),
+        f,
+        float(x),
+        _t(W),
+    )
+    return tuple(np.array(v) for v in out[1:])
+
+
+def _dist_to_line(p: np.ndarray, o: np.ndarray, h: np.ndarray) -> float:
+    d = p - o
+    return float(np.linalg.norm(d - np.dot(d, h) * h))
+
+
+def _parallel(u: np.ndarray, v: np.ndarray) -> bool:
+    return float(np.linalg.norm(np.cross(u, v))) < PARALLEL_TOL
+
+
+def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.ndarray, ...]], tol: float):
+    """``(applies, conditional, meeting point relative to joint a (ab_int) or b (bc_int) at the first sample)``."""
+    ra, rb, rc = types
+    no = (False, False, None)
+    geo = []
+    for ha, hb, hc, pab, pbc, pcw in samples:
+        oa = np.zeros(3)
+        ob = pab
+        oc = pab + pbc
+        geo.append((ha, hb, hc, oa, ob, oc, oc + pcw))
+
+    def dots(u_of: Any) -> tuple[bool, bool]:
+        vals = np.array([u_of(g) for g in geo])
+        if np.min(np.abs(vals)) < MIN_DOT:
+            return False, False
+        return True, bool(np.ptp(vals) > VARY_TOL)
+
+    if case in ("ab_par", "bc_par"):
+        i, j = (0, 1) if case == "ab_par" else (1, 2)
+        if not (types[i] and types[j]) or not all(_parallel(g[i], g[j]) for g in geo):
+            return no
+        if any(_dist_to_line(g[3 + j], g[3 + i], g[i]) < tol for g in geo):  # coincident axes
+            return no
+        k = 2 if case == "ab_par" else 0  # the joint solved first
+        if types[k]:
+            if all(_parallel(g[k], g[i]) for g in geo):  # three parallel: the height says nothing
+                return no
+            if case == "ab_par" and any(_dist_to_line(g[6], g[5], g[2]) < tol for g in geo):
+                return no
+            return True, False, None
+        ok, cond = dots(lambda g: float(np.dot(g[k], g[i])))
+        return ok, cond, None
+    if case in ("ab_int", "bc_int"):
+        i, j = (0, 1) if case == "ab_int" else (1, 2)
+        if not (types[i] and types[j]):
+            return no
+        points = []
+        for g in geo:
+            rel, pt = line_relation(g[i], g[3 + i], g[j], g[3 + j], tol)
+            if rel != "intersecting" or pt is None:
+                return no
+            points.append(pt - g[3 + i])
+        if case == "ab_int" and any(np.linalg.norm(p - points[0]) > tol for p in points):
+            return no
+        k = 2 if case == "ab_int" else 0
+        if types[k]:
+            for g, p in zip(geo, points, strict=True):
+                centre = g[3 + i] + p
+                if _dist_to_line(centre, g[3 + k], g[k]) < tol:  # all three axes through one point
+                    return no
+                if case == "ab_int" and _dist_to_line(g[6], g[5], g[2]) < tol:
+                    return no
+        return True, False, points[0]
+    if case == "ppp":
+        if any(types):
+            return no
+        ok, cond = dots(lambda g: float(np.dot(g[0], np.cross(g[1], g[2]))))
+        return ok, cond, None
+    if case == "ppr":
+        if ra or rb or not rc:
+            return no
+        ok, cond = dots(lambda g: float(np.linalg.norm(np.cross(g[0], g[1]))))
+        if not ok or all(_parallel(np.cross(g[0], g[1]), g[2]) for g in geo):
+            return no
+        if any(_dist_to_line(g[6], g[5], g[2]) < tol for g in geo):
+            return no
+        return True, cond, None
+    if case == "ac_par":
+        if not (ra and rc) or rb or not all(_parallel(g[0], g[2]) for g in geo):
+            return no
+        ok, cond = dots(lambda g: float(np.dot(g[0], g[1])))
+        return ok, cond, None
+    return no
+
+
+def _samples(robot: Robot, chain_index: int, prismatic: bool) -> list[float]:
+    if not prismatic:
+        return list(_ANGLES)
+    lo, hi = float(robot.lower[chain_index]), float(robot.upper[chain_index])
+    if not (np.isfinite(lo) and np.isfinite(hi)) or hi - lo > 1e6 * robot.length_scale:
+        lo, hi = -robot.length_scale, robot.length_scale
+    return [lo + fr * (hi - lo) for fr in _FRACTIONS]
+
+
+def _position_plans(robot: Robot, chain: Chain, rev_chain: bool, W: np.ndarray, frees: tuple[int, ...], family: str):
+    out = []
+    tol = INTERSECT_TOL_REL * robot.length_scale
+    for f in frees:
+        others = [i for i in range(4) if i != f]
+        types = tuple(bool(chain.revolute[i]) for i in others)
+        robot_f = 5 - f if rev_chain else f
+        xs = _samples(robot, robot_f, not chain.revolute[f])
+        samples = [_reduced(chain, W, f, x) for x in xs]
+        pts = np.cumsum(chain.P[:4], axis=0)
+        for case in CASES:
+            ok, cond, rel = _check(case, types, samples, tol)  # type: ignore[arg-type]
+            if not ok:
+                continue
+            nb = BRANCHES[case][0]
+            if case in ("ab_par",):
+                nb = BRANCHES[case][0 if types[2] else 1]
+            elif case in ("bc_par",):
+                nb = BRANCHES[case][0 if types[0] else 1]
+            meet = np.zeros(3)
+            if rel is not None:
+                meet = pts[others[0] if case == "ab_int" else others[1]] + rel
+            out.append(
+                Plan(
+                    family=family,
+                    reversed=rev_chain,
+                    free=f,
+                    case=case,
+                    branches=2 * nb if family == "wrist" else nb,
+                    W=_t(W),
+                    meet=_t(meet),
+                    conditional=cond,
+                )
+            )
+    return out
+
+
+def _rank(p: Plan) -> tuple[int, int, int, int, int]:
+    return (0 if p.closed_form else 1, int(p.conditional), p.branches, int(p.reversed), p.free)
+
+
+def _structures(robot: Robot) -> list[tuple[bool, Chain, Structure]]:
+    out = []
+    for rev_chain in (False, True):
+        chain = robot.chain.reversed() if rev_chain else robot.chain
+        out.append((rev_chain, chain, structure_of(chain, robot.length_scale)))
+    return out
+
+
+@lru_cache(maxsize=64)
+def plans(robot: Robot) -> tuple[Plan, ...]:
+    """Every plan that solves ``robot``, best first (empty: none in the catalogue). Cached per robot (by value)."""
+    if robot.n_joints != 6:
+        return ()
+    found: list[Plan] = []
+    for rev_chain, chain, st in _structures(robot):
+        rev = chain.revolute
+        if rev[3] and rev[4] and rev[5] and st.common_point((3, 4, 5)):
+            W = np.array(st.points[(3, 4)])
+            found += _position_plans(robot, chain, rev_chain, W, (3,), "wrist")
+        if rev[4] and rev[5] and st.intersecting(4, 5):
+            W = np.array(st.points[(4, 5)])
+            found += _position_plans(robot, chain, rev_chain, W, (0, 1, 2, 3), "pair")
+    return tuple(sorted(found, key=_rank))
+
+
+def _missing(robot: Robot) -> str:
+    st = robot.structure()
+    return (
+        f"robot {robot.name!r} ({st.describe()}) is outside sweepik's catalogue: a decomposition needs the last two "
+        "axes (or the first two) revolute and meeting at a point, with the other joints placing that point by "
+        "subproblems (two of them parallel or intersecting, or prismatic)"
+    )
+
+
+def choose(robot: Robot, free_joint: int | None = None) -> Plan:
+    """The best plan for ``robot`` (with theta* = ``free_joint`` if given); NoReductionError if there is none."""
+    options = plans(robot)
+    if free_joint is not None:
+        options = tuple(p for p in options if not p.closed_form and p.free_joint == free_joint)
+        if not options:
+            avail = sorted({p.free_joint + 1 for p in plans(robot) if not p.closed_form})
+            raise NoReductionError(
+                f"robot {robot.name!r}: no decomposition sweeps joint {free_joint + 1} "
+                f"({robot.joint_names[free_joint]}); joints that can be swept: {avail or 'none'}"
+            )
+        return options[0]
+    usable = [p for p in options if not p.conditional]
+    if not usable:
+        if options:
+            return options[0]
+        raise NoReductionError(_missing(robot))
+    return usable[0]
+
+
+def explain(robot: Robot) -> dict[str, Any]:
+    """Plain values for ``sweepik analyze``: structure, every plan, the chosen one (or why none)."""
+    st = robot.structure()
+    found = plans(robot)
+    info: dict[str, Any] = {
+        "robot": robot.name,
+        "structure": st.describe(),
+        "plans": [_plan_dict(robot, p) for p in found],
+    }
+    try:
+        info["chosen"] = _plan_dict(robot, choose(robot))
+        info["reason"] = None
+    except NoReductionError as e:
+        info["chosen"] = None
+        info["reason"] = str(e)
+    return info
+
+
+def _plan_dict(robot: Robot, p: Plan) -> dict[str, Any]:
+    return {
+        "family": p.family,
+        "closed_form": p.closed_form,
+        "free_joint": None if p.closed_form else p.free_joint + 1,
+        "free_joint_name": None if p.closed_form else robot.joint_names[p.free_joint],
+        "chain": "reversed" if p.reversed else "forward",
+        "case": p.case,
+        "branches": p.branches,
+        "blind_spot": p.conditional,
+        "steps": p.steps(),
+    }

@@ -1,0 +1,156 @@
+"""``GeometricReduction``: a reduction derived from the arm's geometry, run by the generic compiled engine.
+
+It holds a :class:`Plan` (which family, which joint is theta*, which position case, forward or reversed chain)
+and turns chain poses into the family's parameter rows (``geometric.LAYOUT``). Nothing in it is specific to an
+arm: :mod:`.decompose` finds the plans of a robot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..chain import Chain
+from ..robot import Robot
+from . import geometric
+from .base import Array, IntArray, Reduction
+from .position import CASES
+
+
+@dataclass(frozen=True)
+class Plan:
+    """One way to solve an arm: ``family`` ('pair': sweep theta*, 'wrist': closed form) on the forward or
+    ``reversed`` chain, with ``free`` (0-3, in the solved chain's order) the fixed joint among the first four
+    and ``case`` the position case placing the wrist centre ``W``; ``meet`` the meeting point of the axes that
+    case uses (zero configuration, world frame)."""
+
+    family: str
+    reversed: bool
+    free: int
+    case: str
+    branches: int
+    W: tuple[float, float, float]
+    meet: tuple[float, float, float]
+    #: theta* enters a division (a line-plane or lines step whose direction turns with theta*): the plan has a
+    #: blind spot where that product vanishes and is chosen only on request.
+    conditional: bool = False
+
+    @property
+    def closed_form(self) -> bool:
+        return self.family == "wrist"
+
+    def joint(self, i: int) -> int:
+        """Robot index of joint ``i`` of the solved chain."""
+        return 5 - i if self.reversed else i
+
+    @property
+    def free_joint(self) -> int:
+        """Robot index of theta* (for the closed form: the joint the family fixes, which does not move ``W``)."""
+        return self.joint(self.free)
+
+    def steps(self) -> list[str]:
+        """The subproblem chain, in words (joints numbered from 1 as the robot numbers them)."""
+        others = [i for i in range(4) if i != self.free]
+        a, b, c = (self.joint(i) + 1 for i in others)
+        place = f"joints {a}, {b}, {c} place the wrist centre ({self.case})"
+        if self.family == "wrist":
+            j4, j5, j6 = (self.joint(i) + 1 for i in (3, 4, 5))
+            return [place, f"joints {j4}, {j5}: sp2 on joint {j6}'s axis", f"joint {j6}: sp1"]
+        j5, j6 = self.joint(4) + 1, self.joint(5) + 1
+        return [
+            f"sweep joint {self.free_joint + 1}",
+            place,
+            f"residual: angle of joint {j5}'s axis to joint {j6}'s in the target",
+            f"joints {j5}, {j6}: sp1",
+        ]
+
+
+def _chain_rows(chain: Chain) -> Array:
+    row = np.zeros(geometric.N_PARAMS)
+    L = geometric.LAYOUT
+    row[L["H"] : L["H"] + 18] = chain.H.reshape(-1)
+    row[L["P"] : L["P"] + 21] = chain.P.reshape(-1)
+    row[L["rev"] : L["rev"] + 6] = chain.revolute
+    return row
+
+
+class GeometricReduction(Reduction):
+    """A reduction from a :class:`Plan`: the family's compiled kernels over the generic parameter row."""
+
+    #: Set per instance (the family's pair); declared here so that ``uses_kernel`` sees this class as its owner.
+    kernel: tuple[Any, Any] | None = None
+
+    def __init__(self, robot: Robot, plan: Plan) -> None:
+        super().__init__(robot, plan.free_joint, plan.branches)
+        self.plan = plan
+        self.name = f"{plan.family}-{robot.joint_names[plan.free_joint]}" if plan.family == "pair" else "closed-form"
+        self.closed_form = plan.closed_form
+        chain = robot.chain.reversed() if plan.reversed else robot.chain
+        self._chain = chain
+        L = geometric.LAYOUT
+        row = _chain_rows(chain)
+        row[L["W"] : L["W"] + 3] = plan.W
+        row[L["O"] : L["O"] + 3] = plan.meet
+        row[L["free"]] = plan.free
+        row[L["case"]] = CASES.index(plan.case)
+        row[L["reversed"]] = float(plan.reversed)
+        row[L["pos_branches"]] = plan.branches // 2 if plan.closed_form else plan.branches
+        self._row = row
+        # the wrist centre in the tool frame (the last joints do not move it)
+        p_end = chain.P.sum(axis=0)
+        self._w_tool = chain.R_end.T @ (np.asarray(plan.W) - p_end)
+        self._kernels = (
+            (geometric.wrist_residual, geometric.wrist_configuration)
+            if plan.closed_form
+            else (geometric.pair_residual, geometric.pair_configuration)
+        )
+        self.kernel = self._kernels
+
+    def kernel_params(self, poses: Array) -> Array:
+        """Parameter rows ``(N, N_PARAMS)`` of chain poses ``(N, 4, 4)``."""
+        robot = self.robot
+        world = poses
+        if not robot.base_is_identity:
+            world = robot.T_world_base @ world
+        if not robot.tool_is_identity:
+            world = world @ robot.T_flange_tool
+        if self.plan.reversed:
+            R = np.swapaxes(world[:, :3, :3], -1, -2)
+            p = -np.einsum("nij,nj->ni", R, world[:, :3, 3])
+        else:
+            R, p = world[:, :3, :3], world[:, :3, 3]
+        L = geometric.LAYOUT
+        out = np.broadcast_to(self._row, (poses.shape[0], geometric.N_PARAMS)).copy()
+        out[:, L["M"] : L["M"] + 9] = (R @ self._chain.R_end.T).reshape(-1, 9)
+        out[:, L["t"] : L["t"] + 3] = p + R @ self._w_tool
+        return out
+
+    def _flat(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, IntArray, Array, IntArray]:
+        N, M = theta.shape
+        params = self.kernel_params(poses)
+        if branch is None:
+            B = self.n_branches
+            pose = np.repeat(np.arange(N), M * B)
+            th = np.repeat(theta.reshape(-1), B)
+            br = np.tile(np.arange(B), N * M)
+        else:
+            pose = np.repeat(np.arange(N), M)
+            th = theta.reshape(-1)
+            br = np.broadcast_to(branch, theta.shape).reshape(-1)
+        return params, pose.astype(np.int64), np.ascontiguousarray(th, dtype=np.float64), br.astype(np.int64)
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
+        params, pose, th, br = self._flat(poses, theta, branch)
+        out = np.empty(th.shape[0])
+        geometric.evaluate(self._kernels[0], params, pose, th, br, out)
+        shape = theta.shape if branch is not None else (*theta.shape, self.n_branches)
+        return out.reshape(shape)
+
+    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        params, pose, th, br = self._flat(poses, theta, branch)
+        out = np.empty((th.shape[0], 6))
+        geometric.configure(self._kernels[1], params, pose, th, br, out)
+        shape = theta.shape if branch is not None else (*theta.shape, self.n_branches)
+        return out.reshape(*shape, 6)

@@ -1,0 +1,210 @@
+"""Kinematic families built from subproblems: one compiled kernel per family, over a generic parameter row.
+
+A family knows no arm: it reads the chain's product-of-exponentials geometry (:mod:`sweepik.chain`) and the
+target from the parameter row (``LAYOUT``), which :mod:`.decompose` fills from the robot's structure. Two families:
+
+``pair`` (one joint swept): the last two axes are revolute and meet at a point ``W`` (a wrist centre) that only
+    the first four joints move. Fix one of those four (theta*), place ``W`` with the other three (a case of
+    :mod:`.position`), and what is left is the orientation: joints 5 and 6 can turn the tool onto its target
+    orientation exactly when joint 5's axis keeps its angle to joint 6's axis in the target, so the signed
+    residual is ``h5 . (R_04^T R_target h6) - h5 . h6`` (dimensionless, built from vectors: no angle wrap);
+    joints 5 and 6 then follow from ``sp1``. Branches: those of the position case.
+
+``wrist`` (closed form, no sweep): the last three axes are revolute and meet at ``W``. The first three joints
+    place ``W`` (a case of :mod:`.position` with joint 4 fixed at any value: it does not move ``W``), joints 4
+    and 5 turn joint 6's axis onto its target (``sp2``, 2 branches) and joint 6 follows from ``sp1``. Every
+    branch gives a configuration (least squares where it has no exact one); FK certification keeps the solutions.
+
+A structure at the base is the same structure at the tool of the reversed chain solving the inverse pose
+(``Chain.reversed``): the parameter row then holds the reversed chain and the kernel writes the joints back in
+the robot's order.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from ..subproblems import sp1, sp2
+from ..subproblems.vec import dot, orthogonal, rot, sub
+from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG
+from .position import place, reduce_chain
+
+Array = NDArray[np.float64]
+
+#: Parameter row: offsets of each field (a generic layout, the same for every arm and family).
+LAYOUT = {
+    "H": 0,  # joint axes (6, 3) of the chain solved (reversed for a structure at the base)
+    "P": 18,  # segments (7, 3)
+    "rev": 39,  # joint types (6,): 1 revolute, 0 prismatic
+    "M": 45,  # target orientation R_target @ R_end^T (3, 3), row-major
+    "t": 54,  # target position of the wrist centre W
+    "W": 57,  # W at the zero configuration
+    "O": 60,  # meeting point of the position case's intersecting axes, zero configuration
+    "free": 63,  # theta*: index (0-3) of the swept joint among the first four; 3 for the wrist family
+    "case": 64,  # position case (index into position.CASES)
+    "reversed": 65,  # 1: the chain is reversed, joints are written back in reverse order
+    "pos_branches": 66,  # branches of the position case (the wrist family multiplies them by 2)
+}
+N_PARAMS = 67
+
+
+@njit(cache=True)
+def _v(p, i):
+    return (p[i], p[i + 1], p[i + 2])
+
+
+@njit(cache=True)
+def _h(p, i):
+    return _v(p, 3 * i)
+
+
+@njit(cache=True)
+def _mat(p, v):
+    """``M v`` for the target orientation ``M`` of the row."""
+    m = 45
+    return (
+        p[m] * v[0] + p[m + 1] * v[1] + p[m + 2] * v[2],
+        p[m + 3] * v[0] + p[m + 4] * v[1] + p[m + 5] * v[2],
+        p[m + 6] * v[0] + p[m + 7] * v[1] + p[m + 8] * v[2],
+    )
+
+
+@njit(cache=True)
+def _arm(p, x, branch):
+    """Values ``(q0, q1, q2, q3)`` of the first four joints with joint ``free`` at ``x`` (NaN: no branch)."""
+    h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
+    r0, r1, r2, r3 = p[39] > 0.5, p[40] > 0.5, p[41] > 0.5, p[42] > 0.5
+    s0, s1, s2, s3 = _v(p, 18), _v(p, 21), _v(p, 24), _v(p, 27)
+    o1 = (s0[0] + s1[0], s0[1] + s1[1], s0[2] + s1[2])
+    o2 = (o1[0] + s2[0], o1[1] + s2[1], o1[2] + s2[2])
+    o3 = (o2[0] + s3[0], o2[1] + s3[1], o2[2] + s3[2])
+    s4 = sub(_v(p, 57), o3)
+    f = int(p[63])
+    case = int(p[64])
+    tp, ha, hb, hc, pab, pbc, pcw = reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, _v(p, 54))
+    meet = _v(p, 60)
+    rev = (r0, r1, r2, r3)
+    pts = (s0, o1, o2, o3)
+    a = 1 if f == 0 else 0
+    b = 2 if f <= 1 else 1
+    c = 2 if f == 3 else 3
+    if case == 2:
+        o = sub(meet, pts[a])
+    else:
+        o = sub(meet, pts[b])
+        if f == 1 and r1:
+            o = rot(h1, x, o)
+    qa, qb, qc = place(case, branch, tp, ha, hb, hc, rev[a], rev[b], rev[c], pab, pbc, pcw, o)
+    if f == 0:
+        return x, qa, qb, qc
+    if f == 1:
+        return qa, x, qb, qc
+    if f == 2:
+        return qa, qb, x, qc
+    return qa, qb, qc, x
+
+
+@njit(cache=True)
+def _back(p, q0, q1, q2, q3, v):
+    """``R_04^T v``: ``v`` seen from frame 4 (revolute joints among the first four undone, last first)."""
+    qs = (q0, q1, q2, q3)
+    for i in range(4):
+        if p[39 + i] > 0.5:
+            v = rot(_h(p, i), -qs[i], v)
+    return v
+
+
+@njit(cache=True)
+def _fore(p, q0, q1, q2, q3, v):
+    """``R_04 v``."""
+    qs = (q0, q1, q2, q3)
+    for i in range(3, -1, -1):
+        if p[39 + i] > 0.5:
+            v = rot(_h(p, i), qs[i], v)
+    return v
+
+
+def _pair_residual(p, x, branch):
+    q0, q1, q2, q3 = _arm(p, x, branch)
+    if math.isnan(q0 + q1 + q2 + q3):
+        return math.nan
+    h4, h5 = _h(p, 4), _h(p, 5)
+    return dot(_fore(p, q0, q1, q2, q3, h4), _mat(p, h5)) - dot(h4, h5)
+
+
+@njit(cache=True)
+def _last_two(p, q0, q1, q2, q3, h4, h5):
+    """Joints 5 and 6 (indices 4, 5) turning the tool onto the target, given the first four."""
+    q4, _ = sp1(h5, _back(p, q0, q1, q2, q3, _mat(p, h5)), h4)
+    e = orthogonal(h5)
+    q5, _ = sp1(e, rot(h4, -q4, _back(p, q0, q1, q2, q3, _mat(p, e))), h5)
+    return q4, q5
+
+
+@njit(cache=True)
+def _write(p, out, q0, q1, q2, q3, q4, q5):
+    qs = (q0, q1, q2, q3, q4, q5)
+    rev = p[65] > 0.5
+    for i in range(6):
+        out[5 - i if rev else i] = qs[i]
+
+
+def _pair_configuration(p, x, branch, out):
+    q0, q1, q2, q3 = _arm(p, x, branch)
+    if math.isnan(q0 + q1 + q2 + q3):
+        for i in range(6):
+            out[i] = math.nan
+        return
+    q4, q5 = _last_two(p, q0, q1, q2, q3, _h(p, 4), _h(p, 5))
+    _write(p, out, q0, q1, q2, q3, q4, q5)
+
+
+def _wrist_configuration(p, x, branch, out):
+    nb = int(p[66])
+    q0, q1, q2, _ = _arm(p, 0.0, branch // 2)
+    if math.isnan(q0 + q1 + q2) or branch >= 2 * nb:
+        for i in range(6):
+            out[i] = math.nan
+        return
+    h3, h4, h5 = _h(p, 3), _h(p, 4), _h(p, 5)
+    v = _back(p, q0, q1, q2, 0.0, _mat(p, h5))
+    t1a, t2a, t1b, t2b, c = sp2(v, h5, h3, h4)
+    if math.isnan(c):  # joint 6's axis on joint 4's: a continuum (wrist singular); one member
+        q3 = 0.0
+        q4, _ = sp1(h5, v, h4)
+    elif branch % 2 == 0:
+        q3, q4 = -t1a, t2a
+    else:
+        q3, q4 = -t1b, t2b
+    e = orthogonal(h5)
+    w = rot(h4, -q4, rot(h3, -q3, _back(p, q0, q1, q2, 0.0, _mat(p, e))))
+    q5, _ = sp1(e, w, h5)
+    _write(p, out, q0, q1, q2, q3, q4, q5)
+
+
+def _no_residual(p, x, branch):
+    return 0.0
+
+
+pair_residual = njit(RESIDUAL_SIG, cache=True)(_pair_residual)
+pair_configuration = njit(CONFIGURATION_SIG, cache=True)(_pair_configuration)
+wrist_residual = njit(RESIDUAL_SIG, cache=True)(_no_residual)
+wrist_configuration = njit(CONFIGURATION_SIG, cache=True)(_wrist_configuration)
+
+
+@njit(cache=True)
+def evaluate(res, params, pose, theta, branch, out):
+    """``out[k] = res(params[pose[k]], theta[k], branch[k])`` (vectorised residual for the NumPy engine)."""
+    for k in range(pose.shape[0]):
+        out[k] = res(params[pose[k]], theta[k], branch[k])
+
+
+@njit(cache=True)
+def configure(cfg, params, pose, theta, branch, out):
+    """``cfg(params[pose[k]], theta[k], branch[k], out[k])`` for every k."""
+    for k in range(pose.shape[0]):
+        cfg(params[pose[k]], theta[k], branch[k], out[k])

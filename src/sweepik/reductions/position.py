@@ -1,0 +1,194 @@
+"""Placing a point with three joints: the position part of a geometric decomposition.
+
+A family (:mod:`.geometric`) fixes all but three of the joints that move a point ``W`` (a wrist centre: the
+point where the last axes meet, which the remaining joints do not move) and asks for the three joint values
+``a < b < c`` that put ``W`` on its target. That is one of the chains of subproblems below, chosen once per
+arm by :mod:`.decompose` from the chain's structure (``CASES``):
+
+===========  ============================================  ===========================================
+case         structure                                     subproblem chain (branches)
+===========  ============================================  ===========================================
+``ab_par``   a, b revolute and parallel                    c: sp4 on the a-height (2) or lp4 (1); b: sp3
+                                                           (2); a: sp1
+``bc_par``   b, c revolute and parallel                    a: sp4 on the b-height (2) or lp4 (1); c: sp3
+                                                           (2); b: sp1
+``ab_int``   a, b revolute, axes meet at O                 c: sp3 / lp3 on the distance from O (2);
+                                                           a, b: sp2 (2)
+``bc_int``   b, c revolute, axes meet at O                 a: sp3 / lp3 on the distance from O (2);
+                                                           b, c: sp2 (2)
+``ppp``      three prismatic                               lines3 (1)
+``ppr``      a, b prismatic, c revolute                    c: sp4 on the normal of a, b (2); a, b: lines2
+``ac_par``   a, c revolute and parallel, b prismatic       b: lp4 on the a-height (1); c: sp3 (2); a: sp1
+===========  ============================================  ===========================================
+
+Outside a branch's domain (a circle or line that misses its sphere or plane) a step continues with its
+least-squares angle or travel, so each branch's values, and the residual built on them, are continuous in
+theta* across the domain edges (where the two branches of a step meet): the sweep sees no NaN gap to bracket
+across, a root at or near an edge is an ordinary sign change, and a root of the continued residual outside the
+domain is a candidate that FK certification rejects.
+
+The reduced chain (``reduce_chain``) is written in product-of-exponentials form: with segments ``s0 .. s4``
+(``s0`` from the world origin to joint 0's point, ``s_i`` from joint i-1's point to joint i's, ``s4`` from joint
+3's point to ``W``), ``W = s0 + T0(s1 + T1(s2 + T2(s3 + T3(s4))))`` where ``T_i`` rotates about (revolute) or
+slides along (prismatic) joint i's axis. The fixed joint ``f`` is absorbed into the segments and the axes that
+follow it.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ..subproblems import lines2, lines3, lp3, lp4, sp1, sp2, sp3, sp4
+from ..subproblems.vec import add, cross, dot, norm, rot, scale, sub, unit
+
+__all__ = ["CASES", "BRANCHES", "reduce_chain", "place", "move", "move_back"]
+
+#: Case names, in the order of their integer codes in a family's parameter row.
+CASES = ("ab_par", "bc_par", "ab_int", "bc_int", "ppp", "ppr", "ac_par")
+#: Branches of each case: (with the first unknown revolute, with it prismatic) for the cases where it matters.
+BRANCHES = {
+    "ab_par": (4, 2),  # indexed by joint c's type
+    "bc_par": (4, 2),  # indexed by joint a's type
+    "ab_int": (4, 4),
+    "bc_int": (4, 4),
+    "ppp": (1, 1),
+    "ppr": (2, 2),
+    "ac_par": (2, 2),
+}
+
+
+@njit(cache=True)
+def move(h, rev, x, v):
+    """``T(v)``: ``v`` rotated about ``h`` by ``x`` (revolute) or translated by ``x h`` (prismatic)."""
+    if rev:
+        return rot(h, x, v)
+    return add(v, scale(x, h))
+
+
+@njit(cache=True)
+def move_back(h, rev, x, v):
+    """The inverse of ``move``."""
+    if rev:
+        return rot(h, -x, v)
+    return sub(v, scale(x, h))
+
+
+@njit(cache=True)
+def _turn(h, rev, x, v):
+    """The rotation part of ``move`` (directions)."""
+    if rev:
+        return rot(h, x, v)
+    return v
+
+
+@njit(cache=True)
+def reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, t):
+    """The three-joint problem left when joint ``f`` (0-3) of the first four is fixed at ``x``.
+
+    Returns ``(tp, ha, hb, hc, pab, pbc, pcw)``: the target of ``W`` relative to joint a's point ``tp`` and the
+    reduced chain ``W - o_a = T_a(pab + T_b(pbc + T_c(pcw)))`` with the axes of a, b, c. Joint types are those
+    of the unknown joints in order (the caller knows them).
+    """
+    if f == 0:
+        tp = sub(move_back(h0, r0, x, sub(t, s0)), s1)
+        return tp, h1, h2, h3, s2, s3, s4
+    tp = sub(t, s0)
+    if f == 1:
+        return (
+            tp,
+            h0,
+            _turn(h1, r1, x, h2),
+            _turn(h1, r1, x, h3),
+            add(s1, move(h1, r1, x, s2)),
+            _turn(h1, r1, x, s3),
+            _turn(h1, r1, x, s4),
+        )
+    if f == 2:
+        return tp, h0, h1, _turn(h2, r2, x, h3), s1, add(s2, move(h2, r2, x, s3)), _turn(h2, r2, x, s4)
+    return tp, h0, h1, h2, s1, s2, add(s3, move(h3, r3, x, s4))
+
+
+@njit(cache=True)
+def _pick(u, v, b):
+    return u if b == 0 else v
+
+
+@njit(cache=True)
+def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Joint values ``(qa, qb, qc)`` of ``branch`` putting ``W`` at ``tp`` (least squares outside the branch's
+    domain; NaN only for an unknown case or dependent prismatic directions).
+
+    ``o``: for ``ab_int`` the meeting point of axes a and b relative to joint a's point; for ``bc_int`` that of b
+    and c relative to joint b's point, in the reduced chain's frame.
+    """
+    nan = math.nan
+    b1 = branch // 2
+    b2 = branch % 2
+    if case == 0:  # ab_par: the height along h_a does not depend on qa, qb
+        height = dot(ha, sub(sub(tp, pab), pbc))
+        if rc:
+            u, v, c = sp4(ha, pcw, hc, height)
+            qc = _pick(u, v, b1)
+        else:
+            qc = lp4(ha, pcw, hc, height)
+            b2 = branch
+        w = add(pbc, move(hc, rc, qc, pcw))
+        u, v, c = sp3(w, scale(-1.0, pab), hb, norm(tp))
+        qb = _pick(u, v, b2)
+        qa, _ = sp1(add(pab, rot(hb, qb, w)), tp, ha)
+        return qa, qb, qc
+    if case == 1:  # bc_par: the height along h_b does not depend on qb, qc
+        height = dot(hb, add(add(pab, pbc), pcw))
+        if ra:
+            u, v, c = sp4(hb, tp, ha, height)
+            qa = -_pick(u, v, b1)
+        else:
+            qa = lp4(hb, tp, scale(-1.0, ha), height)
+            b2 = branch
+        target = sub(move_back(ha, ra, qa, tp), pab)
+        u, v, c = sp3(pcw, scale(-1.0, pbc), hc, norm(target))
+        qc = _pick(u, v, b2)
+        qb, _ = sp1(add(pbc, rot(hc, qc, pcw)), target, hb)
+        return qa, qb, qc
+    if case == 2:  # ab_int: |W - O| depends on qc only
+        base = add(sub(pab, o), pbc)
+        d = norm(sub(tp, o))
+        if rc:
+            u, v, c = sp3(pcw, scale(-1.0, base), hc, d)
+        else:
+            u, v, c = lp3(add(base, pcw), (0.0, 0.0, 0.0), hc, d)
+        qc = _pick(u, v, b1)
+        w0 = add(base, move(hc, rc, qc, pcw))
+        t1a, t2a, t1b, t2b, c = sp2(sub(tp, o), w0, ha, hb)
+        return -_pick(t1a, t1b, b2), _pick(t2a, t2b, b2), qc
+    if case == 3:  # bc_int: |W - O| is fixed; O moves with joint a only
+        w1 = add(sub(pbc, o), pcw)
+        d = norm(w1)
+        centre = add(pab, o)
+        if ra:
+            u, v, c = sp3(centre, tp, ha, d)
+        else:
+            u, v, c = lp3(centre, tp, ha, d)
+        qa = _pick(u, v, b1)
+        target = sub(move_back(ha, ra, qa, tp), centre)
+        t1a, t2a, t1b, t2b, c = sp2(target, w1, hb, hc)
+        return qa, -_pick(t1a, t1b, b2), _pick(t2a, t2b, b2)
+    if case == 4:  # ppp
+        qa, qb, qc = lines3(ha, hb, hc, sub(sub(sub(tp, pab), pbc), pcw))
+        return qa, qb, qc
+    if case == 5:  # ppr: the height along ha x hb does not depend on qa, qb
+        n = unit(cross(ha, hb))
+        u, v, c = sp4(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
+        qc = _pick(u, v, b2)
+        qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), rot(hc, qc, pcw)))
+        return qa, qb, qc
+    if case == 6:  # ac_par: the height along ha fixes the prismatic b
+        qb = lp4(ha, add(add(pab, pbc), pcw), hb, dot(ha, tp))
+        w = add(add(pab, scale(qb, hb)), pbc)
+        u, v, c = sp3(pcw, scale(-1.0, w), hc, norm(tp))
+        qc = _pick(u, v, b2)
+        qa, _ = sp1(add(w, rot(hc, qc, pcw)), tp, ha)
+        return qa, qb, qc
+    return nan, nan, nan

@@ -1,0 +1,10 @@
+"""Canonical geometric subproblems (revolute: circles; prismatic: lines), compiled scalar functions of vectors.
+
+They know no robot: a kinematic family (:mod:`sweepik.reductions.families`) composes them over a chain's axes and
+points. See docs/subproblems.md for each equation, its solution set and its degenerate cases.
+"""
+
+from .prismatic import lines2, lines3, lp1, lp3, lp4
+from .revolute import DOMAIN_TOL, in_domain, sp1, sp2, sp3, sp4
+
+__all__ = ["sp1", "sp2", "sp3", "sp4", "in_domain", "DOMAIN_TOL", "lp1", "lp3", "lp4", "lines2", "lines3"]

@@ -1,0 +1,81 @@
+"""Small 3-vector algebra on tuples ``(x, y, z)`` for compiled scalar code (no array allocation).
+
+Every function is compiled with ``numba.njit`` and callable from Python with tuples of floats.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+__all__ = ["add", "sub", "scale", "dot", "cross", "norm", "unit", "rot", "perp", "along", "orthogonal"]
+
+
+@njit(cache=True)
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+@njit(cache=True)
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+@njit(cache=True)
+def scale(s, a):
+    return (s * a[0], s * a[1], s * a[2])
+
+
+@njit(cache=True)
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit(cache=True)
+def norm(a):
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+@njit(cache=True)
+def unit(a):
+    n = norm(a)
+    return (a[0] / n, a[1] / n, a[2] / n)
+
+
+@njit(cache=True)
+def rot(k, theta, v):
+    """``v`` rotated by ``theta`` (radians) about the unit axis ``k`` (Rodrigues)."""
+    c, s = math.cos(theta), math.sin(theta)
+    kv = dot(k, v)
+    kxv = cross(k, v)
+    return (
+        c * v[0] + s * kxv[0] + (1.0 - c) * kv * k[0],
+        c * v[1] + s * kxv[1] + (1.0 - c) * kv * k[1],
+        c * v[2] + s * kxv[2] + (1.0 - c) * kv * k[2],
+    )
+
+
+@njit(cache=True)
+def along(k, v):
+    """The component of ``v`` along the unit vector ``k``."""
+    return scale(dot(k, v), k)
+
+
+@njit(cache=True)
+def perp(k, v):
+    """The component of ``v`` perpendicular to the unit vector ``k``."""
+    return sub(v, along(k, v))
+
+
+@njit(cache=True)
+def orthogonal(k):
+    """A unit vector perpendicular to the unit vector ``k``."""
+    ax, ay, az = abs(k[0]), abs(k[1]), abs(k[2])
+    e = (1.0, 0.0, 0.0) if ax <= ay and ax <= az else ((0.0, 1.0, 0.0) if ay <= az else (0.0, 0.0, 1.0))
+    return unit(cross(k, e))

@@ -1,0 +1,147 @@
+"""Subproblems against brute force: every returned solution solves its equation, every solution found by a dense
+scan is returned, least-squares answers are the scan's minimum, degenerate cases are flagged."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sweepik.chain import rotation_about
+from sweepik.subproblems import in_domain, lines2, lines3, lp1, lp3, lp4, sp1, sp2, sp3, sp4
+
+RNG = np.random.default_rng(20261123)
+GRID = np.linspace(-np.pi, np.pi, 20001)
+
+
+def _t(v):
+    return tuple(float(x) for x in v)
+
+
+def _unit(rng=RNG):
+    v = rng.normal(size=3)
+    return v / np.linalg.norm(v)
+
+
+def _R(k, th):
+    return rotation_about(np.asarray(k), th)
+
+
+def _ang(a, b):
+    return abs(np.angle(np.exp(1j * (a - b))))
+
+
+def _scan_roots(f):
+    """Angles where f (vectorised over GRID) changes sign or touches zero."""
+    v = f(GRID)
+    i = np.nonzero(np.sign(v[1:]) != np.sign(v[:-1]))[0]
+    return GRID[i]
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_sp1_exact_and_least_squares(seed):
+    rng = np.random.default_rng(seed)
+    k, p1 = _unit(rng), rng.normal(size=3)
+    th = rng.uniform(-np.pi, np.pi)
+    p2 = _R(k, th) @ p1
+    got, err = sp1(_t(p1), _t(p2), _t(k))
+    assert _ang(got, th) < 1e-10 and err < 1e-12
+    # least squares: the minimiser of |R p1 - p2| over a dense grid
+    q = p2 + rng.normal(size=3)
+    got, err = sp1(_t(p1), _t(q), _t(k))
+    errs = np.linalg.norm(np.einsum("nij,j->ni", _R(k, GRID), p1) - q, axis=1)
+    assert err <= errs.min() + 1e-9
+    assert abs(err - np.linalg.norm(_R(k, got) @ p1 - q)) < 1e-12
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_sp4_matches_scan(seed):
+    rng = np.random.default_rng(seed)
+    h, p, k = rng.normal(size=3), rng.normal(size=3), _unit(rng)
+    d = float(h @ _R(k, rng.uniform(-np.pi, np.pi)) @ p) if seed % 3 else float(rng.normal())
+
+    def f(th):
+        return np.einsum("j,nji,i->n", h, _R(k, th), p) - d
+
+    a, b, c = sp4(_t(h), _t(p), _t(k), d)
+    roots = _scan_roots(f)
+    if in_domain(c):
+        for th in (a, b):
+            assert abs(f(np.array([th]))[0]) < 1e-9 * (1 + np.linalg.norm(h) * np.linalg.norm(p))
+        for r in roots:  # every root of the scan is returned
+            assert min(_ang(r, a), _ang(r, b)) < 1e-3
+    else:
+        assert roots.size == 0
+        assert a == b
+        vals = np.abs(f(GRID))
+        assert abs(f(np.array([a]))[0]) <= vals.min() + 1e-9
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_sp3_and_sp2_exact(seed):
+    rng = np.random.default_rng(seed)
+    k1, k2, p1, p2 = _unit(rng), _unit(rng), rng.normal(size=3), rng.normal(size=3)
+    th = rng.uniform(-np.pi, np.pi)
+    d = float(np.linalg.norm(_R(k1, th) @ p1 - p2))
+    a, b, c = sp3(_t(p1), _t(p2), _t(k1), d)
+    assert in_domain(c)
+    assert min(_ang(a, th), _ang(b, th)) < 1e-7
+    for x in (a, b):
+        assert abs(np.linalg.norm(_R(k1, x) @ p1 - p2) - d) < 1e-10
+    # two circles: p2 chosen so that R(k1, t1) p1 = R(k2, t2) p2 has the solution (t1, t2)
+    t1, t2 = rng.uniform(-np.pi, np.pi, size=2)
+    q2 = _R(k2, -t2) @ _R(k1, t1) @ p1
+    t1a, t2a, t1b, t2b, c = sp2(_t(p1), _t(q2), _t(k1), _t(k2))
+    assert in_domain(c)
+    found = [(t1a, t2a), (t1b, t2b)]
+    for x1, x2 in found:
+        np.testing.assert_allclose(_R(k1, x1) @ p1, _R(k2, x2) @ q2, atol=1e-10)
+    assert min(max(_ang(x1, t1), _ang(x2, t2)) for x1, x2 in found) < 1e-7
+
+
+def test_degenerate_cases_are_flagged():
+    z = (0.0, 0.0, 1.0)
+    # a point on the axis: any angle (0), residual 0
+    th, err = sp1((0.0, 0.0, 2.0), (0.0, 0.0, 2.0), z)
+    assert th == 0.0 and err == 0.0
+    # h parallel to the axis: h . R p does not depend on theta
+    a, b, c = sp4(z, (1.0, 0.0, 0.5), z, 0.5)
+    assert np.isnan(c)
+    # tangent: one double solution (both equal), at the domain edge
+    a, b, c = sp4((1.0, 0.0, 0.0), (1.0, 0.0, 0.0), z, 1.0)
+    assert in_domain(c) and abs(a - b) < 1e-12 and abs(c - 1.0) < 1e-15
+    # just outside: no exact solution, the least-squares angle twice
+    a, b, c = sp4((1.0, 0.0, 0.0), (1.0, 0.0, 0.0), z, 1.0 + 1e-6)
+    assert not in_domain(c) and a == b == 0.0
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_line_subproblems(seed):
+    rng = np.random.default_rng(seed)
+    h, p1, p2 = _unit(rng), rng.normal(size=3), rng.normal(size=3)
+    t = rng.normal()
+    # line-point
+    got, err = lp1(_t(p1), _t(p1 + t * h), _t(h))
+    assert abs(got - t) < 1e-12 and err < 1e-12
+    # line-sphere: both intersections, each at distance d
+    d = float(np.linalg.norm(p1 + t * h - p2))
+    a, b, disc = lp3(_t(p1), _t(p2), _t(h), d)
+    assert disc >= 0.0 and min(abs(a - t), abs(b - t)) < 1e-9
+    for x in (a, b):
+        assert abs(np.linalg.norm(p1 + x * h - p2) - d) < 1e-9
+    # line-sphere miss: the closest point, twice
+    far = np.linalg.norm(np.cross(h, p1 - p2)) * 0.5
+    a, b, disc = lp3(_t(p1), _t(p2), _t(h), float(far))
+    assert disc < 0 and a == b
+    ts = np.linspace(-20, 20, 400001)
+    assert abs(a - ts[np.argmin(np.linalg.norm(p1 + ts[:, None] * h - p2, axis=1))]) < 1e-3
+    # line-plane
+    k = _unit(rng)
+    dd = float(k @ (p1 + t * h))
+    assert abs(lp4(_t(k), _t(p1), _t(h), dd) - t) < 1e-9 * (1 + 1 / abs(k @ h))
+    assert np.isnan(lp4((0.0, 0.0, 1.0), _t(p1), (1.0, 0.0, 0.0), 1.0))
+    # two and three lines
+    h2, h3 = _unit(rng), _unit(rng)
+    t1, t2, t3 = rng.normal(size=3)
+    np.testing.assert_allclose(lines2(_t(h), _t(h2), _t(t1 * h + t2 * h2)), (t1, t2), atol=1e-9)
+    np.testing.assert_allclose(lines3(_t(h), _t(h2), _t(h3), _t(t1 * h + t2 * h2 + t3 * h3)), (t1, t2, t3), atol=1e-8)
+    assert np.isnan(lines2(_t(h), _t(h), _t(h))[0])
