@@ -27,11 +27,11 @@ Q_GOOD = np.array([700.0, 0.4, 0.3, -0.5, 0.6, 0.2])
 GOOD_POSE = CARM.fk(Q_GOOD)
 MATRIX_ARGS = [repr(float(v)) for v in GOOD_POSE.ravel()]
 
+
 def _offset_last_joint(text: str) -> str:
     """The C-Arm text with the last joint's axis 30 mm off joint 5's (its DH row ``a = 30``)."""
     head, sep, tail = text.rpartition("a = 0.0\nalpha = 90.0")
     return head + "a = 30.0\nalpha = 90.0" + tail
-
 
 
 def _cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
