@@ -62,7 +62,7 @@ def test_sp4_matches_scan(seed):
     def f(th):
         return np.einsum("j,nji,i->n", h, _R(k, th), p) - d
 
-    a, b, c = sp4(_t(h), _t(p), _t(k), d)
+    a, b, c, _ = sp4(_t(h), _t(p), _t(k), d)
     roots = _scan_roots(f)
     if in_domain(c):
         for th in (a, b):
@@ -82,7 +82,7 @@ def test_sp3_and_sp2_exact(seed):
     k1, k2, p1, p2 = _unit(rng), _unit(rng), rng.normal(size=3), rng.normal(size=3)
     th = rng.uniform(-np.pi, np.pi)
     d = float(np.linalg.norm(_R(k1, th) @ p1 - p2))
-    a, b, c = sp3(_t(p1), _t(p2), _t(k1), d)
+    a, b, c, _ = sp3(_t(p1), _t(p2), _t(k1), d)
     assert in_domain(c)
     assert min(_ang(a, th), _ang(b, th)) < 1e-7
     for x in (a, b):
@@ -90,7 +90,7 @@ def test_sp3_and_sp2_exact(seed):
     # two circles: p2 chosen so that R(k1, t1) p1 = R(k2, t2) p2 has the solution (t1, t2)
     t1, t2 = rng.uniform(-np.pi, np.pi, size=2)
     q2 = _R(k2, -t2) @ _R(k1, t1) @ p1
-    t1a, t2a, t1b, t2b, c = sp2(_t(p1), _t(q2), _t(k1), _t(k2))
+    t1a, t2a, t1b, t2b, c, _ = sp2(_t(p1), _t(q2), _t(k1), _t(k2))
     assert in_domain(c)
     found = [(t1a, t2a), (t1b, t2b)]
     for x1, x2 in found:
@@ -104,13 +104,13 @@ def test_degenerate_cases_are_flagged():
     th, err = sp1((0.0, 0.0, 2.0), (0.0, 0.0, 2.0), z)
     assert th == 0.0 and err == 0.0
     # h parallel to the axis: h . R p does not depend on theta
-    a, b, c = sp4(z, (1.0, 0.0, 0.5), z, 0.5)
+    a, b, c, _ = sp4(z, (1.0, 0.0, 0.5), z, 0.5)
     assert np.isnan(c)
     # tangent: one double solution (both equal), at the domain edge
-    a, b, c = sp4((1.0, 0.0, 0.0), (1.0, 0.0, 0.0), z, 1.0)
+    a, b, c, _ = sp4((1.0, 0.0, 0.0), (1.0, 0.0, 0.0), z, 1.0)
     assert in_domain(c) and abs(a - b) < 1e-12 and abs(c - 1.0) < 1e-15
     # just outside: no exact solution, the least-squares angle twice
-    a, b, c = sp4((1.0, 0.0, 0.0), (1.0, 0.0, 0.0), z, 1.0 + 1e-6)
+    a, b, c, _ = sp4((1.0, 0.0, 0.0), (1.0, 0.0, 0.0), z, 1.0 + 1e-6)
     assert not in_domain(c) and a == b == 0.0
 
 

@@ -108,6 +108,29 @@ class GeometricReduction(Reduction):
         )
         self.kernel = self._kernels
 
+    def sample_hints(self, poses: Array) -> Array | None:
+        """The theta* values where a branch's domain begins or ends: the zeros of the steps' margins ``1 - c^2``
+        (``geometric.pair_margin``), found by the same sweep as the residual's zeros. A root at or next to a
+        domain edge is bracketed only if the edge is a sample; a domain narrower than the grid step is found as a
+        pair of close zeros of its margin."""
+        if self.closed_form or poses.shape[0] == 0:
+            return None
+        from ..sweep import N_SAMPLES  # local: the engine imports the reductions
+
+        lo, hi = self._range(poses.shape[0])
+        swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
+        geometric.swing_hints(self.kernel_params(poses), lo, hi, N_SAMPLES, self.periodic, swings)
+        theta = np.concatenate([_Margins(self).zeros(poses, lo, hi), swings], axis=1)
+        keep = np.any(np.isfinite(theta), axis=0)
+        return theta[:, keep] if keep.any() else None
+
+    def _range(self, n: int) -> tuple[Array, Array]:
+        """theta*'s sweep range for ``n`` poses (as the solver's: the circle, or the joint's limits)."""
+        if self.periodic:
+            return np.full(n, -np.pi), np.full(n, np.pi)
+        j = self.free_joint
+        return np.full(n, self.robot.lower[j]), np.full(n, self.robot.upper[j])
+
     def kernel_params(self, poses: Array) -> Array:
         """Parameter rows ``(N, N_PARAMS)`` of chain poses ``(N, 4, 4)``."""
         robot = self.robot
@@ -127,11 +150,13 @@ class GeometricReduction(Reduction):
         out[:, L["t"] : L["t"] + 3] = p + R @ self._w_tool
         return out
 
-    def _flat(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, IntArray, Array, IntArray]:
+    def _flat(
+        self, poses: Array, theta: Array, branch: IntArray | None, n_branches: int | None = None
+    ) -> tuple[Array, IntArray, Array, IntArray]:
         N, M = theta.shape
         params = self.kernel_params(poses)
         if branch is None:
-            B = self.n_branches
+            B = self.n_branches if n_branches is None else n_branches
             pose = np.repeat(np.arange(N), M * B)
             th = np.repeat(theta.reshape(-1), B)
             br = np.tile(np.arange(B), N * M)
@@ -154,3 +179,44 @@ class GeometricReduction(Reduction):
         geometric.configure(self._kernels[1], params, pose, th, br, out)
         shape = theta.shape if branch is not None else (*theta.shape, self.n_branches)
         return out.reshape(*shape, 6)
+
+
+class _Margins(Reduction):
+    """The margins ``1 - c^2`` of a pair plan's branch domains, as a residual with three branches (the first
+    step's, and the second step's on either branch of the first), so that the sweep finds their zeros."""
+
+    name = "margins"
+    kernel: tuple[Any, Any] | None = None
+
+    def __init__(self, red: GeometricReduction) -> None:
+        super().__init__(red.robot, red.free_joint, 3)
+        self.red = red
+        self.kernel = (geometric.pair_margin, geometric.pair_configuration)
+
+    def kernel_params(self, poses: Array) -> Array:
+        return self.red.kernel_params(poses)
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
+        params, pose, th, br = self.red._flat(poses, theta, branch, self.n_branches)
+        out = np.empty(th.shape[0])
+        geometric.evaluate(geometric.pair_margin, params, pose, th, br, out)
+        return out.reshape(theta.shape if branch is not None else (*theta.shape, self.n_branches))
+
+    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        raise NotImplementedError("margins have no configurations")
+
+    def zeros(self, poses: Array, lo: Array, hi: Array) -> Array:
+        """Zeros ``(N, K)`` (NaN-padded) of every margin over theta*'s sweep range ``[lo, hi]``."""
+        from .. import fastsweep, sweep  # local: the engine imports the reductions
+
+        N = poses.shape[0]
+        if fastsweep.AVAILABLE:
+            cand, _ = fastsweep.search(self, poses, lo, hi, sweep.N_SAMPLES)
+        else:
+            cand, _ = sweep.find_candidates(self, poses, lo, hi, sweep.N_SAMPLES)
+        counts = np.bincount(cand.pose, minlength=N)
+        out = np.full((N, int(counts.max(initial=0))), np.nan)
+        order = np.argsort(cand.pose, kind="stable")
+        slot = np.arange(cand.pose.size) - np.repeat(np.cumsum(counts) - counts, counts)
+        out[cand.pose[order], slot] = cand.theta[order]
+        return out

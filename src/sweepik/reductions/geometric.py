@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from ..subproblems import sp1, sp2
+from ..subproblems import in_domain, sp1, sp2
 from ..subproblems.vec import dot, orthogonal, rot, sub
 from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG
 from .position import place, reduce_chain
@@ -75,7 +75,8 @@ def _mat(p, v):
 
 @njit(cache=True)
 def _arm(p, x, branch):
-    """Values ``(q0, q1, q2, q3)`` of the first four joints with joint ``free`` at ``x`` (NaN: no branch)."""
+    """Values ``(q0, q1, q2, q3)`` of the first four joints with joint ``free`` at ``x``, and the cosines
+    ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the position case's steps (``position.place``)."""
     h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
     r0, r1, r2, r3 = p[39] > 0.5, p[40] > 0.5, p[41] > 0.5, p[42] > 0.5
     s0, s1, s2, s3 = _v(p, 18), _v(p, 21), _v(p, 24), _v(p, 27)
@@ -98,14 +99,14 @@ def _arm(p, x, branch):
         o = sub(meet, pts[b])
         if f == 1 and r1:
             o = rot(h1, x, o)
-    qa, qb, qc = place(case, branch, tp, ha, hb, hc, rev[a], rev[b], rev[c], pab, pbc, pcw, o)
+    qa, qb, qc, c1, c2, a1, a2 = place(case, branch, tp, ha, hb, hc, rev[a], rev[b], rev[c], pab, pbc, pcw, o)
     if f == 0:
-        return x, qa, qb, qc
+        return x, qa, qb, qc, c1, c2, a1, a2
     if f == 1:
-        return qa, x, qb, qc
+        return qa, x, qb, qc, c1, c2, a1, a2
     if f == 2:
-        return qa, qb, x, qc
-    return qa, qb, qc, x
+        return qa, qb, x, qc, c1, c2, a1, a2
+    return qa, qb, qc, x, c1, c2, a1, a2
 
 
 @njit(cache=True)
@@ -129,8 +130,8 @@ def _fore(p, q0, q1, q2, q3, v):
 
 
 def _pair_residual(p, x, branch):
-    q0, q1, q2, q3 = _arm(p, x, branch)
-    if math.isnan(q0 + q1 + q2 + q3):
+    q0, q1, q2, q3, c1, c2, _, _ = _arm(p, x, branch)
+    if math.isnan(q0 + q1 + q2 + q3) or not (in_domain(c1) and in_domain(c2)):
         return math.nan
     h4, h5 = _h(p, 4), _h(p, 5)
     return dot(_fore(p, q0, q1, q2, q3, h4), _mat(p, h5)) - dot(h4, h5)
@@ -153,8 +154,18 @@ def _write(p, out, q0, q1, q2, q3, q4, q5):
         out[5 - i if rev else i] = qs[i]
 
 
+def _pair_margin(p, x, k):
+    """``1 - c^2`` of the position case's first step (k = 0) or its second step on the first step's branch k - 1:
+    positive inside the branch domains, zero at their edges (found by the same sweep, and sampled as hints)."""
+    if k == 0:
+        c = _arm(p, x, 0)[4]
+    else:
+        c = _arm(p, x, 2 * (k - 1))[5]
+    return 1.0 - c * c
+
+
 def _pair_configuration(p, x, branch, out):
-    q0, q1, q2, q3 = _arm(p, x, branch)
+    q0, q1, q2, q3, _, _, _, _ = _arm(p, x, branch)
     if math.isnan(q0 + q1 + q2 + q3):
         for i in range(6):
             out[i] = math.nan
@@ -165,14 +176,14 @@ def _pair_configuration(p, x, branch, out):
 
 def _wrist_configuration(p, x, branch, out):
     nb = int(p[66])
-    q0, q1, q2, _ = _arm(p, 0.0, branch // 2)
+    q0, q1, q2, _, _, _, _, _ = _arm(p, 0.0, branch // 2)
     if math.isnan(q0 + q1 + q2) or branch >= 2 * nb:
         for i in range(6):
             out[i] = math.nan
         return
     h3, h4, h5 = _h(p, 3), _h(p, 4), _h(p, 5)
     v = _back(p, q0, q1, q2, 0.0, _mat(p, h5))
-    t1a, t2a, t1b, t2b, c = sp2(v, h5, h3, h4)
+    t1a, t2a, t1b, t2b, c, _ = sp2(v, h5, h3, h4)
     if math.isnan(c):  # joint 6's axis on joint 4's: a continuum (wrist singular); one member
         q3 = 0.0
         q4, _ = sp1(h5, v, h4)
@@ -192,6 +203,81 @@ def _no_residual(p, x, branch):
 
 pair_residual = njit(RESIDUAL_SIG, cache=True)(_pair_residual)
 pair_configuration = njit(CONFIGURATION_SIG, cache=True)(_pair_configuration)
+pair_margin = njit(RESIDUAL_SIG, cache=True)(_pair_margin)
+
+
+@njit(cache=True)
+def _amplitude(p, x, k):
+    """Amplitude of the first step (k = 0) or of the second on the first step's branch k - 1."""
+    if k == 0:
+        return _arm(p, x, 0)[6]
+    return _arm(p, x, 2 * (k - 1))[7]
+
+
+#: Swing hints: up to this many local minima of each step's amplitude per pose, ...
+SWING_MINIMA = 4
+#: ... each giving its centre and this many samples spread over the window where the angle swings
+#: (``centre + w tan(u)``, u uniform in (-pi/2, pi/2), w the window's half-width).
+SWING_SAMPLES = 16
+#: Golden-section steps locating a minimum between two grid steps (0.618^50 ~ 3e-11 of the bracket).
+SWING_GOLDEN = 50
+#: Only minima below this times the rise to the next sample are located (a window narrower than the grid step
+#: has r* < |r'| h, while the rise is at most |r'| h).
+SWING_DEPTH = 2.0
+SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
+
+
+@njit(cache=True)
+def swing_hints(params, lo, hi, n, periodic, out):
+    """Samples of theta* ``out (N, SWING_PER_POSE)`` (NaN-padded) where a step of the position case is nearly
+    degenerate: around each local minimum ``r*`` of its amplitude ``r(theta*)`` narrower than the grid step
+    ``h``, where its angles turn by up to pi within ``w = r* / |r'|``."""
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    for i in range(params.shape[0]):
+        p = params[i]
+        h = (hi[i] - lo[i]) / n
+        cnt = 0
+        for k in range(3):
+            found = 0
+            xm, am = lo[i] - h, _amplitude(p, lo[i] - h, k)
+            x0, a0 = lo[i], _amplitude(p, lo[i], k)
+            for j in range(1, n + 2):
+                x1 = lo[i] + j * h
+                a1 = _amplitude(p, x1, k)
+                # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
+                # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
+                deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
+                if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
+                    a, b = xm, x1
+                    c, d = b - g * (b - a), a + g * (b - a)
+                    fc, fd = _amplitude(p, c, k), _amplitude(p, d, k)
+                    for _ in range(SWING_GOLDEN):
+                        if fc < fd:
+                            b, d, fd = d, c, fc
+                            c = b - g * (b - a)
+                            fc = _amplitude(p, c, k)
+                        else:
+                            a, c, fc = c, d, fd
+                            d = a + g * (b - a)
+                            fd = _amplitude(p, d, k)
+                    xs = 0.5 * (a + b)
+                    rs = _amplitude(p, xs, k)
+                    slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
+                    if slope > 0.0 and rs < slope * h:
+                        w = rs / slope
+                        for m in range(SWING_SAMPLES + 1):
+                            t = xs
+                            if m > 0:
+                                t = xs + w * math.tan(math.pi * (m / (SWING_SAMPLES + 1.0) - 0.5))
+                            if periodic:
+                                t = lo[i] + (t - lo[i]) % (hi[i] - lo[i])
+                            if lo[i] <= t <= hi[i]:
+                                out[i, cnt] = t
+                                cnt += 1
+                        found += 1
+                xm, am, x0, a0 = x0, a0, x1, a1
+
+
 wrist_residual = njit(RESIDUAL_SIG, cache=True)(_no_residual)
 wrist_configuration = njit(CONFIGURATION_SIG, cache=True)(_wrist_configuration)
 

@@ -116,9 +116,19 @@ def _pick(u, v, b):
 
 
 @njit(cache=True)
+def _line_cos(disc, d):
+    """A line-sphere discriminant as the cosine of a circle subproblem (|c| <= 1 inside the domain)."""
+    if d > 0.0:
+        return math.sqrt(max(0.0, d * d - disc)) / d
+    return 0.0 if disc >= 0.0 else math.inf
+
+
+@njit(cache=True)
 def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
-    """Joint values ``(qa, qb, qc)`` of ``branch`` putting ``W`` at ``tp`` (least squares outside the branch's
-    domain; NaN only for an unknown case or dependent prismatic directions).
+    """Joint values ``(qa, qb, qc)`` of ``branch`` putting ``W`` at ``tp``, the cosines ``(c1, c2)`` of its
+    two-solution steps (0 for a one-solution step): ``|c| <= 1`` inside the branch's domain, and their amplitudes
+    ``(r1, r2)`` (inf for a one-solution step): where one nears 0 the step's angle swings fast. Outside it the steps
+    continue with least squares (NaN only for an unknown case or dependent prismatic directions).
 
     ``o``: for ``ab_int`` the meeting point of axes a and b relative to joint a's point; for ``bc_int`` that of b
     and c relative to joint b's point, in the reduced chain's frame.
@@ -126,69 +136,73 @@ def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     nan = math.nan
     b1 = branch // 2
     b2 = branch % 2
+    c1 = 0.0
+    r1 = math.inf
     if case == 0:  # ab_par: the height along h_a does not depend on qa, qb
         height = dot(ha, sub(sub(tp, pab), pbc))
         if rc:
-            u, v, c = sp4(ha, pcw, hc, height)
+            u, v, c1, r1 = sp4(ha, pcw, hc, height)
             qc = _pick(u, v, b1)
         else:
             qc = lp4(ha, pcw, hc, height)
             b2 = branch
         w = add(pbc, move(hc, rc, qc, pcw))
-        u, v, c = sp3(w, scale(-1.0, pab), hb, norm(tp))
+        u, v, c2, r2 = sp3(w, scale(-1.0, pab), hb, norm(tp))
         qb = _pick(u, v, b2)
         qa, _ = sp1(add(pab, rot(hb, qb, w)), tp, ha)
-        return qa, qb, qc
+        return qa, qb, qc, c1, c2, r1, r2
     if case == 1:  # bc_par: the height along h_b does not depend on qb, qc
         height = dot(hb, add(add(pab, pbc), pcw))
         if ra:
-            u, v, c = sp4(hb, tp, ha, height)
+            u, v, c1, r1 = sp4(hb, tp, ha, height)
             qa = -_pick(u, v, b1)
         else:
             qa = lp4(hb, tp, scale(-1.0, ha), height)
             b2 = branch
         target = sub(move_back(ha, ra, qa, tp), pab)
-        u, v, c = sp3(pcw, scale(-1.0, pbc), hc, norm(target))
+        u, v, c2, r2 = sp3(pcw, scale(-1.0, pbc), hc, norm(target))
         qc = _pick(u, v, b2)
         qb, _ = sp1(add(pbc, rot(hc, qc, pcw)), target, hb)
-        return qa, qb, qc
+        return qa, qb, qc, c1, c2, r1, r2
     if case == 2:  # ab_int: |W - O| depends on qc only
         base = add(sub(pab, o), pbc)
         d = norm(sub(tp, o))
         if rc:
-            u, v, c = sp3(pcw, scale(-1.0, base), hc, d)
+            u, v, c1, r1 = sp3(pcw, scale(-1.0, base), hc, d)
         else:
-            u, v, c = lp3(add(base, pcw), (0.0, 0.0, 0.0), hc, d)
+            u, v, disc = lp3(add(base, pcw), (0.0, 0.0, 0.0), hc, d)
+            c1 = _line_cos(disc, d)
         qc = _pick(u, v, b1)
         w0 = add(base, move(hc, rc, qc, pcw))
-        t1a, t2a, t1b, t2b, c = sp2(sub(tp, o), w0, ha, hb)
-        return -_pick(t1a, t1b, b2), _pick(t2a, t2b, b2), qc
+        t1a, t2a, t1b, t2b, c2, r2 = sp2(sub(tp, o), w0, ha, hb)
+        return -_pick(t1a, t1b, b2), _pick(t2a, t2b, b2), qc, c1, c2, r1, r2
     if case == 3:  # bc_int: |W - O| is fixed; O moves with joint a only
         w1 = add(sub(pbc, o), pcw)
         d = norm(w1)
         centre = add(pab, o)
         if ra:
-            u, v, c = sp3(centre, tp, ha, d)
+            u, v, c1, r1 = sp3(centre, tp, ha, d)
         else:
-            u, v, c = lp3(centre, tp, ha, d)
+            u, v, disc = lp3(centre, tp, ha, d)
+            c1 = _line_cos(disc, d)
         qa = _pick(u, v, b1)
         target = sub(move_back(ha, ra, qa, tp), centre)
-        t1a, t2a, t1b, t2b, c = sp2(target, w1, hb, hc)
-        return qa, -_pick(t1a, t1b, b2), _pick(t2a, t2b, b2)
+        t1a, t2a, t1b, t2b, c2, r2 = sp2(target, w1, hb, hc)
+        return qa, -_pick(t1a, t1b, b2), _pick(t2a, t2b, b2), c1, c2, r1, r2
     if case == 4:  # ppp
         qa, qb, qc = lines3(ha, hb, hc, sub(sub(sub(tp, pab), pbc), pcw))
-        return qa, qb, qc
+        return qa, qb, qc, 0.0, 0.0, math.inf, math.inf
     if case == 5:  # ppr: the height along ha x hb does not depend on qa, qb
         n = unit(cross(ha, hb))
-        u, v, c = sp4(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
+        u, v, c2, r2 = sp4(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
         qc = _pick(u, v, b2)
         qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), rot(hc, qc, pcw)))
-        return qa, qb, qc
+        return qa, qb, qc, c1, c2, r1, r2
     if case == 6:  # ac_par: the height along ha fixes the prismatic b
         qb = lp4(ha, add(add(pab, pbc), pcw), hb, dot(ha, tp))
         w = add(add(pab, scale(qb, hb)), pbc)
-        u, v, c = sp3(pcw, scale(-1.0, w), hc, norm(tp))
+        u, v, c2, r2 = sp3(pcw, scale(-1.0, w), hc, norm(tp))
         qc = _pick(u, v, b2)
         qa, _ = sp1(add(w, rot(hc, qc, pcw)), tp, ha)
-        return qa, qb, qc
-    return nan, nan, nan
+        return qa, qb, qc, c1, c2, r1, r2
+    return nan, nan, nan, nan, nan, nan, nan
