@@ -53,7 +53,7 @@ class Reduction(ABC):
     #: Registry name of a reduction that also solves poses where this one cannot describe the solution set
     #: (``degenerate``: e.g. a continuum along a joint other than theta*) or where its closed form is
     #: ill-conditioned (a candidate that even a Newton polish cannot certify); its solutions are merged in.
-    fallback: str | None = None
+    fallback: str | Reduction | None = None
     #: Compiled scalar kernels ``(residual, configuration)`` with the signatures ``reductions.kernels.RESIDUAL_SIG``
     #: and ``CONFIGURATION_SIG`` over rows of ``kernel_params(poses)`` (None: the NumPy engine is used).
     kernel: tuple[Any, Any] | None = None

@@ -8,9 +8,11 @@ arm: :mod:`.decompose` finds the plans of a robot.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..chain import Chain
 from ..robot import Robot
@@ -107,6 +109,31 @@ class GeometricReduction(Reduction):
             else (geometric.pair_residual, geometric.pair_configuration)
         )
         self.kernel = self._kernels
+
+    @cached_property
+    def _continua(self) -> GeometricReduction | None:
+        """For a closed form: the pair plan sweeping the wrist's first joint, which reports the continuum of a
+        singular wrist as a family (the closed form gives one member)."""
+        if not self.plan.closed_form:
+            return None
+        from .decompose import plans  # local: decompose imports this module
+
+        for p in plans(self.robot):
+            if p.family == "pair" and p.reversed == self.plan.reversed and p.free == 3 and not p.conditional:
+                return GeometricReduction(self.robot, p)
+        return None
+
+    @property
+    def fallback(self) -> Reduction | None:  # type: ignore[override]
+        return self._continua
+
+    def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
+        """Closed form: poses where a branch's wrist is singular (its solutions form a continuum)."""
+        if not self.plan.closed_form or poses.shape[0] == 0:
+            return None
+        out = np.zeros(poses.shape[0], dtype=np.bool_)
+        geometric.wrist_singular(self.kernel_params(poses), out)
+        return out
 
     def sample_hints(self, poses: Array) -> Array | None:
         """The theta* values where a branch's domain begins or ends: the zeros of the steps' margins ``1 - c^2``

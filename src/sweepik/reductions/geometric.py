@@ -29,7 +29,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from ..subproblems import in_domain, sp1, sp2
-from ..subproblems.vec import dot, orthogonal, rot, sub
+from ..subproblems.vec import cross, dot, norm, orthogonal, rot, sub
 from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG
 from .position import place, reduce_chain
 
@@ -294,3 +294,24 @@ def configure(cfg, params, pose, theta, branch, out):
     """``cfg(params[pose[k]], theta[k], branch[k], out[k])`` for every k."""
     for k in range(pose.shape[0]):
         cfg(params[pose[k]], theta[k], branch[k], out[k])
+
+
+#: A wrist is singular (joint 6's target axis along joint 4's: a continuum of solutions) when the sine of the
+#: angle between them is below this.
+WRIST_SINGULAR = 1e-9
+
+
+@njit(cache=True)
+def wrist_singular(params, out):
+    """``out[i]``: some exact position branch of the wrist family leaves pose i with a singular wrist."""
+    h3, h5 = _h(params[0], 3), _h(params[0], 5)
+    for i in range(params.shape[0]):
+        p = params[i]
+        out[i] = False
+        for b in range(int(p[66])):
+            q0, q1, q2, _, c1, c2, _, _ = _arm(p, 0.0, b)
+            if math.isnan(q0 + q1 + q2) or not (in_domain(c1) and in_domain(c2)):
+                continue
+            v = _back(p, q0, q1, q2, 0.0, _mat(p, h5))
+            if norm(cross(v, h3)) < WRIST_SINGULAR:
+                out[i] = True
