@@ -6,9 +6,11 @@ Public API: robots (``load_robot``, ``Robot``, ``Joint``), pose helpers and erro
 
 from importlib.metadata import PackageNotFoundError, version
 
+from .analysis import analyze
 from .errors import (
     InvalidPoseError,
     NonFiniteError,
+    NoReductionError,
     PoseFileError,
     RobotDefinitionError,
     RobotFileError,
@@ -27,7 +29,7 @@ from .pose import (
     xyz_zyz_from_pose,
     zyz_from_matrix,
 )
-from .reductions import REDUCTIONS, CArmD1, CArmTheta2, Reduction, get_reduction
+from .reductions import REDUCTIONS, CArmD1, CArmTheta2, GeometricReduction, Plan, Reduction, get_reduction
 from .robot import Joint, Robot
 from .robot_file import bundled_robots, load_robot, robot_from_dict
 from .solutions import Family, Solutions
@@ -56,6 +58,9 @@ __all__ = [
     "CArmTheta2",
     "REDUCTIONS",
     "get_reduction",
+    "GeometricReduction",
+    "Plan",
+    "analyze",
     "zyz_from_matrix",
     "matrix_from_zyz",
     "pose_from_xyz_zyz",
@@ -73,4 +78,5 @@ __all__ = [
     "InvalidPoseError",
     "UnknownOptionError",
     "PoseFileError",
+    "NoReductionError",
 ]

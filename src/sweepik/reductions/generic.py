@@ -136,10 +136,11 @@ class GeometricReduction(Reduction):
         return out
 
     def sample_hints(self, poses: Array) -> Array | None:
-        """The theta* values where a branch's domain begins or ends: the zeros of the steps' margins ``1 - c^2``
-        (``geometric.pair_margin``), found by the same sweep as the residual's zeros. A root at or next to a
-        domain edge is bracketed only if the edge is a sample; a domain narrower than the grid step is found as a
-        pair of close zeros of its margin."""
+        """Samples where the residual can change faster than the grid resolves: windows where a step's angle
+        swings (``geometric.swing_hints``), and the theta* values where a branch's domain begins or ends, the
+        zeros of the steps' margins ``1 - c^2`` (``geometric.pair_margin``), found by the same sweep as the
+        residual's zeros (with the swing windows as samples). A root at or next to a domain edge is bracketed only
+        if the edge is a sample; a domain narrower than the grid step is found as a pair of close margin zeros."""
         if self.closed_form or poses.shape[0] == 0:
             return None
         from ..sweep import N_SAMPLES  # local: the engine imports the reductions
@@ -147,7 +148,9 @@ class GeometricReduction(Reduction):
         lo, hi = self._range(poses.shape[0])
         swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
         geometric.swing_hints(self.kernel_params(poses), lo, hi, N_SAMPLES, self.periodic, swings)
-        theta = np.concatenate([_Margins(self).zeros(poses, lo, hi), swings], axis=1)
+        keep = np.any(np.isfinite(swings), axis=0)
+        swings = swings[:, keep]
+        theta = np.concatenate([_Margins(self, swings).zeros(poses, lo, hi), swings], axis=1)
         keep = np.any(np.isfinite(theta), axis=0)
         return theta[:, keep] if keep.any() else None
 
@@ -215,10 +218,15 @@ class _Margins(Reduction):
     name = "margins"
     kernel: tuple[Any, Any] | None = None
 
-    def __init__(self, red: GeometricReduction) -> None:
+    def __init__(self, red: GeometricReduction, swings: Array) -> None:
         super().__init__(red.robot, red.free_joint, 3)
         self.red = red
+        self.swings = swings
         self.kernel = (geometric.pair_margin, geometric.pair_configuration)
+
+    def sample_hints(self, poses: Array) -> Array | None:
+        # where a step's angle swings, the next step's margin changes as fast: a domain there can be narrow
+        return self.swings if self.swings.shape[1] else None
 
     def kernel_params(self, poses: Array) -> Array:
         return self.red.kernel_params(poses)

@@ -1,0 +1,266 @@
+"""Contract suite of the automatic decomposition over every bundled arm and over random arms of each family.
+
+Properties (issue 9): ``solve(robot, robot.fk(q))`` with no options contains q, every solution is FK-certified
+and within limits; the solution set agrees with independent references: another decomposition of the same arm
+(another theta*), IK-Geo where it has a closed form for the arm, and a many-start numerical search.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from oracles import contains, ikgeo_solutions, numerical_solutions, same_solution_set
+
+import sweepik
+from sweepik import NoReductionError
+from sweepik.reductions.decompose import plans
+from sweepik.robot_file import bundled_robots, robot_from_dict
+
+BUNDLED = bundled_robots()
+CLOSED = {"puma560", "puma560_std", "kuka_kr6_r900", "abb_irb140", "stanford", "carm_swapped"}
+CERT_REL = 1e-9
+
+
+def _configs(robot, n, rng):
+    lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
+    hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
+    return rng.uniform(lo, hi, size=(n, robot.n_joints))
+
+
+def _edge_configs(robot, rng):
+    """Each joint at each of its limits (one at a time), and joint 5 at 0 (a wrist singularity of most arms)."""
+    base = _configs(robot, 1, rng)[0]
+    out = []
+    for j in range(robot.n_joints):
+        for lim in (robot.lower[j], robot.upper[j]):
+            q = base.copy()
+            q[j] = lim
+            out.append(q)
+    q = base.copy()
+    q[4] = 0.0
+    out.append(q)
+    return np.array(out)
+
+
+def _recalls(robot, sols, q):
+    near = sols.nearest(q)
+    d = near - q
+    d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
+    return bool(np.max(np.abs(d)) < 1e-6)
+
+
+def _kw(robot):
+    # the C-Arm's file names its hand-derived reduction; the automatic one is asked for by name
+    return {"reduction": "auto"} if robot.default_reduction else {}
+
+
+def _check_set(robot, sols):
+    if len(sols):
+        assert np.all(sols.error_geodesic <= CERT_REL * robot.length_scale)
+        assert np.all(robot.within_limits(sols.q))
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_bundled_arm_round_trip(name):
+    robot = sweepik.load_robot(name)
+    rng = np.random.default_rng(abs(hash(name)) % 2**32)
+    Q = np.concatenate([_configs(robot, 60, rng), _edge_configs(robot, rng)])
+    for q, sols in zip(Q, sweepik.solve_many(robot, robot.fk(Q), **_kw(robot)), strict=True):
+        assert _recalls(robot, sols, q), (name, q.tolist())
+        _check_set(robot, sols)
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_bundled_arm_has_expected_decomposition(name):
+    robot = sweepik.load_robot(name)
+    found = plans(robot)
+    assert found, name
+    assert found[0].closed_form == (name in CLOSED)
+
+
+@pytest.mark.parametrize("name", [n for n in BUNDLED if n not in CLOSED])
+def test_other_decompositions_agree(name):
+    """Every theta* the decomposition offers gives the same solution set (different subproblem chains)."""
+    robot = sweepik.load_robot(name)
+    frees = sorted({p.free_joint for p in plans(robot) if not p.closed_form and not p.conditional})
+    assert frees
+    rng = np.random.default_rng(7)
+    Q = _configs(robot, 25, rng)
+    T = robot.fk(Q)
+    # within the limits: a prismatic theta* is swept over its limits only, a revolute one finds solutions whose
+    # prismatic joints lie beyond them
+    ref = sweepik.solve_many(robot, T, free_joint=frees[0])
+    for k in frees[1:]:
+        other = sweepik.solve_many(robot, T, free_joint=k)
+        same = [
+            same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale) for a, b in zip(ref, other, strict=True)
+        ]
+        assert np.mean(same) >= 0.96, (name, k, np.mean(same))
+
+
+@pytest.mark.parametrize("name", ["puma560", "puma560_std", "kuka_kr6_r900", "abb_irb140", "ur5"])
+def test_against_ikgeo(name):
+    pytest.importorskip("ik_geo")
+    robot = sweepik.load_robot(name)
+    rng = np.random.default_rng(11)
+    Q = _configs(robot, 40, rng)
+    T = robot.fk(Q)
+    ours = sweepik.solve_many(robot, T, limits=False)
+    agree = 0
+    for q, t, s in zip(Q, T, ours, strict=True):
+        ref = ikgeo_solutions(robot, t)
+        assert ref is not None and contains(ref, q, robot.is_revolute, robot.length_scale)
+        agree += same_solution_set(s.q, ref, robot.is_revolute, robot.length_scale)
+    assert agree >= 0.95 * len(Q), (name, agree)
+
+
+@pytest.mark.parametrize("name", ["fanuc_crx10ia", "kinova_jaco2", "yaskawa_hc10", "xarm6", "carm", "stanford"])
+def test_against_numerical_search(name):
+    robot = sweepik.load_robot(name)
+    rng = np.random.default_rng(13)
+    Q = _configs(robot, 3, rng)
+    for q in Q:
+        T = robot.fk(q)
+        s = sweepik.solve(robot, T, limits=False, **_kw(robot))
+        num = numerical_solutions(robot, T, n_starts=300)
+        inside = robot.within_limits(num) if num.size else np.zeros(0, bool)
+        assert same_solution_set(s.q[robot.within_limits(s.q)], num[inside], robot.is_revolute, robot.length_scale)
+
+
+def test_carm_automatic_equals_hand_derivations():
+    robot = sweepik.load_robot("carm")
+    rng = np.random.default_rng(17)
+    Q = _configs(robot, 150, rng)
+    T = robot.fk(Q)
+    auto = sweepik.solve_many(robot, T, reduction="auto")
+    for ref_name in ("carm-d1", "carm-theta2"):
+        ref = sweepik.solve_many(robot, T, reduction=ref_name)
+        same = [
+            same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale) for a, b in zip(auto, ref, strict=True)
+        ]
+        assert np.mean(same) >= 0.99, (ref_name, np.mean(same))
+
+
+# ---------------------------------------------------------------------------------------------------------
+# random arms of each family: other dimensions, base and tool transforms, prismatic joints where allowed
+# ---------------------------------------------------------------------------------------------------------
+
+
+def _arm(rows, rng, convention="standard", transforms=True):
+    """A robot from DH rows ``(type, a, alpha_deg, d, theta_deg)`` with random limits-free revolute joints."""
+    joints = []
+    for i, (kind, a, alpha, d, theta) in enumerate(rows):
+        limits = [-180.0, 180.0] if kind == "revolute" else [-0.5, 1.5]
+        row = {"a": a, "alpha": alpha, "d": d, "theta": theta}
+        joints.append({"name": f"j{i + 1}", "type": kind, "limits": limits, **row})
+    data = {"name": "random", "dh_convention": convention, "length_unit": "m", "joints": joints}
+    if transforms:
+        data["base"] = {"xyz": rng.normal(size=3).tolist(), "zyz": rng.uniform(-180, 180, 3).tolist()}
+        data["tool"] = {"xyz": rng.normal(scale=0.1, size=3).tolist(), "zyz": rng.uniform(-180, 180, 3).tolist()}
+    return robot_from_dict(data)
+
+
+def _L(rng):
+    return float(rng.uniform(0.1, 0.8))
+
+
+FAMILIES = {
+    # spherical wrist after a shoulder with 2 || 3 (PUMA-like), closed form
+    "wrist_parallel": lambda g: [
+        ("revolute", _L(g), 90, _L(g), 0),
+        ("revolute", _L(g), 0, _L(g), 0),
+        ("revolute", _L(g), 90, 0, 0),
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 90, 0, 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # Stanford-like RRP + spherical wrist, closed form with a prismatic joint
+    "wrist_rrp": lambda g: [
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 90, _L(g), 0),
+        ("prismatic", 0, 0, 0, 0),
+        ("revolute", 0, -90, 0, 0),
+        ("revolute", 0, 90, 0, 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # Cartesian gantry PPP + spherical wrist
+    "wrist_ppp": lambda g: [
+        ("prismatic", 0, -90, 0, 0),
+        ("prismatic", 0, -90, 0, -90),
+        ("prismatic", 0, 0, 0, 0),
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 90, 0, 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # three parallel axes, offset wrist (UR-like): swept
+    "three_parallel": lambda g: [
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", -_L(g), 0, 0, 0),
+        ("revolute", -_L(g), 0, 0, 0),
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # two intersecting axes at the tool, the rest general except 2 || 3 (CRX-like), swept
+    "pair_parallel": lambda g: [
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", _L(g), 0, 0, 0),
+        ("revolute", 0, 90, 0, 0),
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # C-Arm-like: a prismatic rail first, other dimensions
+    "rail_pair": lambda g: [
+        ("prismatic", 0, 0, 0, 0),
+        ("revolute", 0, 90, 0, 0),
+        ("revolute", 0, -90, 0, -90),
+        ("revolute", _L(g), 0, 0, 0),
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 90, 0, 0),
+    ],
+}
+
+
+@pytest.mark.parametrize("family", sorted(FAMILIES))
+@pytest.mark.parametrize("seed", range(3))
+def test_random_family_arm(family, seed):
+    rng = np.random.default_rng(1000 * seed + len(family))
+    convention = "modified" if family == "rail_pair" else "standard"
+    robot = _arm(FAMILIES[family](rng), rng, convention)
+    assert plans(robot), robot.structure().describe()
+    Q = _configs(robot, 30, rng)
+    for q, sols in zip(Q, sweepik.solve_many(robot, robot.fk(Q)), strict=True):
+        assert _recalls(robot, sols, q), (family, q.tolist())
+        _check_set(robot, sols)
+    if seed == 0:  # one pose against the numerical search
+        T = robot.fk(Q[0])
+        s = sweepik.solve(robot, T, limits=False)
+        num = numerical_solutions(robot, T, n_starts=300)
+        num = num[robot.within_limits(num)] if num.size else num
+        assert same_solution_set(s.q[robot.within_limits(s.q)], num, robot.is_revolute, robot.length_scale)
+
+
+def test_arm_outside_the_catalogue_is_refused():
+    rng = np.random.default_rng(3)
+    rows = [("revolute", _L(rng), float(rng.uniform(20, 70)), _L(rng), 0) for _ in range(6)]
+    robot = _arm(rows, rng)
+    assert plans(robot) == ()
+    with pytest.raises(NoReductionError, match="outside sweepik's catalogue"):
+        sweepik.solve(robot, robot.fk(np.zeros(6)))
+    with pytest.raises(NoReductionError):
+        sweepik.solve(robot, robot.fk(np.zeros(6)), free_joint=0)
+
+
+def test_free_joint_errors():
+    robot = sweepik.load_robot("ur5")
+    T = robot.fk(np.full(6, 0.3))
+    with pytest.raises(NoReductionError, match="no decomposition sweeps joint"):
+        sweepik.solve(robot, T, free_joint=0)
+    with pytest.raises(sweepik.SweepikError, match="not both"):
+        sweepik.solve(robot, T, free_joint=1, reduction="auto")
+    with pytest.raises(sweepik.SweepikError):
+        sweepik.solve(robot, T, free_joint=9)
+    by_name = sweepik.solve(robot, T, free_joint=robot.joint_names[1])
+    by_index = sweepik.solve(robot, T, free_joint=1)
+    assert same_solution_set(by_name.q, by_index.q, robot.is_revolute, robot.length_scale)
