@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import __version__
+from .analysis import analyze
 from .errors import SweepikError
 from .pose import GIMBAL_TOL, zyz_from_matrix
 from .robot import Robot
@@ -40,6 +41,7 @@ from .robot_file import bundled_robots, load_robot
 
 __all__ = ["main", "build_parser"]
 
+from .cli_analyze import add_analyze_parser, cmd_analyze, plan_line
 from .cli_common import (
     DEFAULT_ROBOT,
     EXIT_IO,
@@ -154,7 +156,7 @@ def _add_robots_parser(sub: _SubParsers) -> None:
     p = _subparser(
         sub,
         "robots",
-        help="list the bundled robots and their DH tables",
+        help="list the bundled robots: DH tables, structure and decomposition",
         description="Show robots: the bundled ones, or the named robots / robot files.",
     )
     p.add_argument("robots", nargs="*", metavar="ROBOT", help="robot names or files (default: all bundled)")
@@ -163,6 +165,7 @@ def _add_robots_parser(sub: _SubParsers) -> None:
 
 
 def _robot_summary(robot: Robot) -> dict[str, Any]:
+    info = analyze(robot)
     return {
         "name": robot.name,
         "description": robot.description,
@@ -173,6 +176,8 @@ def _robot_summary(robot: Robot) -> dict[str, Any]:
         "dh_table": robot.dh_table(),
         "T_world_base": robot.T_world_base.tolist(),
         "T_flange_tool": robot.T_flange_tool.tolist(),
+        "structure": info["structure"],
+        "decomposition": info["chosen"],
     }
 
 
@@ -189,6 +194,10 @@ def _cmd_robots(args: argparse.Namespace) -> int:
         print(f"{robot.name}: {robot.description}" if robot.description else robot.name)
         extra = f", default reduction {robot.default_reduction}" if robot.default_reduction else ""
         print(f"  {robot.n_joints} joints, {robot.dh_convention} DH, lengths in {unit}, angles in deg{extra}")
+        info = analyze(robot)
+        print(f"  structure {info['structure']}")
+        chosen = info["chosen"]
+        print(f"  decomposition: {plan_line(chosen) if chosen else 'none in the catalogue'}")
         a_label = "a_{i-1}" if robot.dh_convention == "modified" else "a_i"
         al_label = "alpha_{i-1}" if robot.dh_convention == "modified" else "alpha_i"
         header = [
@@ -227,6 +236,7 @@ _Run = Callable[[argparse.Namespace], int]
 _COMMANDS: dict[str, tuple[_AddParser, _Run]] = {
     "fk": (_add_fk_parser, _cmd_fk),
     "robots": (_add_robots_parser, _cmd_robots),
+    "analyze": (add_analyze_parser, cmd_analyze),
     "solve": (add_solve_parser, cmd_solve),
     "path": (add_path_parser, cmd_path),
     "verify": (add_verify_parser, cmd_verify),

@@ -27,6 +27,7 @@ from .cli_common import (
     _subparser,
     _SubParsers,
 )
+from .errors import UnknownOptionError
 from .pose import pose_from_xyz_zyz
 from .reductions import REDUCTIONS
 from .robot import Robot
@@ -39,7 +40,12 @@ Array = NDArray[np.float64]
 
 def _ik_kwargs(args: argparse.Namespace) -> dict[str, Any]:
     """The solver's keyword arguments from the options of :func:`_add_ik_options`."""
-    return {"reduction": args.reduction, "strategy": args.strategy, "limits": not args.no_limits}
+    free = args.free_joint
+    if free is not None and free.isdigit():
+        if int(free) < 1:
+            raise UnknownOptionError(f"--free-joint numbers joints from 1, got {free}")
+        free = int(free) - 1  # the API numbers joints from 0
+    return {"reduction": args.reduction, "free_joint": free, "strategy": args.strategy, "limits": not args.no_limits}
 
 
 def _add_ik_options(p: argparse.ArgumentParser) -> None:
@@ -47,7 +53,15 @@ def _add_ik_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--reduction",
         metavar="NAME",
-        help=f"reduction (theta* joint): one of {', '.join(sorted(REDUCTIONS))}; default: the robot's own",
+        help=(
+            f"reduction (theta* joint): auto (derived from the arm's geometry) or one of "
+            f"{', '.join(sorted(REDUCTIONS))}; default: the robot file's default_reduction, else auto"
+        ),
+    )
+    p.add_argument(
+        "--free-joint",
+        metavar="J",
+        help="with the automatic decomposition, sweep this joint (number from 1, or name); see 'sweepik analyze'",
     )
     p.add_argument("--no-limits", action="store_true", help="keep solutions outside the joint limits (flagged)")
     p.add_argument("--rad", action="store_true", help="angles in and out in radians instead of degrees")

@@ -117,6 +117,7 @@ def follow_path(
     q_start: ArrayLike | None = None,
     *,
     reduction: str | Reduction | None = None,
+    free_joint: int | str | None = None,
     strategy: Literal["precise", "paper"] = "precise",
     limits: bool = True,
     progress: Progress | None = None,
@@ -145,7 +146,9 @@ def follow_path(
     if ref is not None and ref.ndim != 1:
         raise ShapeError(f"q_start must have shape ({robot.n_joints},), got {ref.shape}")
     report = None if progress is None else (lambda _stage, done, total: progress("path", done, total))
-    sols = iter_solve(robot, P, reduction=reduction, strategy=strategy, limits=limits, progress=report)
+    sols = iter_solve(
+        robot, P, reduction=reduction, free_joint=free_joint, strategy=strategy, limits=limits, progress=report
+    )
     weight = orientation_weight(robot.length_unit)
     N, n = P.shape[0], robot.n_joints
     q = np.full((N, n), np.nan)

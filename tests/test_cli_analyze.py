@@ -1,0 +1,79 @@
+"""``sweepik analyze``, the structure/decomposition lines of ``sweepik robots``, and ``--free-joint``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import sweepik
+from sweepik.cli import main
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_analyze_api_matches_plans():
+    info = sweepik.analyze("carm")
+    assert info["structure"] == "PRRRRR: 2∩3, 3∥4, 4∩5, 5∩6"
+    assert info["chosen"]["free_joint"] == 1 and not info["chosen"]["closed_form"]
+    assert len(info["plans"]) == len(sweepik.reductions.decompose.plans(sweepik.load_robot("carm")))
+    # a plan with a blind spot is offered but never chosen by default
+    assert any(p["blind_spot"] for p in info["plans"]) and not info["chosen"]["blind_spot"]
+    assert sweepik.analyze(sweepik.load_robot("puma560"))["chosen"]["closed_form"]
+    with pytest.raises(sweepik.SweepikError):
+        sweepik.analyze(3)  # type: ignore[arg-type]
+
+
+def test_analyze_cli_text_and_json(capsys):
+    code, out, _ = run(capsys, "analyze", "stanford")
+    assert code == 0 and "RRPRRR: 1∩2" in out and "closed form, 8 branches" in out
+    code, out, _ = run(capsys, "analyze", "xarm6", "--json")
+    info = json.loads(out)
+    assert code == 0 and info["chosen"]["chain"] == "reversed" and info["reason"] is None
+
+
+def test_analyze_cli_outside_the_catalogue(capsys, tmp_path: Path):
+    text = (Path(sweepik.__file__).parent / "robots" / "puma560.toml").read_text()
+    # joint 5's axis 30 mm off joint 4's and 6's: no spherical wrist, no two axes meeting at either end
+    text = text.replace("alpha = 90.0\nlimits = [-100.0, 100.0]", "a = 0.03\nalpha = 90.0\nlimits = [-100.0, 100.0]")
+    text = text.replace(
+        "alpha = -90.0\nlimits = [-266.0, 266.0]", "a = 0.02\nalpha = -90.0\nd = 0.05\nlimits = [-266.0, 266.0]"
+    )
+    text = text.replace('[[joints]]\nname = "q2"', '[[joints]]\nname = "q2"\nd = 0.1\na = 0.05', 1)
+    path = tmp_path / "odd.toml"
+    path.write_text(text)
+    code, out, _ = run(capsys, "analyze", str(path))
+    assert code == 0 and "no decomposition" in out and "outside sweepik's catalogue" in out
+    code, out, err = run(capsys, "solve", str(path), "--xyz", "0.3", "0.2", "0.4")
+    assert code == 2 and out == "" and "catalogue" in err and len(err.strip().splitlines()) == 1
+
+
+def test_robots_lists_structure_and_decomposition(capsys):
+    code, out, _ = run(capsys, "robots", "ur5", "carm_swapped")
+    assert code == 0
+    assert "structure RRRRRR: 1∩2, 2∥3, 2∥4, 3∥4, 4∩5, 5∩6" in out
+    assert "decomposition: closed form, 8 branches" in out  # carm_swapped: the paper's rejected closed form
+    code, out, _ = run(capsys, "robots", "ur5", "--json")
+    assert json.loads(out)[0]["decomposition"]["free_joint"] == 2
+
+
+def test_free_joint_option(capsys):
+    robot = sweepik.load_robot("ur5")
+    T = robot.fk(np.array([0.3, -1.0, 1.2, -0.4, 0.9, 0.2]))
+    matrix = [repr(float(v)) for v in T.reshape(-1)]
+    outs = []
+    for joint in ("2", "4", "wrist_2"):
+        code, out, _ = run(capsys, "solve", "ur5", "--matrix", *matrix, "--free-joint", joint, "--json", "--rad")
+        assert code == 0
+        q = np.array(json.loads(out)["poses"][0]["q"])
+        outs.append(q[np.lexsort(np.round(q, 6).T[::-1])])
+    for o in outs[1:]:
+        np.testing.assert_allclose(o, outs[0], atol=1e-6)
+    code, _, err = run(capsys, "solve", "ur5", "--matrix", *matrix, "--free-joint", "0")
+    assert code == 2 and "from 1" in err
