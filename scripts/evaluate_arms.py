@@ -1,0 +1,94 @@
+"""Evaluate the automatic decomposition on every bundled arm (issue 9's acceptance measurement).
+
+For each arm: N random in-limit configurations plus edge cases (each joint at each limit, joint 5 at 0);
+``sweepik.solve_many(robot, robot.fk(Q))`` with no options (the C-Arm: reduction="auto"). Reports recall
+(q among the solutions, or on a reported family), FK certification (<= 1e-9 x length scale), limits, and the
+agreement of each pose's solution set (within limits) with an independent reference: IK-Geo where it has a
+closed form for the arm, else the many-start numerical search of tests/oracles.py.
+
+    python scripts/evaluate_arms.py [--n 2000] [--arms ur5 carm ...] [--numerical-max 2000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+
+import sweepik  # noqa: E402
+from oracles import ikgeo_solutions, numerical_solutions, same_solution_set  # noqa: E402
+from sweepik.robot_file import bundled_robots  # noqa: E402
+
+
+def configs(robot, n, rng):
+    lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
+    hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
+    Q = rng.uniform(lo, hi, size=(n, robot.n_joints))
+    base = Q[0]
+    edges = []
+    for j in range(robot.n_joints):
+        for lim in (robot.lower[j], robot.upper[j]):
+            q = base.copy()
+            q[j] = lim
+            edges.append(q)
+    q = base.copy()
+    q[4] = 0.0
+    edges.append(q)
+    return np.concatenate([Q, np.array(edges)])
+
+
+def recalls(robot, sols, q):
+    d = sols.nearest(q) - q
+    d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
+    return bool(np.max(np.abs(d)) < 1e-6)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n", type=int, default=2000)
+    ap.add_argument("--arms", nargs="*", default=None)
+    ap.add_argument("--numerical-max", type=int, default=2000, help="poses compared with the numerical search")
+    args = ap.parse_args()
+    for name in args.arms or bundled_robots():
+        robot = sweepik.load_robot(name)
+        rng = np.random.default_rng(2026)
+        Q = configs(robot, args.n, rng)
+        T = robot.fk(Q)
+        kw = {"reduction": "auto"} if robot.default_reduction else {}
+        t0 = time.perf_counter()
+        S = sweepik.solve_many(robot, T, **kw)
+        dt = time.perf_counter() - t0
+        rec = sum(recalls(robot, s, q) for s, q in zip(S, Q, strict=True))
+        cert = all((s.error_geodesic <= 1e-9 * robot.length_scale).all() for s in S if len(s))
+        lim = all(robot.within_limits(s.q).all() for s in S if len(s))
+        same = compared = 0
+        kind = "ik-geo"
+        worst = []
+        for i, (s, t) in enumerate(zip(S, T, strict=True)):
+            ref = ikgeo_solutions(robot, t) if robot.is_revolute.all() else None
+            if ref is None:
+                kind = "numerical"
+                if compared >= args.numerical_max:
+                    continue
+                ref = numerical_solutions(robot, t, n_starts=300)
+            ref = ref[robot.within_limits(ref)] if len(ref) else ref
+            ok = same_solution_set(s.q, ref, robot.is_revolute, robot.length_scale)
+            same += ok
+            compared += 1
+            if not ok:
+                worst.append((i, len(s), len(ref)))
+        print(
+            f"{name:15s} poses {len(Q)} recall {rec}/{len(Q)} certified {cert} in-limits {lim} "
+            f"same-as-{kind} {same}/{compared} ({100 * same / max(compared, 1):.2f} %) "
+            f"solve {1e3 * dt / len(Q):.3f} ms/pose; differing (pose, ours, ref): {worst[:6]}",
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    main()
