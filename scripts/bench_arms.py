@@ -21,8 +21,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-import sweepik  # noqa: E402
 import oracles  # noqa: E402
+
+import sweepik  # noqa: E402
 from sweepik.robot_file import bundled_robots  # noqa: E402
 
 
@@ -105,8 +106,8 @@ def main() -> None:
         cells = {}
         for label, kw in variants.items():
             cells[label] = (
-                _median_us(lambda t, kw=kw: sweepik.solve(robot, t, **kw), list(T[: args.single])),
-                _batch_us(lambda ts, kw=kw: sweepik.solve_many(robot, ts, **kw), T[: args.batch]),
+                _median_us(lambda t, kw=kw, robot=robot: sweepik.solve(robot, t, **kw), list(T[: args.single])),
+                _batch_us(lambda ts, kw=kw, robot=robot: sweepik.solve_many(robot, ts, **kw), T[: args.batch]),
             )
         for peer, (single, batch) in _peers(robot).items():
             cells[peer] = (_median_us(single, list(T[: args.single])), _batch_us(batch, list(T[: args.batch])))

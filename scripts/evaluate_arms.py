@@ -20,8 +20,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-import sweepik  # noqa: E402
 from oracles import ikgeo_solutions, numerical_solutions, same_solution_set  # noqa: E402
+
+import sweepik  # noqa: E402
 from sweepik.robot_file import bundled_robots  # noqa: E402
 
 

@@ -351,7 +351,7 @@ if AVAILABLE:
     _U_EDGE_ARR = _U_EDGE.copy()
 
     @njit(cache=True)
-    def _search_pose(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
+    def _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
         M = grid.shape[1]
         if True:
             p = params[i]
@@ -363,7 +363,8 @@ if AVAILABLE:
             stk_i = np.empty((STACK, 3), dtype=np.int64)
             stk_c = np.empty((STACK, 4))
             no_ctx = np.full(4, np.nan)
-            for b in range(n_branches):
+            for bi in range(branches.shape[0]):
+                b = branches[bi]
                 f = np.empty(M)
                 for j in range(M):
                     f[j] = res(p, th[j], b)
@@ -458,7 +459,7 @@ if AVAILABLE:
         types.FunctionType(RESIDUAL_SIG),
         float64[:, ::1],
         float64[:, ::1],
-        int64,
+        int64[::1],
         float64[::1],
         float64,
         float64[:, ::1],
@@ -470,14 +471,14 @@ if AVAILABLE:
     )
 
     @njit(_SEARCH_SIG, cache=True, parallel=True)
-    def _search_parallel(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
+    def _search_parallel(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in prange(grid.shape[0]):
-            _search_pose(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
+            _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
 
     @njit(_SEARCH_SIG, cache=True)
-    def _search_serial(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
+    def _search_serial(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in range(grid.shape[0]):
-            _search_pose(res, params, grid, n_branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
+            _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
 
 
 def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
@@ -499,7 +500,7 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         first_class(reduction.kernel[0]),
         params,
         np.ascontiguousarray(theta),
-        int(reduction.n_branches),
+        np.asarray(reduction.search_branches, dtype=np.int64),
         np.ascontiguousarray(span, dtype=np.float64),
         float(reduction.residual_noise),
         out_t,

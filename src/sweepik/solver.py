@@ -180,6 +180,30 @@ _DEDUPE_WINDOW = 16
 _DEDUPE_PAIRWISE = 48
 
 
+def _twin_copies(red: Reduction, cand: Candidates, spans: list[FamilySpan]) -> tuple[Candidates, list[FamilySpan]]:
+    """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
+    branches of the class too: their residuals are the same, their configurations differ."""
+    if not red.twins:
+        return cand, spans
+    parts = [cand]
+    for cls in red.twins:
+        k = np.nonzero(cand.branch == cls[0])[0]
+        for b in cls[1:]:
+            parts.append(Candidates(cand.pose[k], np.full(k.size, b, dtype=np.intp), cand.theta[k], cand.mult[k]))
+    spans = spans + [
+        FamilySpan(s.pose, b, s.lo, s.hi) for cls in red.twins for s in spans if s.branch == cls[0] for b in cls[1:]
+    ]
+    return (
+        Candidates(
+            np.concatenate([c.pose for c in parts]),
+            np.concatenate([c.branch for c in parts]),
+            np.concatenate([c.theta for c in parts]),
+            np.concatenate([c.mult for c in parts]),
+        ),
+        spans,
+    )
+
+
 def _every_branch(n_poses: int, n_branches: int) -> Candidates:
     """Candidates of a closed form: every branch of every pose (theta* unused: 0)."""
     return Candidates(
@@ -219,13 +243,13 @@ def _solve_chunk(
                 q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         elif compiled:
             params = red.kernel_params(chain)
-            cand, spans = fastsweep.search(red, chain, lo, hi, n_samples, params)
+            cand, spans = _twin_copies(red, *fastsweep.search(red, chain, lo, hi, n_samples, params))
             cand = _limit_copies(robot, red, cand, hi - lo)
             q, err_geo, err_paper = fastcertify.certify(
                 robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
             )
         else:
-            cand, spans = find_candidates(red, chain, lo, hi, n_samples)
+            cand, spans = _twin_copies(red, *find_candidates(red, chain, lo, hi, n_samples))
             cand = _limit_copies(robot, red, cand, hi - lo)
             q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         pose_idx, mult = cand.pose, cand.mult

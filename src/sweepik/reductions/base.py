@@ -59,6 +59,15 @@ class Reduction(ABC):
     kernel: tuple[Any, Any] | None = None
     #: No sweep: every branch of ``solve_rest`` (at any theta*) is a candidate (a closed-form decomposition).
     closed_form: bool = False
+    #: Classes of branches whose residuals are identical (they differ in the configuration only, e.g. by a
+    #: symmetry of the arm): the engine searches the first of each class and hands its roots to the others.
+    twins: tuple[tuple[int, ...], ...] = ()
+
+    @property
+    def search_branches(self) -> list[int]:
+        """The branches the engine searches: all, or the first of each class of ``twins``."""
+        others = {b for cls in self.twins for b in cls[1:]}
+        return [b for b in range(self.n_branches) if b not in others]
 
     @property
     def uses_kernel(self) -> bool:

@@ -20,6 +20,12 @@ from . import geometric
 from .base import Array, IntArray, Reduction
 from .position import CASES
 
+#: Twin branches: residuals compared at this many random poses and theta* values, equal to this (absolute; the
+#: residual is a difference of cosines).
+TWIN_POSES = 12
+TWIN_SAMPLES = 24
+TWIN_TOL = 1e-12
+
 
 @dataclass(frozen=True)
 class Plan:
@@ -109,6 +115,36 @@ class GeometricReduction(Reduction):
             else (geometric.pair_residual, geometric.pair_configuration)
         )
         self.kernel = self._kernels
+        if not plan.closed_form:
+            self.twins = tuple(tuple(c) for c in _classes(self._probe(self._kernels[0], self.n_branches)) if len(c) > 1)
+
+    def _probe(self, fn: Any, count: int) -> Array:
+        """``fn(params, theta*, k)`` for k < count at random poses and theta* values: ``(poses, samples, count)``."""
+        robot = self.robot
+        rng = np.random.default_rng(0)
+        lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
+        hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
+        q = rng.uniform(lo, hi, size=(TWIN_POSES, robot.n_joints))
+        params = self.kernel_params(robot.T_base_world @ robot.fk(q) @ robot.T_tool_flange)
+        a, b = self._range(1)
+        x = rng.uniform(a[0], b[0], size=TWIN_SAMPLES)
+        pose = np.repeat(np.arange(TWIN_POSES), TWIN_SAMPLES * count).astype(np.int64)
+        th = np.tile(np.repeat(x, count), TWIN_POSES)
+        k = np.tile(np.arange(count), TWIN_POSES * TWIN_SAMPLES).astype(np.int64)
+        out = np.empty(pose.size)
+        geometric.evaluate(fn, params, pose, th, k, out)
+        return out.reshape(TWIN_POSES, TWIN_SAMPLES, count)
+
+    @cached_property
+    def _steps(self) -> tuple[list[int], list[int]]:
+        """The margins and the amplitudes (``geometric.pair_margin``, ``_amplitude``: k = 0, 1, 2) worth sweeping:
+        not constant (a step with one solution, or a circle that always meets its plane) and not the twin of an
+        earlier one."""
+        m = self._probe(geometric.pair_margin, 3)
+        a = self._probe(geometric.amplitude, 3)
+        margins = [c[0] for c in _classes(m) if not np.all(m[..., c[0]] == 1.0)]
+        amplitudes = [c[0] for c in _classes(a) if not np.all(np.isinf(a[..., c[0]]))]
+        return margins, amplitudes
 
     @cached_property
     def _continua(self) -> GeometricReduction | None:
@@ -147,7 +183,8 @@ class GeometricReduction(Reduction):
 
         lo, hi = self._range(poses.shape[0])
         swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
-        geometric.swing_hints(self.kernel_params(poses), lo, hi, N_SAMPLES, self.periodic, swings)
+        ks = np.asarray(self._steps[1], dtype=np.int64)
+        geometric.swing_hints(self.kernel_params(poses), lo, hi, N_SAMPLES, self.periodic, ks, swings)
         keep = np.any(np.isfinite(swings), axis=0)
         swings = swings[:, keep]
         theta = np.concatenate([_Margins(self, swings).zeros(poses, lo, hi), swings], axis=1)
@@ -211,12 +248,32 @@ class GeometricReduction(Reduction):
         return out.reshape(*shape, 6)
 
 
+def _classes(f: Array) -> list[list[int]]:
+    """Classes of the last axis of ``f`` whose values agree to ``TWIN_TOL`` (NaN where the other is NaN), with
+    enough finite values to tell."""
+    classes: list[list[int]] = []
+    for br in range(f.shape[-1]):
+        for cls in classes:
+            g, h = f[..., cls[0]], f[..., br]
+            same_domain = np.array_equal(np.isnan(g), np.isnan(h)) and np.isfinite(g).sum() >= TWIN_SAMPLES
+            if same_domain and np.nanmax(np.abs(np.where(g == h, 0.0, g - h)), initial=0.0) <= TWIN_TOL:
+                cls.append(br)
+                break
+        else:
+            classes.append([br])
+    return classes
+
+
 class _Margins(Reduction):
     """The margins ``1 - c^2`` of a pair plan's branch domains, as a residual with three branches (the first
     step's, and the second step's on either branch of the first), so that the sweep finds their zeros."""
 
     name = "margins"
     kernel: tuple[Any, Any] | None = None
+
+    @property
+    def search_branches(self) -> list[int]:
+        return self.red._steps[0]
 
     def __init__(self, red: GeometricReduction, swings: Array) -> None:
         super().__init__(red.robot, red.free_joint, 3)

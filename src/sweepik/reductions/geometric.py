@@ -206,13 +206,14 @@ pair_configuration = njit(CONFIGURATION_SIG, cache=True)(_pair_configuration)
 pair_margin = njit(RESIDUAL_SIG, cache=True)(_pair_margin)
 
 
-@njit(cache=True)
 def _amplitude(p, x, k):
     """Amplitude of the first step (k = 0) or of the second on the first step's branch k - 1."""
     if k == 0:
         return _arm(p, x, 0)[6]
     return _arm(p, x, 2 * (k - 1))[7]
 
+
+amplitude = njit(RESIDUAL_SIG, cache=True)(_amplitude)
 
 #: Swing hints: up to this many local minima of each step's amplitude per pose, ...
 SWING_MINIMA = 4
@@ -228,40 +229,41 @@ SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
 @njit(cache=True)
-def swing_hints(params, lo, hi, n, periodic, out):
+def swing_hints(params, lo, hi, n, periodic, ks, out):
     """Samples of theta* ``out (N, SWING_PER_POSE)`` (NaN-padded) where a step of the position case is nearly
     degenerate: around each local minimum ``r*`` of its amplitude ``r(theta*)`` narrower than the grid step
-    ``h``, where its angles turn by up to pi within ``w = r* / |r'|``."""
+    ``h``, where its angles turn by up to pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
+    ``_amplitude``)."""
     g = (math.sqrt(5.0) - 1.0) / 2.0
     for i in range(params.shape[0]):
         p = params[i]
         h = (hi[i] - lo[i]) / n
         cnt = 0
-        for k in range(3):
+        for k in ks:
             found = 0
-            xm, am = lo[i] - h, _amplitude(p, lo[i] - h, k)
-            x0, a0 = lo[i], _amplitude(p, lo[i], k)
+            xm, am = lo[i] - h, amplitude(p, lo[i] - h, k)
+            x0, a0 = lo[i], amplitude(p, lo[i], k)
             for j in range(1, n + 2):
                 x1 = lo[i] + j * h
-                a1 = _amplitude(p, x1, k)
+                a1 = amplitude(p, x1, k)
                 # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
                 # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
                 deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
                 if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
                     a, b = xm, x1
                     c, d = b - g * (b - a), a + g * (b - a)
-                    fc, fd = _amplitude(p, c, k), _amplitude(p, d, k)
+                    fc, fd = amplitude(p, c, k), amplitude(p, d, k)
                     for _ in range(SWING_GOLDEN):
                         if fc < fd:
                             b, d, fd = d, c, fc
                             c = b - g * (b - a)
-                            fc = _amplitude(p, c, k)
+                            fc = amplitude(p, c, k)
                         else:
                             a, c, fc = c, d, fd
                             d = a + g * (b - a)
-                            fd = _amplitude(p, d, k)
+                            fd = amplitude(p, d, k)
                     xs = 0.5 * (a + b)
-                    rs = _amplitude(p, xs, k)
+                    rs = amplitude(p, xs, k)
                     slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
                     if slope > 0.0 and rs < slope * h:
                         w = rs / slope
