@@ -264,3 +264,28 @@ def test_free_joint_errors():
     by_name = sweepik.solve(robot, T, free_joint=robot.joint_names[1])
     by_index = sweepik.solve(robot, T, free_joint=1)
     assert same_solution_set(by_name.q, by_index.q, robot.is_revolute, robot.length_scale)
+
+
+def test_origin_and_axis_chain_solves_like_its_dh_twin():
+    """A chain written URDF-style (fixed origin transform + axis per joint, no DH) decomposes and solves."""
+    puma = sweepik.load_robot("puma560")
+    frames = puma.frames(np.zeros(6))
+    joints, prev = [], np.eye(4)
+    for i in range(6):
+        origin = np.linalg.inv(prev) @ frames[i + 1]
+        axis = (0.0, 0.0, 1.0) if i % 2 else (0.0, 0.0, -1.0)  # some axes flipped: the joint values change sign
+        if axis[2] < 0:
+            lower, upper = -puma.upper[i], -puma.lower[i]
+        else:
+            lower, upper = puma.lower[i], puma.upper[i]
+        joints.append(sweepik.Joint("revolute", lower=lower, upper=upper, origin=tuple(map(tuple, origin)), axis=axis))
+        prev = frames[i + 1]
+    robot = sweepik.Robot("puma_urdf", joints, dh_convention="none", length_unit="m")
+    flip = np.array([-1.0, 1.0, -1.0, 1.0, -1.0, 1.0])
+    rng = np.random.default_rng(5)
+    Q = _configs(puma, 40, rng)
+    np.testing.assert_allclose(robot.fk(Q * flip), puma.fk(Q), atol=1e-12)
+    assert plans(robot)[0].closed_form
+    for q, a, b in zip(Q, sweepik.solve_many(robot, puma.fk(Q)), sweepik.solve_many(puma, puma.fk(Q)), strict=True):
+        assert _recalls(robot, a, q * flip)
+        assert same_solution_set(a.q * flip, b.q, puma.is_revolute, puma.length_scale)
