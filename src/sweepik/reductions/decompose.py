@@ -23,7 +23,7 @@ from ..errors import NoReductionError
 from ..robot import Robot
 from ..structure import INTERSECT_TOL_REL, PARALLEL_TOL, Structure, line_relation, structure_of
 from .generic import Plan
-from .position import BRANCHES, CASES, reduce_chain
+from .position import BRANCHES, CASES, motion, reduce_chain
 
 _reduce_chain: Any = reduce_chain
 
@@ -53,7 +53,7 @@ def _reduced(chain: Chain, W: np.ndarray, f: int, x: float) -> tuple[np.ndarray,
         *(_t(P[i]) for i in range(4)),
         _t(W - o3),
         f,
-        float(x),
+        motion(bool(rev[f]), float(x)),
         _t(W),
     )
     return tuple(np.array(v) for v in out[1:])

@@ -29,9 +29,9 @@ from numba import njit
 from numpy.typing import NDArray
 
 from ..subproblems import in_domain, sp1, sp2
-from ..subproblems.vec import cross, dot, norm, orthogonal, rot, sub
+from ..subproblems.vec import cross, dot, norm, orthogonal, rot, rot_cs, sub
 from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG
-from .position import place, reduce_chain
+from .position import angle, motion, place, reduce_chain
 
 Array = NDArray[np.float64]
 
@@ -75,8 +75,8 @@ def _mat(p, v):
 
 @njit(cache=True)
 def _arm(p, x, branch):
-    """Values ``(q0, q1, q2, q3)`` of the first four joints with joint ``free`` at ``x``, and the cosines
-    ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the position case's steps (``position.place``)."""
+    """Motions ``(m0, m1, m2, m3)`` (``position.motion``) of the first four joints with joint ``free`` at ``x``,
+    and the cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the position case's steps (``position.place``)."""
     h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
     r0, r1, r2, r3 = p[39] > 0.5, p[40] > 0.5, p[41] > 0.5, p[42] > 0.5
     s0, s1, s2, s3 = _v(p, 18), _v(p, 21), _v(p, 24), _v(p, 27)
@@ -86,9 +86,10 @@ def _arm(p, x, branch):
     s4 = sub(_v(p, 57), o3)
     f = int(p[63])
     case = int(p[64])
-    tp, ha, hb, hc, pab, pbc, pcw = reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, _v(p, 54))
-    meet = _v(p, 60)
     rev = (r0, r1, r2, r3)
+    mx = motion(rev[f], x)
+    tp, ha, hb, hc, pab, pbc, pcw = reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, mx, _v(p, 54))
+    meet = _v(p, 60)
     pts = (s0, o1, o2, o3)
     a = 1 if f == 0 else 0
     b = 2 if f <= 1 else 1
@@ -98,57 +99,71 @@ def _arm(p, x, branch):
     else:
         o = sub(meet, pts[b])
         if f == 1 and r1:
-            o = rot(h1, x, o)
-    qa, qb, qc, c1, c2, a1, a2 = place(case, branch, tp, ha, hb, hc, rev[a], rev[b], rev[c], pab, pbc, pcw, o)
+            o = rot_cs(h1, mx[0], mx[1], o)
+    ma, mb, mc, c1, c2, a1, a2 = place(case, branch, tp, ha, hb, hc, rev[a], rev[b], rev[c], pab, pbc, pcw, o)
     if f == 0:
-        return x, qa, qb, qc, c1, c2, a1, a2
+        return mx, ma, mb, mc, c1, c2, a1, a2
     if f == 1:
-        return qa, x, qb, qc, c1, c2, a1, a2
+        return ma, mx, mb, mc, c1, c2, a1, a2
     if f == 2:
-        return qa, qb, x, qc, c1, c2, a1, a2
-    return qa, qb, qc, x, c1, c2, a1, a2
+        return ma, mb, mx, mc, c1, c2, a1, a2
+    return ma, mb, mc, mx, c1, c2, a1, a2
 
 
 @njit(cache=True)
-def _back(p, q0, q1, q2, q3, v):
+def _missing(m0, m1, m2, m3):
+    """Some motion is NaN (an unknown case, dependent prismatic directions)."""
+    return math.isnan(m0[0] + m0[2] + m1[0] + m1[2] + m2[0] + m2[2] + m3[0] + m3[2])
+
+
+@njit(cache=True)
+def _back(p, m0, m1, m2, m3, v):
     """``R_04^T v``: ``v`` seen from frame 4 (revolute joints among the first four undone, last first)."""
-    qs = (q0, q1, q2, q3)
+    ms = (m0, m1, m2, m3)
     for i in range(4):
         if p[39 + i] > 0.5:
-            v = rot(_h(p, i), -qs[i], v)
+            v = rot_cs(_h(p, i), ms[i][0], -ms[i][1], v)
     return v
 
 
 @njit(cache=True)
-def _fore(p, q0, q1, q2, q3, v):
+def _fore(p, m0, m1, m2, m3, v):
     """``R_04 v``."""
-    qs = (q0, q1, q2, q3)
+    ms = (m0, m1, m2, m3)
     for i in range(3, -1, -1):
         if p[39 + i] > 0.5:
-            v = rot(_h(p, i), qs[i], v)
+            v = rot_cs(_h(p, i), ms[i][0], ms[i][1], v)
     return v
 
 
 def _pair_residual(p, x, branch):
-    q0, q1, q2, q3, c1, c2, _, _ = _arm(p, x, branch)
-    if math.isnan(q0 + q1 + q2 + q3) or not (in_domain(c1) and in_domain(c2)):
+    m0, m1, m2, m3, c1, c2, _, _ = _arm(p, x, branch)
+    if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
         return math.nan
     h4, h5 = _h(p, 4), _h(p, 5)
-    return dot(_fore(p, q0, q1, q2, q3, h4), _mat(p, h5)) - dot(h4, h5)
+    return dot(_fore(p, m0, m1, m2, m3, h4), _mat(p, h5)) - dot(h4, h5)
 
 
 @njit(cache=True)
-def _last_two(p, q0, q1, q2, q3, h4, h5):
+def _last_two(p, m0, m1, m2, m3, h4, h5):
     """Joints 5 and 6 (indices 4, 5) turning the tool onto the target, given the first four."""
-    q4, _ = sp1(h5, _back(p, q0, q1, q2, q3, _mat(p, h5)), h4)
+    q4, _ = sp1(h5, _back(p, m0, m1, m2, m3, _mat(p, h5)), h4)
     e = orthogonal(h5)
-    q5, _ = sp1(e, rot(h4, -q4, _back(p, q0, q1, q2, q3, _mat(p, e))), h5)
+    q5, _ = sp1(e, rot(h4, -q4, _back(p, m0, m1, m2, m3, _mat(p, e))), h5)
     return q4, q5
 
 
 @njit(cache=True)
-def _write(p, out, q0, q1, q2, q3, q4, q5):
-    qs = (q0, q1, q2, q3, q4, q5)
+def _write(p, out, m0, m1, m2, m3, q4, q5):
+    """The configuration in the robot's joint order (reversed for a reversed chain)."""
+    qs = (
+        angle(p[39] > 0.5, m0),
+        angle(p[40] > 0.5, m1),
+        angle(p[41] > 0.5, m2),
+        angle(p[42] > 0.5, m3),
+        q4,
+        q5,
+    )
     rev = p[65] > 0.5
     for i in range(6):
         out[5 - i if rev else i] = qs[i]
@@ -165,24 +180,24 @@ def _pair_margin(p, x, k):
 
 
 def _pair_configuration(p, x, branch, out):
-    q0, q1, q2, q3, _, _, _, _ = _arm(p, x, branch)
-    if math.isnan(q0 + q1 + q2 + q3):
+    m0, m1, m2, m3, _, _, _, _ = _arm(p, x, branch)
+    if _missing(m0, m1, m2, m3):
         for i in range(6):
             out[i] = math.nan
         return
-    q4, q5 = _last_two(p, q0, q1, q2, q3, _h(p, 4), _h(p, 5))
-    _write(p, out, q0, q1, q2, q3, q4, q5)
+    q4, q5 = _last_two(p, m0, m1, m2, m3, _h(p, 4), _h(p, 5))
+    _write(p, out, m0, m1, m2, m3, q4, q5)
 
 
 def _wrist_configuration(p, x, branch, out):
     nb = int(p[66])
-    q0, q1, q2, _, _, _, _, _ = _arm(p, 0.0, branch // 2)
-    if math.isnan(q0 + q1 + q2) or branch >= 2 * nb:
+    m0, m1, m2, m3, _, _, _, _ = _arm(p, 0.0, branch // 2)
+    if _missing(m0, m1, m2, m3) or branch >= 2 * nb:
         for i in range(6):
             out[i] = math.nan
         return
     h3, h4, h5 = _h(p, 3), _h(p, 4), _h(p, 5)
-    v = _back(p, q0, q1, q2, 0.0, _mat(p, h5))
+    v = _back(p, m0, m1, m2, m3, _mat(p, h5))
     t1a, t2a, t1b, t2b, c, _ = sp2(v, h5, h3, h4)
     if math.isnan(c):  # joint 6's axis on joint 4's: a continuum (wrist singular); one member
         q3 = 0.0
@@ -192,9 +207,9 @@ def _wrist_configuration(p, x, branch, out):
     else:
         q3, q4 = -t1b, t2b
     e = orthogonal(h5)
-    w = rot(h4, -q4, rot(h3, -q3, _back(p, q0, q1, q2, 0.0, _mat(p, e))))
+    w = rot(h4, -q4, rot(h3, -q3, _back(p, m0, m1, m2, m3, _mat(p, e))))
     q5, _ = sp1(e, w, h5)
-    _write(p, out, q0, q1, q2, q3, q4, q5)
+    _write(p, out, m0, m1, m2, motion(True, q3), q4, q5)
 
 
 def _no_residual(p, x, branch):
@@ -311,9 +326,9 @@ def wrist_singular(params, out):
         p = params[i]
         out[i] = False
         for b in range(int(p[66])):
-            q0, q1, q2, _, c1, c2, _, _ = _arm(p, 0.0, b)
-            if math.isnan(q0 + q1 + q2) or not (in_domain(c1) and in_domain(c2)):
+            m0, m1, m2, m3, c1, c2, _, _ = _arm(p, 0.0, b)
+            if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
                 continue
-            v = _back(p, q0, q1, q2, 0.0, _mat(p, h5))
+            v = _back(p, m0, m1, m2, m3, _mat(p, h5))
             if norm(cross(v, h3)) < WRIST_SINGULAR:
                 out[i] = True

@@ -40,10 +40,10 @@ import math
 
 from numba import njit
 
-from ..subproblems import lines2, lines3, lp3, lp4, sp1, sp2, sp3, sp4
-from ..subproblems.vec import add, cross, dot, norm, rot, scale, sub, unit
+from ..subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
+from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
-__all__ = ["CASES", "BRANCHES", "reduce_chain", "place", "move", "move_back"]
+__all__ = ["CASES", "BRANCHES", "reduce_chain", "place", "motion", "angle", "move", "move_back"]
 
 #: Case names, in the order of their integer codes in a family's parameter row.
 CASES = ("ab_par", "bc_par", "ab_int", "bc_int", "ppp", "ppr", "ac_par")
@@ -60,32 +60,59 @@ BRANCHES = {
 
 
 @njit(cache=True)
-def move(h, rev, x, v):
-    """``T(v)``: ``v`` rotated about ``h`` by ``x`` (revolute) or translated by ``x h`` (prismatic)."""
+def motion(rev, x):
+    """A joint value as a *motion* ``(cos, sin, travel)``: ``(cos x, sin x, 0)`` for a revolute joint,
+    ``(1, 0, x)`` for a prismatic one. Kernels rotate by cosines and sines and never need the angle itself."""
     if rev:
-        return rot(h, x, v)
-    return add(v, scale(x, h))
+        return math.cos(x), math.sin(x), 0.0
+    return 1.0, 0.0, x
 
 
 @njit(cache=True)
-def move_back(h, rev, x, v):
+def angle(rev, m):
+    """The joint value of motion ``m`` (radians or travel)."""
+    if rev:
+        return math.atan2(m[1], m[0])
+    return m[2]
+
+
+@njit(cache=True)
+def _rev(c, s):
+    return c, s, 0.0
+
+
+@njit(cache=True)
+def _pris(t):
+    return 1.0, 0.0, t
+
+
+@njit(cache=True)
+def move(h, rev, m, v):
+    """``T(v)``: ``v`` rotated about ``h`` (revolute) or translated along it (prismatic) by motion ``m``."""
+    if rev:
+        return rot_cs(h, m[0], m[1], v)
+    return add(v, scale(m[2], h))
+
+
+@njit(cache=True)
+def move_back(h, rev, m, v):
     """The inverse of ``move``."""
     if rev:
-        return rot(h, -x, v)
-    return sub(v, scale(x, h))
+        return rot_cs(h, m[0], -m[1], v)
+    return sub(v, scale(m[2], h))
 
 
 @njit(cache=True)
-def _turn(h, rev, x, v):
+def _turn(h, rev, m, v):
     """The rotation part of ``move`` (directions)."""
     if rev:
-        return rot(h, x, v)
+        return rot_cs(h, m[0], m[1], v)
     return v
 
 
 @njit(cache=True)
 def reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, t):
-    """The three-joint problem left when joint ``f`` (0-3) of the first four is fixed at ``x``.
+    """The three-joint problem left when joint ``f`` (0-3) of the first four is fixed at the motion ``x``.
 
     Returns ``(tp, ha, hb, hc, pab, pbc, pcw)``: the target of ``W`` relative to joint a's point ``tp`` and the
     reduced chain ``W - o_a = T_a(pab + T_b(pbc + T_c(pcw)))`` with the axes of a, b, c. Joint types are those
@@ -111,11 +138,6 @@ def reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, t):
 
 
 @njit(cache=True)
-def _pick(u, v, b):
-    return u if b == 0 else v
-
-
-@njit(cache=True)
 def _line_cos(disc, d):
     """A line-sphere discriminant as the cosine of a circle subproblem (|c| <= 1 inside the domain)."""
     if d > 0.0:
@@ -125,15 +147,15 @@ def _line_cos(disc, d):
 
 @njit(cache=True)
 def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
-    """Joint values ``(qa, qb, qc)`` of ``branch`` putting ``W`` at ``tp``, the cosines ``(c1, c2)`` of its
-    two-solution steps (0 for a one-solution step): ``|c| <= 1`` inside the branch's domain, and their amplitudes
-    ``(r1, r2)`` (inf for a one-solution step): where one nears 0 the step's angle swings fast. Outside it the steps
-    continue with least squares (NaN only for an unknown case or dependent prismatic directions).
+    """Motions ``(ma, mb, mc)`` (see ``motion``) of ``branch`` putting ``W`` at ``tp``, the cosines ``(c1, c2)`` of
+    its two-solution steps (0 for a one-solution step): ``|c| <= 1`` inside the branch's domain, and their
+    amplitudes ``(r1, r2)`` (inf for a one-solution step): where one nears 0 the step's angle swings fast. Outside
+    the domain the steps continue with least squares (NaN only for an unknown case or dependent prismatic
+    directions).
 
     ``o``: for ``ab_int`` the meeting point of axes a and b relative to joint a's point; for ``bc_int`` that of b
     and c relative to joint b's point, in the reduced chain's frame.
     """
-    nan = math.nan
     b1 = branch // 2
     b2 = branch % 2
     c1 = 0.0
@@ -141,68 +163,75 @@ def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     if case == 0:  # ab_par: the height along h_a does not depend on qa, qb
         height = dot(ha, sub(sub(tp, pab), pbc))
         if rc:
-            u, v, c1, r1 = sp4(ha, pcw, hc, height)
-            qc = _pick(u, v, b1)
+            ua, va, ub, vb, c1, r1 = sp4_cs(ha, pcw, hc, height)
+            mc = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
         else:
-            qc = lp4(ha, pcw, hc, height)
+            mc = _pris(lp4(ha, pcw, hc, height))
             b2 = branch
-        w = add(pbc, move(hc, rc, qc, pcw))
-        u, v, c2, r2 = sp3(w, scale(-1.0, pab), hb, norm(tp))
-        qb = _pick(u, v, b2)
-        qa, _ = sp1(add(pab, rot(hb, qb, w)), tp, ha)
-        return qa, qb, qc, c1, c2, r1, r2
+        w = add(pbc, move(hc, rc, mc, pcw))
+        ua, va, ub, vb, c2, r2 = sp3_cs(w, scale(-1.0, pab), hb, norm(tp))
+        mb = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
+        ca, sa = sp1_cs(add(pab, move(hb, True, mb, w)), tp, ha)
+        return _rev(ca, sa), mb, mc, c1, c2, r1, r2
     if case == 1:  # bc_par: the height along h_b does not depend on qb, qc
         height = dot(hb, add(add(pab, pbc), pcw))
         if ra:
-            u, v, c1, r1 = sp4(hb, tp, ha, height)
-            qa = -_pick(u, v, b1)
+            ua, va, ub, vb, c1, r1 = sp4_cs(hb, tp, ha, height)
+            ma = _rev(ua, -va) if b1 == 0 else _rev(ub, -vb)
         else:
-            qa = lp4(hb, tp, scale(-1.0, ha), height)
+            ma = _pris(lp4(hb, tp, scale(-1.0, ha), height))
             b2 = branch
-        target = sub(move_back(ha, ra, qa, tp), pab)
-        u, v, c2, r2 = sp3(pcw, scale(-1.0, pbc), hc, norm(target))
-        qc = _pick(u, v, b2)
-        qb, _ = sp1(add(pbc, rot(hc, qc, pcw)), target, hb)
-        return qa, qb, qc, c1, c2, r1, r2
+        target = sub(move_back(ha, ra, ma, tp), pab)
+        ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, pbc), hc, norm(target))
+        mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
+        cb, sb = sp1_cs(add(pbc, move(hc, True, mc, pcw)), target, hb)
+        return ma, _rev(cb, sb), mc, c1, c2, r1, r2
     if case == 2:  # ab_int: |W - O| depends on qc only
         base = add(sub(pab, o), pbc)
         d = norm(sub(tp, o))
         if rc:
-            u, v, c1, r1 = sp3(pcw, scale(-1.0, base), hc, d)
+            ua, va, ub, vb, c1, r1 = sp3_cs(pcw, scale(-1.0, base), hc, d)
+            mc = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
         else:
             u, v, disc = lp3(add(base, pcw), (0.0, 0.0, 0.0), hc, d)
             c1 = _line_cos(disc, d)
-        qc = _pick(u, v, b1)
-        w0 = add(base, move(hc, rc, qc, pcw))
-        t1a, t2a, t1b, t2b, c2, r2 = sp2(sub(tp, o), w0, ha, hb)
-        return -_pick(t1a, t1b, b2), _pick(t2a, t2b, b2), qc, c1, c2, r1, r2
+            mc = _pris(u if b1 == 0 else v)
+        w0 = add(base, move(hc, rc, mc, pcw))
+        c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c2, r2 = sp2_cs(sub(tp, o), w0, ha, hb)
+        if b2 == 0:
+            return _rev(c1a, -s1a), _rev(c2a, s2a), mc, c1, c2, r1, r2
+        return _rev(c1b, -s1b), _rev(c2b, s2b), mc, c1, c2, r1, r2
     if case == 3:  # bc_int: |W - O| is fixed; O moves with joint a only
         w1 = add(sub(pbc, o), pcw)
         d = norm(w1)
         centre = add(pab, o)
         if ra:
-            u, v, c1, r1 = sp3(centre, tp, ha, d)
+            ua, va, ub, vb, c1, r1 = sp3_cs(centre, tp, ha, d)
+            ma = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
         else:
             u, v, disc = lp3(centre, tp, ha, d)
             c1 = _line_cos(disc, d)
-        qa = _pick(u, v, b1)
-        target = sub(move_back(ha, ra, qa, tp), centre)
-        t1a, t2a, t1b, t2b, c2, r2 = sp2(target, w1, hb, hc)
-        return qa, -_pick(t1a, t1b, b2), _pick(t2a, t2b, b2), c1, c2, r1, r2
+            ma = _pris(u if b1 == 0 else v)
+        target = sub(move_back(ha, ra, ma, tp), centre)
+        c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c2, r2 = sp2_cs(target, w1, hb, hc)
+        if b2 == 0:
+            return ma, _rev(c1a, -s1a), _rev(c2a, s2a), c1, c2, r1, r2
+        return ma, _rev(c1b, -s1b), _rev(c2b, s2b), c1, c2, r1, r2
     if case == 4:  # ppp
         qa, qb, qc = lines3(ha, hb, hc, sub(sub(sub(tp, pab), pbc), pcw))
-        return qa, qb, qc, 0.0, 0.0, math.inf, math.inf
+        return _pris(qa), _pris(qb), _pris(qc), 0.0, 0.0, math.inf, math.inf
     if case == 5:  # ppr: the height along ha x hb does not depend on qa, qb
         n = unit(cross(ha, hb))
-        u, v, c2, r2 = sp4(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
-        qc = _pick(u, v, b2)
-        qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), rot(hc, qc, pcw)))
-        return qa, qb, qc, c1, c2, r1, r2
+        ua, va, ub, vb, c2, r2 = sp4_cs(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
+        mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
+        qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), move(hc, True, mc, pcw)))
+        return _pris(qa), _pris(qb), mc, c1, c2, r1, r2
     if case == 6:  # ac_par: the height along ha fixes the prismatic b
         qb = lp4(ha, add(add(pab, pbc), pcw), hb, dot(ha, tp))
         w = add(add(pab, scale(qb, hb)), pbc)
-        u, v, c2, r2 = sp3(pcw, scale(-1.0, w), hc, norm(tp))
-        qc = _pick(u, v, b2)
-        qa, _ = sp1(add(w, rot(hc, qc, pcw)), tp, ha)
-        return qa, qb, qc, c1, c2, r1, r2
-    return nan, nan, nan, nan, nan, nan, nan
+        ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, w), hc, norm(tp))
+        mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
+        ca, sa = sp1_cs(add(w, move(hc, True, mc, pcw)), tp, ha)
+        return _rev(ca, sa), _pris(qb), mc, c1, c2, r1, r2
+    nan = (math.nan, math.nan, math.nan)
+    return nan, nan, nan, math.nan, math.nan, math.nan, math.nan

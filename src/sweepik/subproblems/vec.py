@@ -9,7 +9,7 @@ import math
 
 from numba import njit
 
-__all__ = ["add", "sub", "scale", "dot", "cross", "norm", "unit", "rot", "perp", "along", "orthogonal"]
+__all__ = ["add", "sub", "scale", "dot", "cross", "norm", "unit", "rot", "rot_cs", "perp", "along", "orthogonal"]
 
 
 @njit(cache=True)
@@ -51,7 +51,12 @@ def unit(a):
 @njit(cache=True)
 def rot(k, theta, v):
     """``v`` rotated by ``theta`` (radians) about the unit axis ``k`` (Rodrigues)."""
-    c, s = math.cos(theta), math.sin(theta)
+    return rot_cs(k, math.cos(theta), math.sin(theta), v)
+
+
+@njit(cache=True)
+def rot_cs(k, c, s, v):
+    """``v`` rotated about the unit axis ``k`` by the angle whose cosine and sine are ``c``, ``s``."""
     kv = dot(k, v)
     kxv = cross(k, v)
     return (
