@@ -102,7 +102,7 @@ def main() -> None:
         if robot.default_reduction:
             variants[f"sweepik {robot.default_reduction}"] = {"reduction": robot.default_reduction}
         plan = sweepik.analyze(robot)["chosen"]
-        how = "closed form" if plan["closed_form"] else f"sweep joint {plan['free_joint']}"
+        how = "closed form" if plan["closed_form"] else f"sweep joint {plan['free_joint_number']}"
         cells = {}
         for label, kw in variants.items():
             cells[label] = (

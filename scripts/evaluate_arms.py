@@ -71,8 +71,8 @@ def main() -> None:
         kind = "ik-geo"
         plans = sweepik.analyze(robot)["plans"]
         chosen = plans[0]
-        alts = [p["free_joint"] - 1 for p in plans if not p["closed_form"] and not p["blind_spot"]]
-        alt = next((j for j in alts if chosen["closed_form"] or j != chosen["free_joint"] - 1), None)
+        alts = [p["free_joint"] for p in plans if not p["closed_form"] and not p["blind_spot"]]
+        alt = next((j for j in alts if chosen["closed_form"] or j != chosen["free_joint"]), None)
         worst = []
         for i, (s, t) in enumerate(zip(S, T, strict=True)):
             ref = ikgeo_solutions(robot, t) if robot.is_revolute.all() else None

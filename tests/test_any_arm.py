@@ -255,10 +255,11 @@ def test_arm_outside_the_catalogue_is_refused():
 def test_free_joint_errors():
     robot = sweepik.load_robot("ur5")
     T = robot.fk(np.full(6, 0.3))
-    with pytest.raises(NoReductionError, match="no decomposition sweeps joint"):
+    with pytest.raises(NoReductionError, match="no decomposition sweeps joint index 0"):
         sweepik.solve(robot, T, free_joint=0)
-    with pytest.raises(sweepik.SweepikError, match="not both"):
-        sweepik.solve(robot, T, free_joint=1, reduction="auto")
+    with pytest.raises(sweepik.SweepikError, match="fixes its own theta"):
+        sweepik.solve(robot, T, free_joint=1, reduction="carm-d1")
+    assert len(sweepik.solve(robot, T, free_joint=1, reduction="auto"))
     with pytest.raises(sweepik.SweepikError):
         sweepik.solve(robot, T, free_joint=9)
     by_name = sweepik.solve(robot, T, free_joint=robot.joint_names[1])
@@ -289,3 +290,31 @@ def test_origin_and_axis_chain_solves_like_its_dh_twin():
     for q, a, b in zip(Q, sweepik.solve_many(robot, puma.fk(Q)), sweepik.solve_many(puma, puma.fk(Q)), strict=True):
         assert _recalls(robot, a, q * flip)
         assert same_solution_set(a.q * flip, b.q, puma.is_revolute, puma.length_scale)
+
+
+def test_moving_meeting_point_is_not_used():
+    """Regression: a prismatic theta* between joints 2 and 4 that does not slide along joint 4's axis moves the
+    point where axes 2 and 4 meet; the bc_int case (which rebuilds that point from one sample) must not apply."""
+    points = [(0.2, 0, 0), (0, 0, 0.5), (0, 0, 0.5), (0, 0.3, 0.5), (0, 0.6, 1.0), (0, 0.6, 1.0)]
+    axes = [(0, 0, 1), (0, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 0), (0, 0, 1)]
+    kinds = ["revolute", "revolute", "prismatic", "revolute", "revolute", "revolute"]
+    joints, prev = [], np.zeros(3)
+    for i in range(6):
+        origin = np.eye(4)
+        origin[:3, 3] = np.array(points[i]) - prev
+        prev = np.array(points[i])
+        lo, hi = (-np.pi, np.pi) if kinds[i] == "revolute" else (-0.4, 0.4)
+        joints.append(
+            sweepik.Joint(
+                kinds[i], lower=lo, upper=hi, origin=tuple(map(tuple, origin)), axis=axes[i], name=f"j{i + 1}"
+            )
+        )
+    robot = sweepik.Robot("moving_meet", joints, dh_convention="none", length_unit="m")
+    assert not any(p.case == "bc_int" and p.free == 2 and not p.reversed for p in plans(robot))
+    Q = _configs(robot, 20, np.random.default_rng(0))
+    if not plans(robot):  # refused, never an empty answer presented as complete
+        with pytest.raises(NoReductionError):
+            sweepik.solve(robot, robot.fk(Q[0]))
+        return
+    for q, sols in zip(Q, sweepik.solve_many(robot, robot.fk(Q)), strict=True):
+        assert _recalls(robot, sols, q)

@@ -21,7 +21,8 @@ def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
 def test_analyze_api_matches_plans():
     info = sweepik.analyze("carm")
     assert info["structure"] == "PRRRRR: 2∩3, 3∥4, 4∩5, 5∩6"
-    assert info["chosen"]["free_joint"] == 1 and not info["chosen"]["closed_form"]
+    assert info["chosen"]["free_joint"] == 0 and info["chosen"]["free_joint_number"] == 1
+    assert not info["chosen"]["closed_form"]
     assert len(info["plans"]) == len(sweepik.reductions.decompose.plans(sweepik.load_robot("carm")))
     # a plan with a blind spot is offered but never chosen by default
     assert any(p["blind_spot"] for p in info["plans"]) and not info["chosen"]["blind_spot"]
@@ -60,7 +61,7 @@ def test_robots_lists_structure_and_decomposition(capsys):
     assert "structure RRRRRR: 1∩2, 2∥3, 2∥4, 3∥4, 4∩5, 5∩6" in out
     assert "decomposition: closed form, 8 branches" in out  # carm_swapped: the paper's rejected closed form
     code, out, _ = run(capsys, "robots", "ur5", "--json")
-    assert json.loads(out)[0]["decomposition"]["free_joint"] == 2
+    assert json.loads(out)[0]["decomposition"]["free_joint"] == 1  # an index, as solve(free_joint=) takes it
 
 
 def test_free_joint_option(capsys):
@@ -75,5 +76,10 @@ def test_free_joint_option(capsys):
         outs.append(q[np.lexsort(np.round(q, 6).T[::-1])])
     for o in outs[1:]:
         np.testing.assert_allclose(o, outs[0], atol=1e-6)
-    code, _, err = run(capsys, "solve", "ur5", "--matrix", *matrix, "--free-joint", "0")
-    assert code == 2 and "from 1" in err
+    for bad in ("0", "7", "²"):
+        code, _, err = run(capsys, "solve", "ur5", "--matrix", *matrix, "--free-joint", bad)
+        assert code == 2 and err.startswith("sweepik") and len(err.strip().splitlines()) == 1, (bad, err)
+    code, _, err = run(capsys, "solve", "ur5", "--matrix", *matrix, "--free-joint", "7")
+    assert "from 1 to 6" in err
+    code, out, _ = run(capsys, "solve", "ur5", "--matrix", *matrix, "--free-joint", "2", "--reduction", "auto")
+    assert code == 0

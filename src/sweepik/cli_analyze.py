@@ -33,7 +33,7 @@ def plan_line(plan: dict[str, Any]) -> str:
     if plan["closed_form"]:
         head = "closed form"
     else:
-        head = f"sweep joint {plan['free_joint']} ({plan['free_joint_name']})"
+        head = f"sweep joint {plan['free_joint_number']} ({plan['free_joint_name']})"
     chain = ", reversed chain" if plan["chain"] == "reversed" else ""
     blind = ", blind spot" if plan["blind_spot"] else ""
     return f"{head}, {plan['branches']} branches{chain}{blind}"
@@ -55,7 +55,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     rows = [
         [
             str(i + 1),
-            "closed form" if p["closed_form"] else f"{p['free_joint']} ({p['free_joint_name']})",
+            "closed form" if p["closed_form"] else f"{p['free_joint_number']} ({p['free_joint_name']})",
             p["chain"],
             p["case"],
             str(p["branches"]),

@@ -41,10 +41,11 @@ Array = NDArray[np.float64]
 def _ik_kwargs(args: argparse.Namespace) -> dict[str, Any]:
     """The solver's keyword arguments from the options of :func:`_add_ik_options`."""
     free = args.free_joint
-    if free is not None and free.isdigit():
-        if int(free) < 1:
-            raise UnknownOptionError(f"--free-joint numbers joints from 1, got {free}")
-        free = int(free) - 1  # the API numbers joints from 0
+    if free is not None and free.strip().isdecimal():
+        number = int(free)
+        if not 1 <= number <= 6:
+            raise UnknownOptionError(f"--free-joint takes a joint number from 1 to 6 (or a joint name), got {free}")
+        free = number - 1  # the API numbers joints from 0
     return {"reduction": args.reduction, "free_joint": free, "strategy": args.strategy, "limits": not args.no_limits}
 
 

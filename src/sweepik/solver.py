@@ -374,7 +374,7 @@ def _solve_chunk(
             fam = unique_families(fam + other.families)
         reason = None
         if e == s and not fam:
-            if strategy == "paper":  # its fixed final resolution decides nothing about reachability
+            if strategy == "paper" and not red.closed_form:  # its final resolution decides nothing about reachability
                 step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"
                 reason = (
                     f"no solution with J < 1e-5 mm found by the paper's strategy (its final {step} step "
@@ -558,8 +558,11 @@ def _free_joint_index(robot: Robot, free_joint: object, reduction: object) -> in
     """``free_joint`` (an index from 0, or a joint name) as an index; None if not given."""
     if free_joint is None:
         return None
-    if reduction is not None:
-        raise UnknownOptionError("give either reduction= or free_joint=, not both (a reduction fixes its theta*)")
+    if reduction is not None and reduction != "auto":
+        raise UnknownOptionError(
+            f"free_joint chooses theta* of the automatic decomposition; reduction {short_repr(reduction, 40)} fixes "
+            "its own theta* (give reduction='auto' or none)"
+        )
     if isinstance(free_joint, str):
         if free_joint not in robot.joint_names:
             raise UnknownOptionError(f"free_joint {free_joint!r} is not a joint of {robot.name!r}: {robot.joint_names}")

@@ -130,6 +130,7 @@ def follow_path(
     members of self-motion families count). A pose without solution gets a NaN row and the next point is
     compared with the last configuration found. The poses are solved a chunk at a time (:func:`iter_solve`), so
     memory grows with the path's joint rows only; ``progress("path", done, total)`` follows the solves.
+    ``reduction``, ``free_joint``, ``strategy`` and ``limits`` are passed to :func:`iter_solve` (see :func:`solve`).
 
     >>> import numpy as np
     >>> from sweepik import load_robot

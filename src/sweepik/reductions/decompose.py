@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..chain import Chain
+from ..chain import Chain, rotation_about
 from ..errors import NoReductionError
 from ..robot import Robot
 from ..structure import INTERSECT_TOL_REL, PARALLEL_TOL, Structure, line_relation, structure_of
@@ -69,7 +69,8 @@ def _parallel(u: np.ndarray, v: np.ndarray) -> bool:
 
 
 def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.ndarray, ...]], tol: float):
-    """``(applies, conditional, meeting point relative to joint a (ab_int) or b (bc_int) at the first sample)``."""
+    """``(applies, conditional, meeting points)``: for ab_int / bc_int the point where the axes meet, relative to
+    joint a (ab_int) or b (bc_int), at each sample."""
     ra, rb, rc = types
     no = (False, False, None)
     geo = []
@@ -120,7 +121,7 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
                     return no
                 if case == "ab_int" and _dist_to_line(g[6], g[5], g[2]) < tol:
                     return no
-        return True, False, points[0]
+        return True, False, points
     if case == "ppp":
         if any(types):
             return no
@@ -173,7 +174,9 @@ def _position_plans(robot: Robot, chain: Chain, rev_chain: bool, W: np.ndarray, 
                 nb = BRANCHES[case][0 if types[0] else 1]
             meet = np.zeros(3)
             if rel is not None:
-                meet = pts[others[0] if case == "ab_int" else others[1]] + rel
+                if case == "bc_int" and not _meets_as_kernel(chain, f, xs, rel, tol):
+                    continue
+                meet = pts[others[0] if case == "ab_int" else others[1]] + rel[0]
             out.append(
                 Plan(
                     family=family,
@@ -187,6 +190,17 @@ def _position_plans(robot: Robot, chain: Chain, rev_chain: bool, W: np.ndarray, 
                 )
             )
     return out
+
+
+def _meets_as_kernel(chain: Chain, f: int, xs: list[float], rel: list[np.ndarray], tol: float) -> bool:
+    """The kernel rebuilds b and c's meeting point from its value at the first sample, turned with theta* when
+    theta* is a revolute joint 2 (between a and b); the case applies only if that is where the axes meet."""
+    turn = f == 1 and bool(chain.revolute[1])
+    for x, p in zip(xs, rel, strict=True):
+        expected = rotation_about(chain.H[1], x - xs[0]) @ rel[0] if turn else rel[0]
+        if np.linalg.norm(p - expected) > tol:
+            return False
+    return True
 
 
 def _rank(p: Plan) -> tuple[int, int, int, int, int]:
@@ -219,6 +233,8 @@ def plans(robot: Robot) -> tuple[Plan, ...]:
 
 
 def _missing(robot: Robot) -> str:
+    if robot.n_joints != 6:
+        return f"robot {robot.name!r} has {robot.n_joints} joints: the decompositions solve 6-joint arms"
     st = robot.structure()
     return (
         f"robot {robot.name!r} ({st.describe()}) is outside sweepik's catalogue: a decomposition needs the last two "
@@ -233,10 +249,11 @@ def choose(robot: Robot, free_joint: int | None = None) -> Plan:
     if free_joint is not None:
         options = tuple(p for p in options if not p.closed_form and p.free_joint == free_joint)
         if not options:
-            avail = sorted({p.free_joint + 1 for p in plans(robot) if not p.closed_form})
+            avail = sorted({p.free_joint for p in plans(robot) if not p.closed_form})
+            names = ", ".join(f"{j} ({robot.joint_names[j]})" for j in avail) or "none"
             raise NoReductionError(
-                f"robot {robot.name!r}: no decomposition sweeps joint {free_joint + 1} "
-                f"({robot.joint_names[free_joint]}); joints that can be swept: {avail or 'none'}"
+                f"robot {robot.name!r}: no decomposition sweeps joint index {free_joint} "
+                f"({robot.joint_names[free_joint]}); joints that can be swept (index from 0): {names}"
             )
         return options[0]
     usable = [p for p in options if not p.conditional]
@@ -269,7 +286,8 @@ def _plan_dict(robot: Robot, p: Plan) -> dict[str, Any]:
     return {
         "family": p.family,
         "closed_form": p.closed_form,
-        "free_joint": None if p.closed_form else p.free_joint + 1,
+        "free_joint": None if p.closed_form else p.free_joint,
+        "free_joint_number": None if p.closed_form else p.free_joint + 1,
         "free_joint_name": None if p.closed_form else robot.joint_names[p.free_joint],
         "chain": "reversed" if p.reversed else "forward",
         "case": p.case,

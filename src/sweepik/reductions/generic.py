@@ -32,7 +32,8 @@ class Plan:
     """One way to solve an arm: ``family`` ('pair': sweep theta*, 'wrist': closed form) on the forward or
     ``reversed`` chain, with ``free`` (0-3, in the solved chain's order) the fixed joint among the first four
     and ``case`` the position case placing the wrist centre ``W``; ``meet`` the meeting point of the axes that
-    case uses (zero configuration, world frame)."""
+    case uses (world frame, at the zero configuration of the joints other than theta*; for a prismatic theta* at
+    the middle of its sampled range: its position relative to joint a or b does not depend on the slide)."""
 
     family: str
     reversed: bool
@@ -126,8 +127,11 @@ class GeometricReduction(Reduction):
         hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
         q = rng.uniform(lo, hi, size=(TWIN_POSES, robot.n_joints))
         params = self.kernel_params(robot.T_base_world @ robot.fk(q) @ robot.T_tool_flange)
-        a, b = self._range(1)
-        x = rng.uniform(a[0], b[0], size=TWIN_SAMPLES)
+        j = self.free_joint
+        a, b = (-np.pi, np.pi) if self.periodic else (float(robot.lower[j]), float(robot.upper[j]))
+        if not b - a < 1e6 * robot.length_scale:  # no practical end: around the arm
+            a, b = -robot.length_scale, robot.length_scale
+        x = rng.uniform(a, b, size=TWIN_SAMPLES)
         pose = np.repeat(np.arange(TWIN_POSES), TWIN_SAMPLES * count).astype(np.int64)
         th = np.tile(np.repeat(x, count), TWIN_POSES)
         k = np.tile(np.arange(count), TWIN_POSES * TWIN_SAMPLES).astype(np.int64)
@@ -171,6 +175,25 @@ class GeometricReduction(Reduction):
         geometric.wrist_singular(self.kernel_params(poses), out)
         return out
 
+    def search_range(self, poses: Array) -> Array | None:
+        """A prismatic theta*: the travel that can hold a solution, joint limits aside, ``(N, 2)``: the wrist centre
+        W lies within R (the lengths of the segments from the slide to W, summed) of the point the slide moves,
+        so along a first joint's fixed direction h: ``h . (t - P0) +- R``; deeper in the chain (its direction
+        turns with the joints before it) ``|x| <= |t - P0| + R``. The solver sweeps this interval with and without
+        limits, so that ``limits=False`` keeps (and flags) solutions beyond the limits."""
+        if self.periodic or self.closed_form:
+            return None
+        chain, f = self._chain, self.plan.free
+        o3 = chain.P[:4].sum(axis=0)
+        R = float(np.linalg.norm(chain.P[1:4], axis=1).sum() + np.linalg.norm(np.asarray(self.plan.W) - o3))
+        L = geometric.LAYOUT
+        t = self.kernel_params(poses)[:, L["t"] : L["t"] + 3] - chain.P[0]
+        if f == 0:
+            mid = t @ chain.H[0]
+            return np.stack([mid - R, mid + R], axis=1)
+        reach = np.linalg.norm(t, axis=1) + R
+        return np.stack([-reach, reach], axis=1)
+
     def sample_hints(self, poses: Array) -> Array | None:
         """Samples where the residual can change faster than the grid resolves: windows where a step's angle
         swings (``geometric.swing_hints``), and the theta* values where a branch's domain begins or ends, the
@@ -181,7 +204,7 @@ class GeometricReduction(Reduction):
             return None
         from ..sweep import N_SAMPLES  # local: the engine imports the reductions
 
-        lo, hi = self._range(poses.shape[0])
+        lo, hi = self._range(poses)
         swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
         ks = np.asarray(self._steps[1], dtype=np.int64)
         geometric.swing_hints(self.kernel_params(poses), lo, hi, N_SAMPLES, self.periodic, ks, swings)
@@ -191,12 +214,14 @@ class GeometricReduction(Reduction):
         keep = np.any(np.isfinite(theta), axis=0)
         return theta[:, keep] if keep.any() else None
 
-    def _range(self, n: int) -> tuple[Array, Array]:
-        """theta*'s sweep range for ``n`` poses (as the solver's: the circle, or the joint's limits)."""
+    def _range(self, poses: Array) -> tuple[Array, Array]:
+        """theta*'s sweep range for chain ``poses (N, 4, 4)`` (as the solver's: the circle, or ``search_range``)."""
+        n = poses.shape[0]
         if self.periodic:
             return np.full(n, -np.pi), np.full(n, np.pi)
-        j = self.free_joint
-        return np.full(n, self.robot.lower[j]), np.full(n, self.robot.upper[j])
+        rng = self.search_range(poses)
+        assert rng is not None
+        return rng[:, 0], rng[:, 1]
 
     def kernel_params(self, poses: Array) -> Array:
         """Parameter rows ``(N, N_PARAMS)`` of chain poses ``(N, 4, 4)``."""

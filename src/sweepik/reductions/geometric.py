@@ -118,7 +118,7 @@ def _missing(m0, m1, m2, m3):
 
 @njit(cache=True)
 def _back(p, m0, m1, m2, m3, v):
-    """``R_04^T v``: ``v`` seen from frame 4 (revolute joints among the first four undone, last first)."""
+    """``R_04^T v = R_3^T R_2^T R_1^T R_0^T v``: ``v`` seen from frame 4 (joint 0's rotation undone first)."""
     ms = (m0, m1, m2, m3)
     for i in range(4):
         if p[39 + i] > 0.5:

@@ -22,10 +22,9 @@ case         structure                                     subproblem chain (bra
 ===========  ============================================  ===========================================
 
 Outside a branch's domain (a circle or line that misses its sphere or plane) a step continues with its
-least-squares angle or travel, so each branch's values, and the residual built on them, are continuous in
-theta* across the domain edges (where the two branches of a step meet): the sweep sees no NaN gap to bracket
-across, a root at or near an edge is an ordinary sign change, and a root of the continued residual outside the
-domain is a candidate that FK certification rejects.
+least-squares angle or travel (so configurations stay defined for certification and polish) and reports its
+cosine ``|c| > 1``: the family's residual is NaN there, and the domain edges (``|c| = 1``, where a step's two
+branches meet) are sampled (:mod:`.generic`).
 
 The reduced chain (``reduce_chain``) is written in product-of-exponentials form: with segments ``s0 .. s4``
 (``s0`` from the world origin to joint 0's point, ``s_i`` from joint i-1's point to joint i's, ``s4`` from joint
@@ -221,7 +220,11 @@ def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         qa, qb, qc = lines3(ha, hb, hc, sub(sub(sub(tp, pab), pbc), pcw))
         return _pris(qa), _pris(qb), _pris(qc), 0.0, 0.0, math.inf, math.inf
     if case == 5:  # ppr: the height along ha x hb does not depend on qa, qb
-        n = unit(cross(ha, hb))
+        n = cross(ha, hb)
+        if norm(n) == 0.0:  # parallel slides (a blind spot of a plan whose slides turn with theta*)
+            nan = (math.nan, math.nan, math.nan)
+            return nan, nan, nan, math.nan, math.nan, math.nan, math.nan
+        n = unit(n)
         ua, va, ub, vb, c2, r2 = sp4_cs(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
         mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
         qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), move(hc, True, mc, pcw)))
