@@ -50,6 +50,11 @@ LAYOUT = {
     "pos_branches": 66,  # branches of the position case (the wrist family multiplies them by 2)
 }
 N_PARAMS = 67
+# The offsets as module constants (Numba freezes globals into the compiled kernels: a change of LAYOUT needs the
+# on-disk cache cleared, see docs/decomposition.md).
+_H, _P, _REV, _M = LAYOUT["H"], LAYOUT["P"], LAYOUT["rev"], LAYOUT["M"]
+_T, _W, _O, _FREE = LAYOUT["t"], LAYOUT["W"], LAYOUT["O"], LAYOUT["free"]
+_CASE, _REVERSED, _POS_BRANCHES = LAYOUT["case"], LAYOUT["reversed"], LAYOUT["pos_branches"]
 
 
 @njit(cache=True)
@@ -59,13 +64,13 @@ def _v(p, i):
 
 @njit(cache=True)
 def _h(p, i):
-    return _v(p, 3 * i)
+    return _v(p, _H + 3 * i)
 
 
 @njit(cache=True)
 def _mat(p, v):
     """``M v`` for the target orientation ``M`` of the row."""
-    m = 45
+    m = _M
     return (
         p[m] * v[0] + p[m + 1] * v[1] + p[m + 2] * v[2],
         p[m + 3] * v[0] + p[m + 4] * v[1] + p[m + 5] * v[2],
@@ -78,18 +83,18 @@ def _arm(p, x, branch):
     """Motions ``(m0, m1, m2, m3)`` (``position.motion``) of the first four joints with joint ``free`` at ``x``,
     and the cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the position case's steps (``position.place``)."""
     h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
-    r0, r1, r2, r3 = p[39] > 0.5, p[40] > 0.5, p[41] > 0.5, p[42] > 0.5
-    s0, s1, s2, s3 = _v(p, 18), _v(p, 21), _v(p, 24), _v(p, 27)
+    r0, r1, r2, r3 = p[_REV] > 0.5, p[_REV + 1] > 0.5, p[_REV + 2] > 0.5, p[_REV + 3] > 0.5
+    s0, s1, s2, s3 = _v(p, _P), _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
     o1 = (s0[0] + s1[0], s0[1] + s1[1], s0[2] + s1[2])
     o2 = (o1[0] + s2[0], o1[1] + s2[1], o1[2] + s2[2])
     o3 = (o2[0] + s3[0], o2[1] + s3[1], o2[2] + s3[2])
-    s4 = sub(_v(p, 57), o3)
-    f = int(p[63])
-    case = int(p[64])
+    s4 = sub(_v(p, _W), o3)
+    f = int(p[_FREE])
+    case = int(p[_CASE])
     rev = (r0, r1, r2, r3)
     mx = motion(rev[f], x)
-    tp, ha, hb, hc, pab, pbc, pcw = reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, mx, _v(p, 54))
-    meet = _v(p, 60)
+    tp, ha, hb, hc, pab, pbc, pcw = reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, mx, _v(p, _T))
+    meet = _v(p, _O)
     pts = (s0, o1, o2, o3)
     a = 1 if f == 0 else 0
     b = 2 if f <= 1 else 1
@@ -121,7 +126,7 @@ def _back(p, m0, m1, m2, m3, v):
     """``R_04^T v = R_3^T R_2^T R_1^T R_0^T v``: ``v`` seen from frame 4 (joint 0's rotation undone first)."""
     ms = (m0, m1, m2, m3)
     for i in range(4):
-        if p[39 + i] > 0.5:
+        if p[_REV + i] > 0.5:
             v = rot_cs(_h(p, i), ms[i][0], -ms[i][1], v)
     return v
 
@@ -131,7 +136,7 @@ def _fore(p, m0, m1, m2, m3, v):
     """``R_04 v``."""
     ms = (m0, m1, m2, m3)
     for i in range(3, -1, -1):
-        if p[39 + i] > 0.5:
+        if p[_REV + i] > 0.5:
             v = rot_cs(_h(p, i), ms[i][0], ms[i][1], v)
     return v
 
@@ -157,14 +162,14 @@ def _last_two(p, m0, m1, m2, m3, h4, h5):
 def _write(p, out, m0, m1, m2, m3, q4, q5):
     """The configuration in the robot's joint order (reversed for a reversed chain)."""
     qs = (
-        angle(p[39] > 0.5, m0),
-        angle(p[40] > 0.5, m1),
-        angle(p[41] > 0.5, m2),
-        angle(p[42] > 0.5, m3),
+        angle(p[_REV] > 0.5, m0),
+        angle(p[_REV + 1] > 0.5, m1),
+        angle(p[_REV + 2] > 0.5, m2),
+        angle(p[_REV + 3] > 0.5, m3),
         q4,
         q5,
     )
-    rev = p[65] > 0.5
+    rev = p[_REVERSED] > 0.5
     for i in range(6):
         out[5 - i if rev else i] = qs[i]
 
@@ -190,7 +195,7 @@ def _pair_configuration(p, x, branch, out):
 
 
 def _wrist_configuration(p, x, branch, out):
-    nb = int(p[66])
+    nb = int(p[_POS_BRANCHES])
     m0, m1, m2, m3, _, _, _, _ = _arm(p, 0.0, branch // 2)
     if _missing(m0, m1, m2, m3) or branch >= 2 * nb:
         for i in range(6):
@@ -325,7 +330,7 @@ def wrist_singular(params, out):
     for i in range(params.shape[0]):
         p = params[i]
         out[i] = False
-        for b in range(int(p[66])):
+        for b in range(int(p[_POS_BRANCHES])):
             m0, m1, m2, m3, c1, c2, _, _ = _arm(p, 0.0, b)
             if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
                 continue
