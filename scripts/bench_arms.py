@@ -27,12 +27,6 @@ import sweepik  # noqa: E402
 from sweepik.robot_file import bundled_robots  # noqa: E402
 
 
-def _configs(robot, n, rng):
-    lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
-    hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
-    return rng.uniform(lo, hi, size=(n, robot.n_joints))
-
-
 def _median_us(fn, items):
     fn(items[0])
     times = []
@@ -97,7 +91,7 @@ def main() -> None:
     for name in args.arms or bundled_robots():
         robot = sweepik.load_robot(name)
         rng = np.random.default_rng(1)
-        T = robot.fk(_configs(robot, max(args.single, args.batch), rng))
+        T = robot.fk(oracles.in_limit_configurations(robot, max(args.single, args.batch), rng))
         variants = {"sweepik": {"reduction": "auto"}}
         if robot.default_reduction:
             variants[f"sweepik {robot.default_reduction}"] = {"reduction": robot.default_reduction}

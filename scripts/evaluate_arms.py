@@ -20,33 +20,17 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-from oracles import ikgeo_solutions, numerical_solutions, same_solution_set  # noqa: E402
+from oracles import (  # noqa: E402
+    edge_configurations,
+    ikgeo_solutions,
+    in_limit_configurations,
+    numerical_solutions,
+    recovers,
+    same_solution_set,
+)
 
 import sweepik  # noqa: E402
 from sweepik.robot_file import bundled_robots  # noqa: E402
-
-
-def configs(robot, n, rng):
-    lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
-    hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
-    Q = rng.uniform(lo, hi, size=(n, robot.n_joints))
-    base = Q[0]
-    edges = []
-    for j in range(robot.n_joints):
-        for lim in (robot.lower[j], robot.upper[j]):
-            q = base.copy()
-            q[j] = lim
-            edges.append(q)
-    q = base.copy()
-    q[4] = 0.0
-    edges.append(q)
-    return np.concatenate([Q, np.array(edges)])
-
-
-def recalls(robot, sols, q):
-    d = sols.nearest(q) - q
-    d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
-    return bool(np.max(np.abs(d)) < 1e-6)
 
 
 def main() -> None:
@@ -58,13 +42,14 @@ def main() -> None:
     for name in args.arms or bundled_robots():
         robot = sweepik.load_robot(name)
         rng = np.random.default_rng(2026)
-        Q = configs(robot, args.n, rng)
+        Q = in_limit_configurations(robot, args.n, rng)
+        Q = np.concatenate([Q, edge_configurations(robot, Q[0])])
         T = robot.fk(Q)
         kw = {"reduction": "auto"} if robot.default_reduction else {}
         t0 = time.perf_counter()
         S = sweepik.solve_many(robot, T, **kw)
         dt = time.perf_counter() - t0
-        rec = sum(recalls(robot, s, q) for s, q in zip(S, Q, strict=True))
+        rec = sum(recovers(robot, s, q) for s, q in zip(S, Q, strict=True))
         cert = all((s.error_geodesic <= 1e-9 * robot.length_scale).all() for s in S if len(s))
         lim = all(robot.within_limits(s.q).all() for s in S if len(s))
         same = compared = rechecked = by_alt = 0

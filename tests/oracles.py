@@ -47,6 +47,9 @@ __all__ = [
     "pose_errors",
     "same_solution_set",
     "contains",
+    "in_limit_configurations",
+    "edge_configurations",
+    "recovers",
 ]
 
 #: The wrappers keep a returned solution when its FK matches the pose this closely (relative position error,
@@ -142,6 +145,36 @@ def same_solution_set(a: Array, b: Array, revolute: np.ndarray, length_scale: fl
 # ----------------------------------------------------------------------------------------------------------
 # 1. many-start numerical search
 # ----------------------------------------------------------------------------------------------------------
+
+
+def in_limit_configurations(robot: Any, n: int, rng: np.random.Generator) -> Array:
+    """``(n, n_joints)`` configurations uniform inside the limits, revolute joints also inside [-pi, pi]."""
+    lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
+    hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
+    return rng.uniform(lo, hi, size=(n, robot.n_joints))
+
+
+def edge_configurations(robot: Any, base: Array) -> Array:
+    """``base`` with each joint at each of its limits (one at a time), and with joint 5 at 0 (a wrist
+    singularity of most arms): ``(2 n_joints + 1, n_joints)``."""
+    out = []
+    for j in range(robot.n_joints):
+        for lim in (robot.lower[j], robot.upper[j]):
+            q = np.array(base, dtype=np.float64)
+            q[j] = lim
+            out.append(q)
+    q = np.array(base, dtype=np.float64)
+    q[4] = 0.0
+    out.append(q)
+    return np.array(out)
+
+
+def recovers(robot: Any, sols: Any, q: Array, tol: float = 1e-6) -> bool:
+    """``q`` is among the solutions ``sols`` (a ``sweepik.Solutions``), or on one of its families: revolute joints
+    modulo 2 pi, prismatic ones relative to the length scale."""
+    d = sols.nearest(q) - q
+    d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
+    return bool(np.max(np.abs(d)) < tol)
 
 
 def _skew(v: Array) -> Array:

@@ -9,7 +9,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from oracles import contains, ikgeo_solutions, numerical_solutions, same_solution_set
+from oracles import (
+    contains,
+    edge_configurations,
+    ikgeo_solutions,
+    in_limit_configurations,
+    numerical_solutions,
+    recovers,
+    same_solution_set,
+)
 
 import sweepik
 from sweepik import NoReductionError
@@ -19,34 +27,6 @@ from sweepik.robot_file import bundled_robots, robot_from_dict
 BUNDLED = bundled_robots()
 CLOSED = {"puma560", "puma560_std", "kuka_kr6_r900", "abb_irb140", "stanford", "carm_swapped"}
 CERT_REL = 1e-9
-
-
-def _configs(robot, n, rng):
-    lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
-    hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
-    return rng.uniform(lo, hi, size=(n, robot.n_joints))
-
-
-def _edge_configs(robot, rng):
-    """Each joint at each of its limits (one at a time), and joint 5 at 0 (a wrist singularity of most arms)."""
-    base = _configs(robot, 1, rng)[0]
-    out = []
-    for j in range(robot.n_joints):
-        for lim in (robot.lower[j], robot.upper[j]):
-            q = base.copy()
-            q[j] = lim
-            out.append(q)
-    q = base.copy()
-    q[4] = 0.0
-    out.append(q)
-    return np.array(out)
-
-
-def _recalls(robot, sols, q):
-    near = sols.nearest(q)
-    d = near - q
-    d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
-    return bool(np.max(np.abs(d)) < 1e-6)
 
 
 def _kw(robot):
@@ -64,9 +44,10 @@ def _check_set(robot, sols):
 def test_bundled_arm_round_trip(name):
     robot = sweepik.load_robot(name)
     rng = np.random.default_rng(abs(hash(name)) % 2**32)
-    Q = np.concatenate([_configs(robot, 60, rng), _edge_configs(robot, rng)])
+    Q = in_limit_configurations(robot, 60, rng)
+    Q = np.concatenate([Q, edge_configurations(robot, in_limit_configurations(robot, 1, rng)[0])])
     for q, sols in zip(Q, sweepik.solve_many(robot, robot.fk(Q), **_kw(robot)), strict=True):
-        assert _recalls(robot, sols, q), (name, q.tolist())
+        assert recovers(robot, sols, q), (name, q.tolist())
         _check_set(robot, sols)
 
 
@@ -85,7 +66,7 @@ def test_other_decompositions_agree(name):
     frees = sorted({p.free_joint for p in plans(robot) if not p.closed_form and not p.conditional})
     assert frees
     rng = np.random.default_rng(7)
-    Q = _configs(robot, 25, rng)
+    Q = in_limit_configurations(robot, 25, rng)
     T = robot.fk(Q)
     # within the limits: a prismatic theta* is swept over its limits only, a revolute one finds solutions whose
     # prismatic joints lie beyond them
@@ -103,7 +84,7 @@ def test_against_ikgeo(name):
     pytest.importorskip("ik_geo")
     robot = sweepik.load_robot(name)
     rng = np.random.default_rng(11)
-    Q = _configs(robot, 40, rng)
+    Q = in_limit_configurations(robot, 40, rng)
     T = robot.fk(Q)
     ours = sweepik.solve_many(robot, T, limits=False)
     agree = 0
@@ -118,7 +99,7 @@ def test_against_ikgeo(name):
 def test_against_numerical_search(name):
     robot = sweepik.load_robot(name)
     rng = np.random.default_rng(13)
-    Q = _configs(robot, 3, rng)
+    Q = in_limit_configurations(robot, 3, rng)
     for q in Q:
         T = robot.fk(q)
         s = sweepik.solve(robot, T, limits=False, **_kw(robot))
@@ -130,7 +111,7 @@ def test_against_numerical_search(name):
 def test_carm_automatic_equals_hand_derivations():
     robot = sweepik.load_robot("carm")
     rng = np.random.default_rng(17)
-    Q = _configs(robot, 150, rng)
+    Q = in_limit_configurations(robot, 150, rng)
     T = robot.fk(Q)
     auto = sweepik.solve_many(robot, T, reduction="auto")
     for ref_name in ("carm-d1", "carm-theta2"):
@@ -229,9 +210,9 @@ def test_random_family_arm(family, seed):
     convention = "modified" if family == "rail_pair" else "standard"
     robot = _arm(FAMILIES[family](rng), rng, convention)
     assert plans(robot), robot.structure().describe()
-    Q = _configs(robot, 30, rng)
+    Q = in_limit_configurations(robot, 30, rng)
     for q, sols in zip(Q, sweepik.solve_many(robot, robot.fk(Q)), strict=True):
-        assert _recalls(robot, sols, q), (family, q.tolist())
+        assert recovers(robot, sols, q), (family, q.tolist())
         _check_set(robot, sols)
     if seed == 0:  # one pose against the numerical search
         T = robot.fk(Q[0])
@@ -284,11 +265,11 @@ def test_origin_and_axis_chain_solves_like_its_dh_twin():
     robot = sweepik.Robot("puma_urdf", joints, dh_convention="none", length_unit="m")
     flip = np.array([-1.0, 1.0, -1.0, 1.0, -1.0, 1.0])
     rng = np.random.default_rng(5)
-    Q = _configs(puma, 40, rng)
+    Q = in_limit_configurations(puma, 40, rng)
     np.testing.assert_allclose(robot.fk(Q * flip), puma.fk(Q), atol=1e-12)
     assert plans(robot)[0].closed_form
     for q, a, b in zip(Q, sweepik.solve_many(robot, puma.fk(Q)), sweepik.solve_many(puma, puma.fk(Q)), strict=True):
-        assert _recalls(robot, a, q * flip)
+        assert recovers(robot, a, q * flip)
         assert same_solution_set(a.q * flip, b.q, puma.is_revolute, puma.length_scale)
 
 
@@ -311,10 +292,10 @@ def test_moving_meeting_point_is_not_used():
         )
     robot = sweepik.Robot("moving_meet", joints, dh_convention="none", length_unit="m")
     assert not any(p.case == "bc_int" and p.free == 2 and not p.reversed for p in plans(robot))
-    Q = _configs(robot, 20, np.random.default_rng(0))
+    Q = in_limit_configurations(robot, 20, np.random.default_rng(0))
     if not plans(robot):  # refused, never an empty answer presented as complete
         with pytest.raises(NoReductionError):
             sweepik.solve(robot, robot.fk(Q[0]))
         return
     for q, sols in zip(Q, sweepik.solve_many(robot, robot.fk(Q)), strict=True):
-        assert _recalls(robot, sols, q)
+        assert recovers(robot, sols, q)

@@ -552,8 +552,9 @@ def find_candidates(
         f = reduction.residual(poses, theta)
     N, M, B = f.shape
     valid = np.isfinite(f)
-    if reduction.twins:  # the other branches of a class of twins get their roots from its first (solver)
-        valid[:, :, [b for b in range(B) if b not in reduction.search_branches]] = False
+    skip = sorted(set(range(B)) - set(reduction.search_branches))
+    if skip:  # e.g. the other branches of a class of twins, which get their roots from its first (solver)
+        valid[:, :, skip] = False
     spans, in_family = _families(reduction, poses, theta, f, valid, hi - lo)
     valid &= ~in_family
     search = _Search(reduction, poses, hi - lo)

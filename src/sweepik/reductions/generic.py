@@ -107,6 +107,7 @@ class GeometricReduction(Reduction):
         row[L["reversed"]] = float(plan.reversed)
         row[L["pos_branches"]] = plan.branches // 2 if plan.closed_form else plan.branches
         self._row = row
+        self._last_params: tuple[Array, Array] | None = None
         # the wrist centre in the tool frame (the last joints do not move it)
         p_end = chain.P.sum(axis=0)
         self._w_tool = chain.R_end.T @ (np.asarray(plan.W) - p_end)
@@ -224,7 +225,16 @@ class GeometricReduction(Reduction):
         return rng[:, 0], rng[:, 1]
 
     def kernel_params(self, poses: Array) -> Array:
-        """Parameter rows ``(N, N_PARAMS)`` of chain poses ``(N, 4, 4)``."""
+        """Parameter rows ``(N, N_PARAMS)`` of chain poses ``(N, 4, 4)``. A solve asks for the rows of one chunk
+        several times (the sweep, its hints, the margins' sweep, certification): the last chunk's are kept."""
+        last = self._last_params
+        if last is not None and last[0] is poses:
+            return last[1]
+        out = self._params(poses)
+        self._last_params = (poses, out)
+        return out
+
+    def _params(self, poses: Array) -> Array:
         robot = self.robot
         world = poses
         if not robot.base_is_identity:
@@ -258,12 +268,16 @@ class GeometricReduction(Reduction):
             br = np.broadcast_to(branch, theta.shape).reshape(-1)
         return params, pose.astype(np.int64), np.ascontiguousarray(th, dtype=np.float64), br.astype(np.int64)
 
-    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
-        params, pose, th, br = self._flat(poses, theta, branch)
+    def _evaluate(self, fn: Any, poses: Array, theta: Array, branch: IntArray | None, n_branches: int) -> Array:
+        """Compiled scalar ``fn(params, theta*, branch)`` over ``theta (N, M)``: ``(N, M, B)``, or ``(N, M)``
+        with ``branch``."""
+        params, pose, th, br = self._flat(poses, theta, branch, n_branches)
         out = np.empty(th.shape[0])
-        geometric.evaluate(self._kernels[0], params, pose, th, br, out)
-        shape = theta.shape if branch is not None else (*theta.shape, self.n_branches)
-        return out.reshape(shape)
+        geometric.evaluate(fn, params, pose, th, br, out)
+        return out.reshape(theta.shape if branch is not None else (*theta.shape, n_branches))
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
+        return self._evaluate(self._kernels[0], poses, theta, branch, self.n_branches)
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         params, pose, th, br = self._flat(poses, theta, branch)
@@ -314,10 +328,7 @@ class _Margins(Reduction):
         return self.red.kernel_params(poses)
 
     def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
-        params, pose, th, br = self.red._flat(poses, theta, branch, self.n_branches)
-        out = np.empty(th.shape[0])
-        geometric.evaluate(geometric.pair_margin, params, pose, th, br, out)
-        return out.reshape(theta.shape if branch is not None else (*theta.shape, self.n_branches))
+        return self.red._evaluate(geometric.pair_margin, poses, theta, branch, self.n_branches)
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         raise NotImplementedError("margins have no configurations")

@@ -174,13 +174,21 @@ def _write(p, out, m0, m1, m2, m3, q4, q5):
         out[5 - i if rev else i] = qs[i]
 
 
-def _pair_margin(p, x, k):
-    """``1 - c^2`` of the position case's first step (k = 0) or its second step on the first step's branch k - 1:
-    positive inside the branch domains, zero at their edges (found by the same sweep, and sampled as hints)."""
+@njit(cache=True)
+def _step(p, x, k):
+    """Cosine and amplitude of the position case's first step (k = 0) or of its second step on the first step's
+    branch k - 1 (k = 1, 2)."""
     if k == 0:
-        c = _arm(p, x, 0)[4]
-    else:
-        c = _arm(p, x, 2 * (k - 1))[5]
+        arm = _arm(p, x, 0)
+        return arm[4], arm[6]
+    arm = _arm(p, x, 2 * (k - 1))
+    return arm[5], arm[7]
+
+
+def _pair_margin(p, x, k):
+    """``1 - c^2`` of step k (``_step``): positive inside the branch domains, zero at their edges (found by the
+    same sweep, and sampled as hints)."""
+    c = _step(p, x, k)[0]
     return 1.0 - c * c
 
 
@@ -227,10 +235,8 @@ pair_margin = njit(RESIDUAL_SIG, cache=True)(_pair_margin)
 
 
 def _amplitude(p, x, k):
-    """Amplitude of the first step (k = 0) or of the second on the first step's branch k - 1."""
-    if k == 0:
-        return _arm(p, x, 0)[6]
-    return _arm(p, x, 2 * (k - 1))[7]
+    """Amplitude of step k (``_step``)."""
+    return _step(p, x, k)[1]
 
 
 amplitude = njit(RESIDUAL_SIG, cache=True)(_amplitude)
