@@ -25,7 +25,7 @@ from sweepik.reductions.decompose import plans
 from sweepik.robot_file import bundled_robots, robot_from_dict
 
 BUNDLED = bundled_robots()
-CLOSED = {"puma560", "puma560_std", "kuka_kr6_r900", "abb_irb140", "stanford", "carm_swapped"}
+CLOSED = {"puma560", "puma560_std", "kuka_kr6_r900", "abb_irb140", "stanford", "carm_swapped", "ur5"}
 CERT_REL = 1e-9
 
 
@@ -59,19 +59,20 @@ def test_bundled_arm_has_expected_decomposition(name):
     assert found[0].closed_form == (name in CLOSED)
 
 
-@pytest.mark.parametrize("name", [n for n in BUNDLED if n not in CLOSED])
+@pytest.mark.parametrize("name", BUNDLED)
 def test_other_decompositions_agree(name):
-    """Every theta* the decomposition offers gives the same solution set (different subproblem chains)."""
+    """Every theta* the decomposition offers gives the same solution set as the chosen plan (closed form or
+    sweep: different subproblem chains)."""
     robot = sweepik.load_robot(name)
     frees = sorted({p.free_joint for p in plans(robot) if not p.closed_form and not p.conditional})
-    assert frees
+    assert frees or name in CLOSED
     rng = np.random.default_rng(7)
     Q = in_limit_configurations(robot, 25, rng)
     T = robot.fk(Q)
     # within the limits: a prismatic theta* is swept over its limits only, a revolute one finds solutions whose
     # prismatic joints lie beyond them
-    ref = sweepik.solve_many(robot, T, free_joint=frees[0])
-    for k in frees[1:]:
+    ref = sweepik.solve_many(robot, T, **_kw(robot))
+    for k in frees:
         other = sweepik.solve_many(robot, T, free_joint=k)
         same = [
             same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale) for a, b in zip(ref, other, strict=True)
@@ -173,11 +174,20 @@ FAMILIES = {
         ("revolute", 0, 90, 0, 0),
         ("revolute", 0, 0, _L(g), 0),
     ],
-    # three parallel axes, offset wrist (UR-like): swept
+    # three parallel axes, the last two meeting (UR-like): closed form
     "three_parallel": lambda g: [
         ("revolute", 0, 90, _L(g), 0),
         ("revolute", -_L(g), 0, 0, 0),
         ("revolute", -_L(g), 0, 0, 0),
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # a slide oblique to three parallel axes, the last two meeting: closed form with a prismatic joint
+    "slide_parallel": lambda g: [
+        ("prismatic", _L(g), 30, 0, 0),
+        ("revolute", _L(g), 0, _L(g), 0),
+        ("revolute", _L(g), 0, 0, 0),
         ("revolute", 0, 90, _L(g), 0),
         ("revolute", 0, -90, _L(g), 0),
         ("revolute", 0, 0, _L(g), 0),
@@ -220,6 +230,27 @@ def test_random_family_arm(family, seed):
         num = numerical_solutions(robot, T, n_starts=300)
         num = num[robot.within_limits(num)] if num.size else num
         assert same_solution_set(s.q[robot.within_limits(s.q)], num, robot.is_revolute, robot.length_scale)
+
+
+@pytest.mark.parametrize("family", ["three_parallel", "slide_parallel"])
+def test_parallel_closed_form_agrees_with_a_sweep(family):
+    """The parallel family's closed form and a sweep of joint 4 give the same sets, also where joint 6's axis
+    turns onto the parallel axes (q5 = 0: a continuum, reported by the sweep as a family) and at a straight
+    elbow (q3 = 0)."""
+    rng = np.random.default_rng(23)
+    robot = _arm(FAMILIES[family](rng), rng)
+    assert plans(robot)[0].family == "parallel"
+    Q = in_limit_configurations(robot, 20, rng)
+    Q[:5, 4] = 0.0
+    Q[5:10, 2] = 0.0
+    T = robot.fk(Q)
+    closed = sweepik.solve_many(robot, T)
+    swept = sweepik.solve_many(robot, T, free_joint=3)
+    for q, a, b in zip(Q, closed, swept, strict=True):
+        assert recovers(robot, a, q) and recovers(robot, b, q)
+        _check_set(robot, a)
+        assert same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale)
+        assert len(a.families) == len(b.families)
 
 
 def test_arm_outside_the_catalogue_is_refused():

@@ -60,8 +60,10 @@ def test_robots_lists_structure_and_decomposition(capsys):
     assert code == 0
     assert "structure RRRRRR: 1∩2, 2∥3, 2∥4, 3∥4, 4∩5, 5∩6" in out
     assert "decomposition: closed form, 8 branches" in out  # carm_swapped: the paper's rejected closed form
-    code, out, _ = run(capsys, "robots", "ur5", "--json")
-    assert json.loads(out)[0]["decomposition"]["free_joint"] == 1  # an index, as solve(free_joint=) takes it
+    code, out, _ = run(capsys, "robots", "ur5", "fanuc_crx10ia", "--json")
+    info = json.loads(out)
+    assert info[0]["decomposition"]["closed_form"] and info[0]["decomposition"]["free_joint"] is None
+    assert info[1]["decomposition"]["free_joint"] == 0  # an index, as solve(free_joint=) takes it
 
 
 def test_free_joint_option(capsys):

@@ -86,6 +86,8 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
             return False, False
         return True, bool(np.ptp(vals) > VARY_TOL)
 
+    if rc and any(_dist_to_line(g[6], g[5], g[2]) < tol for g in geo):
+        return no  # joint c does not move W (its axis passes through W): W is left to two joints
     if case in ("ab_par", "bc_par"):
         i, j = (0, 1) if case == "ab_par" else (1, 2)
         if not (types[i] and types[j]) or not all(_parallel(g[i], g[j]) for g in geo):
@@ -95,8 +97,6 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
         k = 2 if case == "ab_par" else 0  # the joint solved first
         if types[k]:
             if all(_parallel(g[k], g[i]) for g in geo):  # three parallel: the height says nothing
-                return no
-            if case == "ab_par" and any(_dist_to_line(g[6], g[5], g[2]) < tol for g in geo):
                 return no
             return True, False, None
         ok, cond = dots(lambda g: float(np.dot(g[k], g[i])))
@@ -119,8 +119,6 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
                 centre = g[3 + i] + p
                 if _dist_to_line(centre, g[3 + k], g[k]) < tol:  # all three axes through one point
                     return no
-                if case == "ab_int" and _dist_to_line(g[6], g[5], g[2]) < tol:
-                    return no
         return True, False, points
     if case == "ppp":
         if any(types):
@@ -132,8 +130,6 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
             return no
         ok, cond = dots(lambda g: float(np.linalg.norm(np.cross(g[0], g[1]))))
         if not ok or all(_parallel(np.cross(g[0], g[1]), g[2]) for g in geo):
-            return no
-        if any(_dist_to_line(g[6], g[5], g[2]) < tol for g in geo):
             return no
         return True, cond, None
     if case == "ac_par":
@@ -192,6 +188,28 @@ def _position_plans(robot: Robot, chain: Chain, rev_chain: bool, W: np.ndarray, 
     return out
 
 
+def _parallel_plans(robot: Robot, chain: Chain, rev_chain: bool, st: Structure, W: np.ndarray) -> list[Plan]:
+    """The parallel family (closed form): axes 2, 3, 4 revolute and parallel, no two of them on one line; axis 1
+    (revolute, or a slide) and axis 5 not parallel to them (the heights the family solves for would not move)."""
+    rev, H, P = chain.revolute, chain.H, chain.P
+    if not (rev[1] and rev[2] and rev[3] and st.is_parallel(1, 2) and st.is_parallel(2, 3)):
+        return []
+    h = H[1]
+    pts = np.cumsum(P[:4], axis=0)
+    tol = INTERSECT_TOL_REL * robot.length_scale
+    if _dist_to_line(pts[2], pts[1], h) < tol or _dist_to_line(pts[3], pts[2], h) < tol:
+        return []
+    if _parallel(H[4], h):
+        return []
+    if rev[0] and _parallel(H[0], h):
+        return []
+    if not rev[0] and abs(float(np.dot(H[0], h))) < MIN_DOT:
+        return []
+    branches = 8 if rev[0] else 4
+    case = "parallel" if rev[0] else "parallel_slide"
+    return [Plan("parallel", rev_chain, 3, case, branches, _t(W), _t(np.zeros(3)))]
+
+
 def _meets_as_kernel(chain: Chain, f: int, xs: list[float], rel: list[np.ndarray], tol: float) -> bool:
     """The kernel rebuilds b and c's meeting point from its value at the first sample, turned with theta* when
     theta* is a revolute joint 2 (between a and b); the case applies only if that is where the axes meet."""
@@ -229,6 +247,7 @@ def plans(robot: Robot) -> tuple[Plan, ...]:
         if rev[4] and rev[5] and st.intersecting(4, 5):
             W = np.array(st.points[(4, 5)])
             found += _position_plans(robot, chain, rev_chain, W, (0, 1, 2, 3), "pair")
+            found += _parallel_plans(robot, chain, rev_chain, st, W)
     return tuple(sorted(found, key=_rank))
 
 

@@ -29,7 +29,7 @@ TWIN_TOL = 1e-12
 
 @dataclass(frozen=True)
 class Plan:
-    """One way to solve an arm: ``family`` ('pair': sweep theta*, 'wrist': closed form) on the forward or
+    """One way to solve an arm: ``family`` ('pair': sweep theta*; 'wrist', 'parallel': closed forms) on the forward or
     ``reversed`` chain, with ``free`` (0-3, in the solved chain's order) the fixed joint among the first four
     and ``case`` the position case placing the wrist centre ``W``; ``meet`` the meeting point of the axes that
     case uses (world frame, at the zero configuration of the joints other than theta*; for a prismatic theta* at
@@ -48,7 +48,7 @@ class Plan:
 
     @property
     def closed_form(self) -> bool:
-        return self.family == "wrist"
+        return self.family in ("wrist", "parallel")
 
     def joint(self, i: int) -> int:
         """Robot index of joint ``i`` of the solved chain."""
@@ -61,6 +61,15 @@ class Plan:
 
     def steps(self) -> list[str]:
         """The subproblem chain, in words (joints numbered from 1 as the robot numbers them)."""
+        if self.family == "parallel":
+            j = [self.joint(i) + 1 for i in range(6)]
+            return [
+                f"joint {j[0]}: {'sp4' if self.case == 'parallel' else 'lp4'} on the height of the wrist centre "
+                f"along the parallel axes {j[1]}, {j[2]}, {j[3]}",
+                f"joint {j[4]}: sp4 on the angle of joint {j[5]}'s axis to them",
+                f"joint {j[5]} and the sum of joints {j[1]}-{j[3]}: sp1",
+                f"joints {j[2]}, {j[1]}: sp3, sp1; joint {j[3]} from the sum",
+            ]
         others = [i for i in range(4) if i != self.free]
         a, b, c = (self.joint(i) + 1 for i in others)
         place = f"joints {a}, {b}, {c} place the wrist centre ({self.case})"
@@ -103,7 +112,7 @@ class GeometricReduction(Reduction):
         row[L["W"] : L["W"] + 3] = plan.W
         row[L["O"] : L["O"] + 3] = plan.meet
         row[L["free"]] = plan.free
-        row[L["case"]] = CASES.index(plan.case)
+        row[L["case"]] = CASES.index(plan.case) if plan.case in CASES else -1
         row[L["reversed"]] = float(plan.reversed)
         row[L["pos_branches"]] = plan.branches // 2 if plan.closed_form else plan.branches
         self._row = row
@@ -111,11 +120,11 @@ class GeometricReduction(Reduction):
         # the wrist centre in the tool frame (the last joints do not move it)
         p_end = chain.P.sum(axis=0)
         self._w_tool = chain.R_end.T @ (np.asarray(plan.W) - p_end)
-        self._kernels = (
-            (geometric.wrist_residual, geometric.wrist_configuration)
-            if plan.closed_form
-            else (geometric.pair_residual, geometric.pair_configuration)
-        )
+        self._kernels = {
+            "pair": (geometric.pair_residual, geometric.pair_configuration),
+            "wrist": (geometric.wrist_residual, geometric.wrist_configuration),
+            "parallel": (geometric.wrist_residual, geometric.parallel_configuration),
+        }[plan.family]
         self.kernel = self._kernels
         if not plan.closed_form:
             self.twins = tuple(tuple(c) for c in _classes(self._probe(self._kernels[0], self.n_branches)) if len(c) > 1)
@@ -153,8 +162,9 @@ class GeometricReduction(Reduction):
 
     @cached_property
     def _continua(self) -> GeometricReduction | None:
-        """For a closed form: the pair plan sweeping the wrist's first joint, which reports the continuum of a
-        singular wrist as a family (the closed form gives one member)."""
+        """For a closed form: the pair plan sweeping joint 4 (the wrist's first joint; for the parallel family the
+        last of the parallel ones), which reports the continuum of a singular wrist as a family (the closed form
+        gives one member)."""
         if not self.plan.closed_form:
             return None
         from .decompose import plans  # local: decompose imports this module
@@ -173,7 +183,8 @@ class GeometricReduction(Reduction):
         if not self.plan.closed_form or poses.shape[0] == 0:
             return None
         out = np.zeros(poses.shape[0], dtype=np.bool_)
-        geometric.wrist_singular(self.kernel_params(poses), out)
+        singular = geometric.parallel_singular if self.plan.family == "parallel" else geometric.wrist_singular
+        singular(self.kernel_params(poses), out)
         return out
 
     def search_range(self, poses: Array) -> Array | None:

@@ -15,6 +15,14 @@ target from the parameter row (``LAYOUT``), which :mod:`.decompose` fills from t
     and 5 turn joint 6's axis onto its target (``sp2``, 2 branches) and joint 6 follows from ``sp1``. Every
     branch gives a configuration (least squares where it has no exact one); FK certification keeps the solutions.
 
+``parallel`` (closed form, no sweep; the UR family): axes 2, 3, 4 revolute and parallel (direction ``h``), the
+    last two revolute and meeting at ``W``. Joints 2-4 turn about ``h`` only, so the height of ``W`` along ``h``
+    seen from joint 1 is fixed: joint 1 from ``sp4`` (or ``lp4`` for a slide; 2 branches), the angle of joint 6's
+    axis to ``h`` fixes joint 5 (``sp4``, 2), joint 6 and the sum of joints 2-4 follow from ``sp1``, and the planar
+    arm of joints 2-4 places ``W``: joint 3 from ``sp3`` (2), joint 2 from ``sp1``, joint 4 from the sum. 8
+    branches (4 with a slide first). Where joint 6's axis turns onto ``h`` the last joints' rotations combine (a
+    continuum, as a singular wrist).
+
 A structure at the base is the same structure at the tool of the reversed chain solving the inverse pose
 (``Chain.reversed``): the parameter row then holds the reversed chain and the kernel writes the joints back in
 the robot's order.
@@ -28,8 +36,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from ..subproblems import in_domain, sp1, sp2
-from ..subproblems.vec import cross, dot, norm, orthogonal, rot, rot_cs, sub
+from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs
+from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
 from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG
 from .position import angle, motion, place, reduce_chain
 
@@ -75,6 +83,17 @@ def _mat(p, v):
         p[m] * v[0] + p[m + 1] * v[1] + p[m + 2] * v[2],
         p[m + 3] * v[0] + p[m + 4] * v[1] + p[m + 5] * v[2],
         p[m + 6] * v[0] + p[m + 7] * v[1] + p[m + 8] * v[2],
+    )
+
+
+@njit(cache=True)
+def _mat_t(p, v):
+    """``M^T v``."""
+    m = _M
+    return (
+        p[m] * v[0] + p[m + 3] * v[1] + p[m + 6] * v[2],
+        p[m + 1] * v[0] + p[m + 4] * v[1] + p[m + 7] * v[2],
+        p[m + 2] * v[0] + p[m + 5] * v[1] + p[m + 8] * v[2],
     )
 
 
@@ -225,6 +244,79 @@ def _wrist_configuration(p, x, branch, out):
     _write(p, out, m0, m1, m2, motion(True, q3), q4, q5)
 
 
+@njit(cache=True)
+def _o3(p):
+    """Joint 4's point (index 3) at the zero configuration."""
+    o = _v(p, _P)
+    for i in range(1, 4):
+        o = add(o, _v(p, _P + 3 * i))
+    return o
+
+
+@njit(cache=True)
+def _parallel_g(p, m0, v):
+    """``R_0^T M v``: the target orientation seen after joint 1."""
+    w = _mat(p, v)
+    if p[_REV] > 0.5:
+        return rot_cs(_h(p, 0), m0[0], -m0[1], w)
+    return w
+
+
+@njit(cache=True)
+def _parallel_first(p, branch):
+    """The parallel family's first steps: motion of joint 1, ``(cos, sin)`` of joint 5, and their cosines
+    ``(c0, c4)`` (``|c| <= 1`` inside the branch's domain)."""
+    h0, h, h4, h5 = _h(p, 0), _h(p, 1), _h(p, 4), _h(p, 5)
+    s0 = _v(p, _P)
+    v = sub(_v(p, _T), s0)
+    # the height of W along h seen from joint 1 does not depend on joints 2-4
+    height = dot(h, add(add(add(_v(p, _P + 3), _v(p, _P + 6)), _v(p, _P + 9)), sub(_v(p, _W), _o3(p))))
+    b0, b4 = branch // 4, (branch // 2) % 2
+    if p[_REV] > 0.5:
+        ua, va, ub, vb, c0, _ = sp4_cs(h, v, h0, height)
+        m0 = (ua, -va, 0.0) if b0 == 0 else (ub, -vb, 0.0)
+    else:
+        m0 = (1.0, 0.0, lp4(h, v, scale(-1.0, h0), height))
+        c0 = 0.0 if b0 == 0 else math.nan
+    # the angle of joint 6's axis to h does not depend on joints 2-4 or 6
+    u = _parallel_g(p, m0, h5)
+    ua, va, ub, vb, c4, _ = sp4_cs(h, h5, h4, dot(h, u))
+    m4 = (ua, va) if b4 == 0 else (ub, vb)
+    return m0, m4, c0, c4
+
+
+def _parallel_configuration(p, x, branch, out):
+    h0, h, h4, h5 = _h(p, 0), _h(p, 1), _h(p, 4), _h(p, 5)
+    m0, m4, _, _ = _parallel_first(p, branch)
+    if math.isnan(m0[0] + m0[2]) or branch >= (8 if p[_REV] > 0.5 else 4):
+        for i in range(6):
+            out[i] = math.nan
+        return
+    # joint 6: h^T R_0^T M = h^T R_4 R_5, i.e. R_5^T (R_4^T h) = M^T R_0 h
+    r0h = rot_cs(h0, m0[0], m0[1], h) if p[_REV] > 0.5 else h
+    c5, s5 = sp1_cs(rot_cs(h4, m4[0], -m4[1], h), _mat_t(p, r0h), h5)
+    s5 = -s5
+    # the sum phi of joints 2-4: R(h, phi) = R_0^T M R_5^T R_4^T
+    e = orthogonal(h)
+    cf, sf = sp1_cs(e, _parallel_g(p, m0, rot_cs(h5, c5, -s5, rot_cs(h4, m4[0], -m4[1], e))), h)
+    # the planar arm: R_1 (s2 + R_2 s3) = R_0^T (t - s0) - s1 - R(h, phi) s4
+    s1, s2, s3 = _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
+    s4 = sub(_v(p, _W), _o3(p))
+    t0 = sub(_v(p, _T), _v(p, _P))
+    if p[_REV] > 0.5:
+        t0 = rot_cs(h0, m0[0], -m0[1], t0)
+    else:
+        t0 = sub(t0, scale(m0[2], h0))
+    d = sub(sub(t0, s1), rot_cs(h, cf, sf, s4))
+    ua, va, ub, vb, _, _ = sp3_cs(s3, scale(-1.0, s2), h, norm(d))
+    c2, s2_ = (ua, va) if branch % 2 == 0 else (ub, vb)
+    c1, s1_ = sp1_cs(add(s2, rot_cs(h, c2, s2_, s3)), d, h)
+    # joint 4 = phi - joint 2 - joint 3 (angles as unit complex numbers)
+    c12, s12 = c1 * c2 - s1_ * s2_, s1_ * c2 + c1 * s2_
+    c3, s3_ = cf * c12 + sf * s12, sf * c12 - cf * s12
+    _write(p, out, m0, (c1, s1_, 0.0), (c2, s2_, 0.0), (c3, s3_, 0.0), math.atan2(m4[1], m4[0]), math.atan2(s5, c5))
+
+
 def _no_residual(p, x, branch):
     return 0.0
 
@@ -308,6 +400,7 @@ def swing_hints(params, lo, hi, n, periodic, ks, out):
 
 wrist_residual = njit(RESIDUAL_SIG, cache=True)(_no_residual)
 wrist_configuration = njit(CONFIGURATION_SIG, cache=True)(_wrist_configuration)
+parallel_configuration = njit(CONFIGURATION_SIG, cache=True)(_parallel_configuration)
 
 
 @njit(cache=True)
@@ -342,4 +435,22 @@ def wrist_singular(params, out):
                 continue
             v = _back(p, m0, m1, m2, m3, _mat(p, h5))
             if norm(cross(v, h3)) < WRIST_SINGULAR:
+                out[i] = True
+
+
+@njit(cache=True)
+def parallel_singular(params, out):
+    """``out[i]``: some exact branch of joint 1 leaves pose i with joint 6's axis along the parallel axes (joint 6
+    and the sum of joints 2-4 then turn about one direction: a continuum)."""
+    h, h5 = _h(params[0], 1), _h(params[0], 5)
+    for i in range(params.shape[0]):
+        p = params[i]
+        out[i] = False
+        for b in (0, 4):
+            m0, _, c0, _ = _parallel_first(p, b)
+            if math.isnan(m0[0] + m0[2]) or not in_domain(c0):
+                continue
+            # joint 6's axis seen after joint 1 along h (judged before joint 5's sp4, whose angle near there
+            # carries the square root of the rounding)
+            if norm(cross(_parallel_g(p, m0, h5), h)) < WRIST_SINGULAR:
                 out[i] = True
