@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 from numpy.typing import NDArray
 
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs
@@ -338,8 +338,10 @@ SWING_MINIMA = 4
 #: ... each giving its centre and this many samples spread over the window where the angle swings
 #: (``centre + w tan(u)``, u uniform in (-pi/2, pi/2), w the window's half-width).
 SWING_SAMPLES = 16
-#: Golden-section steps locating a minimum between two grid steps (0.618^50 ~ 3e-11 of the bracket).
+#: Golden-section steps locating a minimum between two grid steps (at most; 0.618^50 ~ 3e-11 of the bracket) ...
 SWING_GOLDEN = 50
+#: ... stopping once the bracket is this fraction of the window's estimated half-width.
+SWING_LOCATE = 0.01
 #: Only minima below this times the rise to the next sample are located (a window narrower than the grid step
 #: has r* < |r'| h, while the rise is at most |r'| h).
 SWING_DEPTH = 2.0
@@ -347,55 +349,79 @@ SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
 @njit(cache=True)
+def _swing_pose(params, lo, hi, n, periodic, ks, out, i):
+    """Swing hints of pose i (``swing_hints``)."""
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    p = params[i]
+    h = (hi[i] - lo[i]) / n
+    cnt = 0
+    for k in ks:
+        found = 0
+        xm, am = lo[i] - h, amplitude(p, lo[i] - h, k)
+        x0, a0 = lo[i], amplitude(p, lo[i], k)
+        for j in range(1, n + 2):
+            x1 = lo[i] + j * h
+            a1 = amplitude(p, x1, k)
+            # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
+            # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
+            deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
+            if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
+                a, b = xm, x1
+                c, d = b - g * (b - a), a + g * (b - a)
+                fc, fd = amplitude(p, c, k), amplitude(p, d, k)
+                for _ in range(SWING_GOLDEN):
+                    # located well enough: the bracket is a small part of the window it centres
+                    fm = min(fc, fd)
+                    slope = max(abs(am - fm) / max(c - xm, 1e-300), abs(a1 - fm) / max(x1 - d, 1e-300))
+                    if b - a < SWING_LOCATE * fm / max(slope, 1e-300):
+                        break
+                    if fc < fd:
+                        b, d, fd = d, c, fc
+                        c = b - g * (b - a)
+                        fc = amplitude(p, c, k)
+                    else:
+                        a, c, fc = c, d, fd
+                        d = a + g * (b - a)
+                        fd = amplitude(p, d, k)
+                xs = 0.5 * (a + b)
+                rs = amplitude(p, xs, k)
+                slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
+                if slope > 0.0 and rs < slope * h:
+                    w = rs / slope
+                    for m in range(SWING_SAMPLES + 1):
+                        t = xs
+                        if m > 0:
+                            t = xs + w * math.tan(math.pi * (m / (SWING_SAMPLES + 1.0) - 0.5))
+                        if periodic:
+                            t = lo[i] + (t - lo[i]) % (hi[i] - lo[i])
+                        if lo[i] <= t <= hi[i]:
+                            out[i, cnt] = t
+                            cnt += 1
+                    found += 1
+            xm, am, x0, a0 = x0, a0, x1, a1
+
+
+@njit(cache=True, parallel=True)
+def _swing_parallel(params, lo, hi, n, periodic, ks, out):
+    for i in prange(params.shape[0]):
+        _swing_pose(params, lo, hi, n, periodic, ks, out, i)
+
+
+@njit(cache=True)
+def _swing_serial(params, lo, hi, n, periodic, ks, out):
+    for i in range(params.shape[0]):
+        _swing_pose(params, lo, hi, n, periodic, ks, out, i)
+
+
 def swing_hints(params, lo, hi, n, periodic, ks, out):
     """Samples of theta* ``out (N, SWING_PER_POSE)`` (NaN-padded) where a step of the position case is nearly
     degenerate: around each local minimum ``r*`` of its amplitude ``r(theta*)`` narrower than the grid step
     ``h``, where its angles turn by up to pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
-    ``_amplitude``)."""
-    g = (math.sqrt(5.0) - 1.0) / 2.0
-    for i in range(params.shape[0]):
-        p = params[i]
-        h = (hi[i] - lo[i]) / n
-        cnt = 0
-        for k in ks:
-            found = 0
-            xm, am = lo[i] - h, amplitude(p, lo[i] - h, k)
-            x0, a0 = lo[i], amplitude(p, lo[i], k)
-            for j in range(1, n + 2):
-                x1 = lo[i] + j * h
-                a1 = amplitude(p, x1, k)
-                # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
-                # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
-                deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
-                if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
-                    a, b = xm, x1
-                    c, d = b - g * (b - a), a + g * (b - a)
-                    fc, fd = amplitude(p, c, k), amplitude(p, d, k)
-                    for _ in range(SWING_GOLDEN):
-                        if fc < fd:
-                            b, d, fd = d, c, fc
-                            c = b - g * (b - a)
-                            fc = amplitude(p, c, k)
-                        else:
-                            a, c, fc = c, d, fd
-                            d = a + g * (b - a)
-                            fd = amplitude(p, d, k)
-                    xs = 0.5 * (a + b)
-                    rs = amplitude(p, xs, k)
-                    slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
-                    if slope > 0.0 and rs < slope * h:
-                        w = rs / slope
-                        for m in range(SWING_SAMPLES + 1):
-                            t = xs
-                            if m > 0:
-                                t = xs + w * math.tan(math.pi * (m / (SWING_SAMPLES + 1.0) - 0.5))
-                            if periodic:
-                                t = lo[i] + (t - lo[i]) % (hi[i] - lo[i])
-                            if lo[i] <= t <= hi[i]:
-                                out[i, cnt] = t
-                                cnt += 1
-                        found += 1
-                xm, am, x0, a0 = x0, a0, x1, a1
+    ``_amplitude``). Batches use both cores, as the engine's search."""
+    from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
+
+    run = _swing_parallel if params.shape[0] >= PARALLEL_MIN else _swing_serial
+    run(params, lo, hi, n, periodic, ks, out)
 
 
 wrist_residual = njit(RESIDUAL_SIG, cache=True)(_no_residual)

@@ -48,7 +48,7 @@ def sp1_cs(p1, p2, k):
     b = perp(k, p2)
     x = dot(a, b)
     y = dot(k, cross(a, b))
-    n = math.hypot(x, y)
+    n = math.sqrt(x * x + y * y)
     if n == 0.0:
         return 1.0, 0.0
     return x / n, y / n
@@ -68,7 +68,7 @@ def sp4_cs(h, p, k, d):
     ``cos w = c``, ``sin w = sqrt(1 - c^2)`` (``w`` = 0 or pi outside ``|c| <= 1``: the least-squares angle)."""
     A = dot(h, perp(k, p))
     B = dot(h, cross(k, p))
-    r = math.hypot(A, B)
+    r = math.sqrt(A * A + B * B)
     rhs = d - dot(h, k) * dot(k, p)
     if r == 0.0:
         return 1.0, 0.0, 1.0, 0.0, math.nan, 0.0
