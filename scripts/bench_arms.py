@@ -6,7 +6,7 @@ solutions are not FK-filtered here); "-" where a solver cannot solve the arm at 
 decomposition or a prismatic joint; IK-Geo 1.0.3: only its closed forms are reliable, see tests/oracles.py).
 For the C-Arm the automatic decomposition and the hand-written carm-d1 are timed side by side.
 
-    pip install -e '.[bench]'; python scripts/bench_arms.py [--single 300] [--batch 2000] [--markdown]
+    pip install -e '.[bench]'; python scripts/bench_arms.py [--single 300] [--batch 2000] [--arms carm ur5 ...]
 """
 
 from __future__ import annotations
