@@ -33,12 +33,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import float64, int64, njit, prange, types
 from numpy.typing import NDArray
 
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
-from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG
+from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, first_class
 from .position import angle, motion, place, reduce_chain
 
 Array = NDArray[np.float64]
@@ -429,18 +429,46 @@ wrist_configuration = njit(CONFIGURATION_SIG, cache=True)(_wrist_configuration)
 parallel_configuration = njit(CONFIGURATION_SIG, cache=True)(_parallel_configuration)
 
 
-@njit(cache=True)
-def evaluate(res, params, pose, theta, branch, out):
-    """``out[k] = res(params[pose[k]], theta[k], branch[k])`` (vectorised residual for the NumPy engine)."""
+# Kernels enter as first-class functions (``kernels.first_class``) through an explicit signature: compiled once
+# and cached (a dispatcher argument would be typed, compiled and appended to the cache anew in every process).
+_EVALUATE_SIG = (
+    types.FunctionType(RESIDUAL_SIG),
+    float64[:, ::1],
+    int64[::1],
+    float64[::1],
+    int64[::1],
+    float64[::1],
+)
+_CONFIGURE_SIG = (
+    types.FunctionType(CONFIGURATION_SIG),
+    float64[:, ::1],
+    int64[::1],
+    float64[::1],
+    int64[::1],
+    float64[:, ::1],
+)
+
+
+@njit(_EVALUATE_SIG, cache=True)
+def _evaluate(res, params, pose, theta, branch, out):
     for k in range(pose.shape[0]):
         out[k] = res(params[pose[k]], theta[k], branch[k])
 
 
-@njit(cache=True)
-def configure(cfg, params, pose, theta, branch, out):
-    """``cfg(params[pose[k]], theta[k], branch[k], out[k])`` for every k."""
+@njit(_CONFIGURE_SIG, cache=True)
+def _configure(cfg, params, pose, theta, branch, out):
     for k in range(pose.shape[0]):
         cfg(params[pose[k]], theta[k], branch[k], out[k])
+
+
+def evaluate(res, params, pose, theta, branch, out):
+    """``out[k] = res(params[pose[k]], theta[k], branch[k])`` (vectorised residual for the NumPy engine)."""
+    _evaluate(first_class(res), params, pose, theta, branch, out)
+
+
+def configure(cfg, params, pose, theta, branch, out):
+    """``cfg(params[pose[k]], theta[k], branch[k], out[k])`` for every k."""
+    _configure(first_class(cfg), params, pose, theta, branch, out)
 
 
 #: A wrist is singular (joint 6's target axis along joint 4's: a continuum of solutions) when the sine of the
