@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from sweepik.chain import rotation_about
-from sweepik.subproblems import in_domain, lines2, lines3, lp1, lp3, lp4, sp1, sp2, sp3, sp4
+from sweepik.subproblems import in_domain, lines2, lines3, lp1, lp3, lp4, sp1, sp2, sp3, sp4, sp5, sp6, trig2_roots
 
 RNG = np.random.default_rng(20261123)
 GRID = np.linspace(-np.pi, np.pi, 20001)
@@ -145,3 +145,119 @@ def test_line_subproblems(seed):
     np.testing.assert_allclose(lines2(_t(h), _t(h2), _t(t1 * h + t2 * h2)), (t1, t2), atol=1e-9)
     np.testing.assert_allclose(lines3(_t(h), _t(h2), _t(h3), _t(t1 * h + t2 * h2 + t3 * h3)), (t1, t2, t3), atol=1e-8)
     assert np.isnan(lines2(_t(h), _t(h), _t(h))[0])
+
+
+# ---------------------------------------------------------------------------------------------------------
+# SP5 and SP6: a trigonometric polynomial of degree 2
+# ---------------------------------------------------------------------------------------------------------
+
+
+def _trig(c, t):
+    a0, a1, b1, a2, b2 = c
+    return a0 + a1 * np.cos(t) + b1 * np.sin(t) + a2 * np.cos(2 * t) + b2 * np.sin(2 * t)
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_trig2_roots_match_scan(seed):
+    rng = np.random.default_rng(seed)
+    c = rng.normal(size=5)
+    if seed % 4 == 0:
+        c[3:] = 0.0  # degree 1
+    if seed % 5 == 0:  # a root at pi exactly
+        c[0] -= _trig(c, np.pi)
+    roots, n = trig2_roots(*c)
+    assert n == np.count_nonzero(np.isfinite(roots))
+    for t in roots[:n]:
+        assert abs(_trig(c, t)) < 1e-10 * np.abs(c).max()
+    scan = _scan_roots(lambda t: _trig(c, t))
+    if seed % 5 != 0:  # (a root at the scan's end points is seen twice or not at all)
+        assert n == len(scan)
+    for t in scan:
+        assert min(_ang(t, r) for r in roots[:n]) < 1e-3
+
+
+def test_trig2_roots_double_root_and_degenerate():
+    # (cos t - 0.3)^2 - 0: a double root pair at +-acos(0.3)
+    c0, c1 = 0.3, 1.0
+    # (cos t - c0)^2 = cos^2 - 2 c0 cos + c0^2 = 0.5 + 0.5 cos 2t - 2 c0 cos + c0^2
+    roots, n = trig2_roots(0.5 + c0 * c0, -2 * c0, 0.0, 0.5 * c1, 0.0)
+    assert n == 2 and np.allclose(np.sort(np.abs(roots[:2])), [np.arccos(0.3)] * 2, atol=1e-7)
+    assert trig2_roots(0.0, 0.0, 0.0, 0.0, 0.0)[1] == -1
+    assert trig2_roots(1.0, 0.0, 0.0, 0.0, 0.0)[1] == 0
+
+
+def _sp6_data(rng):
+    return [(rng.normal(size=3), _unit(rng), rng.normal(size=3)) for _ in range(4)]
+
+
+def _sp6_residual(data, d, t1, t2):
+    (h1, k1, p1), (h2, k2, p2), (h3, k3, p3), (h4, k4, p4) = data
+    r1 = h1 @ _R(k1, t1) @ p1 + h2 @ _R(k2, t2) @ p2 - d[0]
+    r2 = h3 @ _R(k3, t1) @ p3 + h4 @ _R(k4, t2) @ p4 - d[1]
+    return r1, r2
+
+
+def _sp6(data, d):
+    args = [_t(v) for hkp in data for v in hkp]
+    return sp6(*args, float(d[0]), float(d[1]))
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_sp6_recovers_constructed_solution(seed):
+    rng = np.random.default_rng(seed)
+    data = _sp6_data(rng)
+    t1, t2 = rng.uniform(-np.pi, np.pi, 2)
+    d = np.array(_sp6_residual(data, (0.0, 0.0), t1, t2))
+    a, b, n = _sp6(data, d)
+    assert 1 <= n <= 4
+    for x, y in zip(a[:n], b[:n], strict=True):
+        assert np.max(np.abs(_sp6_residual(data, d, x, y))) < 1e-9
+    assert min(_ang(x, t1) + _ang(y, t2) for x, y in zip(a[:n], b[:n], strict=True)) < 1e-8
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_sp6_matches_scan(seed):
+    """Brute force: theta2 from the first equation (sp4) on a dense theta1 grid, the second's sign changes. Every
+    root the scan finds is returned, and every returned pair solves both equations (the scan can miss a root where
+    sp4's two branches meet, so it bounds the count from below)."""
+    rng = np.random.default_rng(100 + seed)
+    data = _sp6_data(rng)
+    d = rng.normal(size=2)
+    a, b, n = _sp6(data, d)
+    (h1, k1, p1), (h2, k2, p2), (h3, k3, p3), (h4, k4, p4) = data
+    found = []
+    for branch in (0, 1):
+        g = np.full(GRID.size, np.nan)
+        for i, t in enumerate(GRID):
+            x, y, c, _ = sp4(_t(h2), _t(p2), _t(k2), float(d[0] - h1 @ _R(k1, t) @ p1))
+            if in_domain(c):
+                g[i] = h3 @ _R(k3, t) @ p3 + h4 @ _R(k4, (x, y)[branch]) @ p4 - d[1]
+        ok = np.isfinite(g[1:]) & np.isfinite(g[:-1])
+        found += list(GRID[:-1][ok & (np.sign(g[1:]) != np.sign(g[:-1]))])
+    assert len(found) <= n <= 4
+    for t in found:
+        assert min(_ang(x, t) for x in a[:n]) < 1e-3
+    for x, y in zip(a[:n], b[:n], strict=True):
+        assert np.max(np.abs(_sp6_residual(data, d, x, y))) < 1e-9
+
+
+def test_sp6_degenerate():
+    z = (0.0, 0.0, 1.0)
+    # every p on its axis: no equation depends on an angle
+    t1, t2, n = sp6(z, z, z, z, z, z, z, z, z, z, z, z, 1.0, 1.0)
+    assert n == -1 and np.all(np.isnan(t1)) and np.all(np.isnan(t2))
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_sp5_recovers_constructed_solution(seed):
+    rng = np.random.default_rng(seed)
+    p1, p2, p3 = rng.normal(size=(3, 3))
+    k1, k2, k3 = _unit(rng), _unit(rng), _unit(rng)
+    t1, t2, t3 = rng.uniform(-np.pi, np.pi, 3)
+    p0 = _R(k2, t2) @ (p2 + _R(k3, t3) @ p3) - _R(k1, t1) @ p1
+    a, b, c, n = sp5(_t(p0), _t(p1), _t(p2), _t(p3), _t(k1), _t(k2), _t(k3))
+    assert 1 <= n <= 4
+    for x, y, w in zip(a[:n], b[:n], c[:n], strict=True):
+        miss = p0 + _R(k1, x) @ p1 - _R(k2, y) @ (p2 + _R(k3, w) @ p3)
+        assert np.linalg.norm(miss) < 1e-9
+    assert min(_ang(x, t1) + _ang(y, t2) + _ang(w, t3) for x, y, w in zip(a[:n], b[:n], c[:n], strict=True)) < 1e-8

@@ -5,13 +5,17 @@ points. See docs/subproblems.md for each equation, its solution set and its dege
 """
 
 from .prismatic import lines2, lines3, lp1, lp3, lp4
-from .revolute import DOMAIN_TOL, in_domain, sp1, sp1_cs, sp2, sp2_cs, sp3, sp3_cs, sp4, sp4_cs
+from .revolute import DOMAIN_TOL, in_domain, sp1, sp1_cs, sp2, sp2_cs, sp3, sp3_cs, sp4, sp4_cs, sp5, sp6
+from .trig import trig2_roots
 
 __all__ = [
     "sp1",
     "sp2",
     "sp3",
     "sp4",
+    "sp5",
+    "sp6",
+    "trig2_roots",
     "sp1_cs",
     "sp2_cs",
     "sp3_cs",

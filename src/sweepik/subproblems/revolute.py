@@ -9,6 +9,10 @@ from Python. Axes ``k`` are unit vectors; angles are radians; ``R(k, theta)`` is
 * ``sp4(h, p, k, d)``: ``h . R(k, theta) p = d`` (circle-plane). Two angles ``phi +- acos(c)``.
 * ``sp3(p1, p2, k, d)``: ``|R(k, theta) p1 - p2| = d`` (circle-sphere), an ``sp4`` in disguise.
 * ``sp2(p1, p2, k1, k2)``: ``R(k1, theta1) p1 = R(k2, theta2) p2`` (two circles). Two pairs.
+* ``sp5(p0, p1, p2, p3, k1, k2, k3)``: ``p0 + R(k1, theta1) p1 = R(k2, theta2)(p2 + R(k3, theta3) p3)`` (three
+  circles). Up to 4 triples.
+* ``sp6(h1, k1, p1, ..., d1, d2)``: two equations ``h . R(k, theta1) p + h' . R(k', theta2) p' = d`` (four
+  circles). Up to 4 pairs. Both reduce to the roots of a trigonometric polynomial of degree 2 (``trig``).
 
 The two-solution subproblems return both angles, ``c``, the cosine they are built from, and ``r``, the amplitude
 it is divided by (its conditioning): ``|c| <= 1`` means
@@ -24,11 +28,26 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
-from .vec import cross, dot, norm, perp, rot_cs, sub
+from .trig import trig2_roots
+from .vec import cross, dot, norm, perp, rot, rot_cs, sub
 
-__all__ = ["sp1", "sp2", "sp3", "sp4", "sp1_cs", "sp2_cs", "sp3_cs", "sp4_cs", "in_domain", "DOMAIN_TOL"]
+__all__ = [
+    "sp1",
+    "sp2",
+    "sp3",
+    "sp4",
+    "sp5",
+    "sp6",
+    "sp1_cs",
+    "sp2_cs",
+    "sp3_cs",
+    "sp4_cs",
+    "in_domain",
+    "DOMAIN_TOL",
+]
 
 #: ``|c|`` up to ``1 + DOMAIN_TOL`` counts as 1 (``in_domain``): rounding of the vectors a subproblem is built
 #: from moves ``c`` by a few ulps, and a solution exactly at a branch-domain edge must not turn into "none".
@@ -128,3 +147,91 @@ def sp2(p1, p2, k1, k2):
     """
     c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c, r = sp2_cs(p1, p2, k1, k2)
     return math.atan2(s1a, c1a), math.atan2(s2a, c2a), math.atan2(s1b, c1b), math.atan2(s2b, c2b), c, r
+
+
+@njit(cache=True)
+def _trig_terms(h, k, p):
+    """``(a_c, a_s, a_0)`` with ``h . R(k, t) p = a_c cos t + a_s sin t + a_0``."""
+    return dot(h, perp(k, p)), dot(h, cross(k, p)), dot(h, k) * dot(k, p)
+
+
+#: SP6 is degenerate (its two equations do not fix the angles: a continuum or no solution, not solved) when both
+#: 2x2 blocks of its linear system in the cosines and sines are singular to this, relative to their entries.
+SP6_SINGULAR = 1e-12
+
+
+@njit(cache=True)
+def sp6(h1, k1, p1, h2, k2, p2, h3, k3, p3, h4, k4, p4, d1, d2):
+    """Pairs ``(theta1, theta2)`` with (IK-Geo's SP6, "four circles")::
+
+        h1 . R(k1, theta1) p1 + h2 . R(k2, theta2) p2 = d1
+        h3 . R(k3, theta1) p3 + h4 . R(k4, theta2) p4 = d2
+
+    Returns ``(theta1 (4,), theta2 (4,), n)``, NaN-padded, ``n`` the number of solutions (at most 4); ``n = -1``
+    when the equations do not fix the angles (degenerate: a continuum or none; not solved).
+
+    Both equations are linear in ``x1 = (cos theta1, sin theta1)`` and ``x2 = (cos theta2, sin theta2)``:
+    ``A x1 + B x2 = e``. Eliminating the angle whose block is better conditioned (``x2 = M x1 + v``) leaves
+    ``|M x1 + v|^2 = 1``, a trigonometric polynomial of degree 2 in theta1 (:func:`.trig.trig2_roots`).
+    """
+    a1c, a1s, a10 = _trig_terms(h1, k1, p1)
+    b1c, b1s, b10 = _trig_terms(h2, k2, p2)
+    a2c, a2s, a20 = _trig_terms(h3, k3, p3)
+    b2c, b2s, b20 = _trig_terms(h4, k4, p4)
+    e1, e2 = d1 - a10 - b10, d2 - a20 - b20
+    t1 = np.full(4, np.nan)
+    t2 = np.full(4, np.nan)
+    det_a = a1c * a2s - a1s * a2c
+    det_b = b1c * b2s - b1s * b2c
+    size = max(abs(a1c), abs(a1s), abs(a2c), abs(a2s), abs(b1c), abs(b1s), abs(b2c), abs(b2s))
+    if max(abs(det_a), abs(det_b)) <= SP6_SINGULAR * size * size:
+        return t1, t2, -1
+    swap = abs(det_a) > abs(det_b)
+    if swap:  # eliminate theta1 instead: the roles of the two angles exchange
+        a1c, a1s, a2c, a2s, b1c, b1s, b2c, b2s = b1c, b1s, b2c, b2s, a1c, a1s, a2c, a2s
+        det_b = det_a
+    # x2 = B^-1 (e - A x1) = M x1 + v
+    i11, i12, i21, i22 = b2s / det_b, -b1s / det_b, -b2c / det_b, b1c / det_b
+    m11, m12 = -(i11 * a1c + i12 * a2c), -(i11 * a1s + i12 * a2s)
+    m21, m22 = -(i21 * a1c + i22 * a2c), -(i21 * a1s + i22 * a2s)
+    v1, v2 = i11 * e1 + i12 * e2, i21 * e1 + i22 * e2
+    q11, q12, q22 = m11 * m11 + m21 * m21, m11 * m12 + m21 * m22, m12 * m12 + m22 * m22
+    w1, w2 = m11 * v1 + m21 * v2, m12 * v1 + m22 * v2
+    roots, n = trig2_roots(0.5 * (q11 + q22) + v1 * v1 + v2 * v2 - 1.0, 2.0 * w1, 2.0 * w2, 0.5 * (q11 - q22), q12)
+    if n < 0:
+        return t1, t2, -1
+    for i in range(n):
+        c, s = math.cos(roots[i]), math.sin(roots[i])
+        other = math.atan2(m21 * c + m22 * s + v2, m11 * c + m12 * s + v1)
+        if swap:
+            t1[i], t2[i] = other, roots[i]
+        else:
+            t1[i], t2[i] = roots[i], other
+    return t1, t2, n
+
+
+@njit(cache=True)
+def sp5(p0, p1, p2, p3, k1, k2, k3):
+    """Triples ``(theta1, theta2, theta3)`` with (IK-Geo's SP5, "three circles")::
+
+        p0 + R(k1, theta1) p1 = R(k2, theta2) (p2 + R(k3, theta3) p3)
+
+    Returns ``(theta1 (4,), theta2 (4,), theta3 (4,), n)``, NaN-padded; ``n = -1`` when degenerate (as ``sp6``).
+
+    A rotation about ``k2`` (through the origin) maps one point onto another exactly when both have the same
+    height along ``k2`` and the same distance from the origin: two equations in theta1 and theta3 of SP6's form;
+    theta2 then follows from ``sp1``.
+    """
+    nk2 = (-k2[0], -k2[1], -k2[2])
+    np2 = (-p2[0], -p2[1], -p2[2])
+    d1 = dot(k2, p2) - dot(k2, p0)
+    d2 = 0.5 * (dot(p2, p2) + dot(p3, p3) - dot(p0, p0) - dot(p1, p1))
+    t1, t3, n = sp6(k2, k1, p1, nk2, k3, p3, p0, k1, p1, np2, k3, p3, d1, d2)
+    t2 = np.full(4, np.nan)
+    for i in range(max(n, 0)):
+        a = rot(k3, t3[i], p3)
+        a = (a[0] + p2[0], a[1] + p2[1], a[2] + p2[2])
+        b = rot(k1, t1[i], p1)
+        b = (b[0] + p0[0], b[1] + p0[1], b[2] + p0[2])
+        t2[i], _ = sp1(a, b, k2)
+    return t1, t2, t3, n

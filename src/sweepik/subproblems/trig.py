@@ -1,0 +1,89 @@
+"""Roots of a trigonometric polynomial of degree 2 in one angle: what SP5 and SP6 reduce to.
+
+``f(theta) = a0 + a1 cos(theta) + b1 sin(theta) + a2 cos(2 theta) + b2 sin(2 theta)`` has at most 4 roots on the
+circle. With ``z = exp(i theta)``, ``z^2 f`` is a polynomial of degree 4 in ``z`` whose roots on the unit circle are
+the roots of ``f``: its companion matrix's eigenvalues (``numpy.roots``), those within ``UNIT_TOL`` of the circle
+kept, each polished by Newton's method on ``f`` itself and accepted only where ``|f|`` is then at rounding level.
+No tangent-half-angle substitution, so no angle is special (theta = pi included).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["trig2_roots", "trig2"]
+
+#: Roots of ``z^2 f`` this far from the unit circle (in ``| |z| - 1 |``) are candidates: a double root (f tangent
+#: to zero) splits into two roots ~sqrt(rounding) off the circle.
+UNIT_TOL = 1e-4
+#: Newton steps polishing each candidate on ``f``.
+NEWTON_STEPS = 8
+#: A candidate is a root when ``|f|`` ends below this times the size of ``f``'s coefficients.
+ROOT_TOL = 1e-10
+#: Two roots closer than this (radians) are one, at their midpoint: a double root (f tangent to zero) comes out of
+#: the eigenvalues as two roots ~sqrt(rounding) apart.
+SAME_ROOT = 1e-6
+
+
+@njit(cache=True)
+def trig2(a0, a1, b1, a2, b2, theta):
+    """``f(theta)`` and ``f'(theta)``."""
+    c, s = math.cos(theta), math.sin(theta)
+    c2, s2 = c * c - s * s, 2.0 * s * c
+    f = a0 + a1 * c + b1 * s + a2 * c2 + b2 * s2
+    df = -a1 * s + b1 * c - 2.0 * a2 * s2 + 2.0 * b2 * c2
+    return f, df
+
+
+@njit(cache=True)
+def trig2_roots(a0, a1, b1, a2, b2):
+    """Roots ``(4,)`` (NaN-padded, ascending) of ``a0 + a1 cos t + b1 sin t + a2 cos 2t + b2 sin 2t`` in (-pi, pi],
+    and their count. An identically zero ``f`` (every angle a root) gives count -1."""
+    out = np.full(4, np.nan)
+    scale = max(abs(a0), abs(a1), abs(b1), abs(a2), abs(b2))
+    if scale == 0.0:
+        return out, -1
+    # z^2 f = c4 z^4 + c3 z^3 + c2 z^2 + c1 z + c0, c4 = conj(c0), c3 = conj(c1)
+    c4 = complex(0.5 * a2, -0.5 * b2)
+    c3 = complex(0.5 * a1, -0.5 * b1)
+    c2 = complex(a0, 0.0)
+    c1 = complex(0.5 * a1, 0.5 * b1)
+    c0 = complex(0.5 * a2, 0.5 * b2)
+    small = 1e-13 * scale
+    if abs(c4) > small:
+        z = np.roots(np.array([c4, c3, c2, c1, c0]))
+    elif abs(c3) > small:  # degree 1 in the angle: z f = c3 z^2 + c2 z + c1
+        z = np.roots(np.array([c3, c2, c1]))
+    else:  # constant and nonzero
+        return out, 0
+    n = 0
+    for zi in z:
+        if abs(abs(zi) - 1.0) > UNIT_TOL:
+            continue
+        t = math.atan2(zi.imag, zi.real)
+        for _ in range(NEWTON_STEPS):
+            f, df = trig2(a0, a1, b1, a2, b2, t)
+            if df == 0.0:
+                break
+            step = f / df
+            if abs(step) > 0.1:  # a near-double root: Newton would wander; keep the eigenvalue's angle
+                break
+            t -= step
+        f, _ = trig2(a0, a1, b1, a2, b2, t)
+        if abs(f) > ROOT_TOL * scale:
+            continue
+        t = math.atan2(math.sin(t), math.cos(t))
+        dup = False
+        for j in range(n):
+            gap = math.atan2(math.sin(t - out[j]), math.cos(t - out[j]))
+            if abs(gap) < SAME_ROOT:
+                out[j] += 0.5 * gap
+                dup = True
+        if not dup and n < 4:
+            out[n] = t
+            n += 1
+    out[:n] = np.sort(out[:n])
+    return out, n
