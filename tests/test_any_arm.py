@@ -183,6 +183,24 @@ FAMILIES = {
         ("revolute", 0, -90, _L(g), 0),
         ("revolute", 0, 0, _L(g), 0),
     ],
+    # three parallel axes, an offset between the last two (IK-Geo's three-parallel case): closed form by sp6
+    "three_parallel_offset": lambda g: [
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", -_L(g), 0, 0, 0),
+        ("revolute", -_L(g), 0, 0, 0),
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", _L(g), -60, _L(g), 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # the same after an oblique slide
+    "slide_parallel_offset": lambda g: [
+        ("prismatic", _L(g), 30, 0, 0),
+        ("revolute", _L(g), 0, _L(g), 0),
+        ("revolute", _L(g), 0, 0, 0),
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", _L(g), -60, _L(g), 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
     # a slide oblique to three parallel axes, the last two meeting: closed form with a prismatic joint
     "slide_parallel": lambda g: [
         ("prismatic", _L(g), 30, 0, 0),
@@ -232,25 +250,30 @@ def test_random_family_arm(family, seed):
         assert same_solution_set(s.q[robot.within_limits(s.q)], num, robot.is_revolute, robot.length_scale)
 
 
-@pytest.mark.parametrize("family", ["three_parallel", "slide_parallel"])
+@pytest.mark.parametrize("family", ["three_parallel", "slide_parallel", "three_parallel_offset"])
 def test_parallel_closed_form_agrees_with_a_sweep(family):
-    """The parallel family's closed form and a sweep of joint 4 give the same sets, also where joint 6's axis
-    turns onto the parallel axes (q5 = 0: a continuum, reported by the sweep as a family) and at a straight
+    """The parallel family's closed form and a sweep give the same sets, also where joint 6's axis turns onto the
+    parallel axes (q5 = 0 on the UR-like arm: a continuum, reported by the sweep as a family) and at a straight
     elbow (q3 = 0)."""
     rng = np.random.default_rng(23)
     robot = _arm(FAMILIES[family](rng), rng)
     assert plans(robot)[0].family == "parallel"
+    free = min(p.free_joint for p in plans(robot) if not p.closed_form and not p.conditional)
     Q = in_limit_configurations(robot, 20, rng)
     Q[:5, 4] = 0.0
     Q[5:10, 2] = 0.0
     T = robot.fk(Q)
     closed = sweepik.solve_many(robot, T)
-    swept = sweepik.solve_many(robot, T, free_joint=3)
+    swept = sweepik.solve_many(robot, T, free_joint=free)
     for q, a, b in zip(Q, closed, swept, strict=True):
         assert recovers(robot, a, q) and recovers(robot, b, q)
         _check_set(robot, a)
         assert same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale)
-        assert len(a.families) == len(b.families)
+        assert bool(a.families) == bool(b.families)
+        for x, y in ((a, b), (b, a)):  # the continua agree: members of one lie on the other's
+            for fam in x.families:
+                for m in fam.sample(5):
+                    assert recovers(robot, y, m)
 
 
 def test_arm_outside_the_catalogue_is_refused():

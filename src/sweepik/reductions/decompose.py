@@ -188,26 +188,32 @@ def _position_plans(robot: Robot, chain: Chain, rev_chain: bool, W: np.ndarray, 
     return out
 
 
-def _parallel_plans(robot: Robot, chain: Chain, rev_chain: bool, st: Structure, W: np.ndarray) -> list[Plan]:
-    """The parallel family (closed form): axes 2, 3, 4 revolute and parallel, no two of them on one line; axis 1
-    (revolute, or a slide) and axis 5 not parallel to them (the heights the family solves for would not move)."""
+def _parallel_plans(robot: Robot, chain: Chain, rev_chain: bool, st: Structure) -> list[Plan]:
+    """The parallel family (closed form): axes 2, 3, 4 revolute and parallel, no two of them on one line; axes 5 and
+    6 revolute, neither parallel to them, and not parallel to each other; axis 1 revolute and not parallel to them,
+    or a slide not perpendicular to them (else the heights the family solves for would not move). ``W``: where
+    axes 5 and 6 meet, else joint 6's point, with ``meet`` joint 5's point (their offset goes to ``sp6``)."""
     rev, H, P = chain.revolute, chain.H, chain.P
-    if not (rev[1] and rev[2] and rev[3] and st.is_parallel(1, 2) and st.is_parallel(2, 3)):
+    if not (all(rev[1:]) and st.is_parallel(1, 2) and st.is_parallel(2, 3)):
         return []
     h = H[1]
-    pts = np.cumsum(P[:4], axis=0)
+    pts = np.cumsum(P[:6], axis=0)
     tol = INTERSECT_TOL_REL * robot.length_scale
     if _dist_to_line(pts[2], pts[1], h) < tol or _dist_to_line(pts[3], pts[2], h) < tol:
         return []
-    if _parallel(H[4], h):
+    if st.is_parallel(1, 4) or st.is_parallel(1, 5) or st.is_parallel(4, 5):  # (in every configuration)
         return []
     if rev[0] and _parallel(H[0], h):
         return []
     if not rev[0] and abs(float(np.dot(H[0], h))) < MIN_DOT:
         return []
+    if st.intersecting(4, 5):
+        W = meet = np.array(st.points[(4, 5)])
+    else:
+        W, meet = pts[5], pts[4]
     branches = 8 if rev[0] else 4
     case = "parallel" if rev[0] else "parallel_slide"
-    return [Plan("parallel", rev_chain, 3, case, branches, _t(W), _t(np.zeros(3)))]
+    return [Plan("parallel", rev_chain, 3, case, branches, _t(W), _t(meet))]
 
 
 def _meets_as_kernel(chain: Chain, f: int, xs: list[float], rel: list[np.ndarray], tol: float) -> bool:
@@ -247,7 +253,7 @@ def plans(robot: Robot) -> tuple[Plan, ...]:
         if rev[4] and rev[5] and st.intersecting(4, 5):
             W = np.array(st.points[(4, 5)])
             found += _position_plans(robot, chain, rev_chain, W, (0, 1, 2, 3), "pair")
-            found += _parallel_plans(robot, chain, rev_chain, st, W)
+        found += _parallel_plans(robot, chain, rev_chain, st)
     return tuple(sorted(found, key=_rank))
 
 

@@ -63,10 +63,24 @@ class Plan:
         """The subproblem chain, in words (joints numbered from 1 as the robot numbers them)."""
         if self.family == "parallel":
             j = [self.joint(i) + 1 for i in range(6)]
+            axes = f"the parallel axes {j[1]}, {j[2]}, {j[3]}"
+            if self.case != "parallel":  # a slide first
+                first = [
+                    f"joint {j[4]}: sp4 on the angle of joint {j[5]}'s axis to {axes}",
+                    f"joint {j[0]}: lp4 on the height of joint {j[5]}'s point along them",
+                ]
+            elif self.W != self.meet:
+                first = [
+                    f"joints {j[0]}, {j[4]}: sp6 on the height of joint {j[5]}'s point along {axes} and the angle "
+                    f"of joint {j[5]}'s axis to them"
+                ]
+            else:
+                first = [
+                    f"joint {j[0]}: sp4 on the height of the wrist centre along {axes}",
+                    f"joint {j[4]}: sp4 on the angle of joint {j[5]}'s axis to them",
+                ]
             return [
-                f"joint {j[0]}: {'sp4' if self.case == 'parallel' else 'lp4'} on the height of the wrist centre "
-                f"along the parallel axes {j[1]}, {j[2]}, {j[3]}",
-                f"joint {j[4]}: sp4 on the angle of joint {j[5]}'s axis to them",
+                *first,
                 f"joint {j[5]} and the sum of joints {j[1]}-{j[3]}: sp1",
                 f"joints {j[2]}, {j[1]}: sp3, sp1; joint {j[3]} from the sum",
             ]
@@ -170,7 +184,7 @@ class GeometricReduction(Reduction):
         from .decompose import plans  # local: decompose imports this module
 
         for p in plans(self.robot):
-            if p.family == "pair" and p.reversed == self.plan.reversed and p.free == 3 and not p.conditional:
+            if p.family == "pair" and p.free_joint == self.plan.joint(3) and not p.conditional:
                 return GeometricReduction(self.robot, p)
         return None
 

@@ -16,12 +16,13 @@ target from the parameter row (``LAYOUT``), which :mod:`.decompose` fills from t
     branch gives a configuration (least squares where it has no exact one); FK certification keeps the solutions.
 
 ``parallel`` (closed form, no sweep; the UR family): axes 2, 3, 4 revolute and parallel (direction ``h``), the
-    last two revolute and meeting at ``W``. Joints 2-4 turn about ``h`` only, so the height of ``W`` along ``h``
-    seen from joint 1 is fixed: joint 1 from ``sp4`` (or ``lp4`` for a slide; 2 branches), the angle of joint 6's
-    axis to ``h`` fixes joint 5 (``sp4``, 2), joint 6 and the sum of joints 2-4 follow from ``sp1``, and the planar
-    arm of joints 2-4 places ``W``: joint 3 from ``sp3`` (2), joint 2 from ``sp1``, joint 4 from the sum. 8
-    branches (4 with a slide first). Where joint 6's axis turns onto ``h`` the last joints' rotations combine (a
-    continuum, as a singular wrist).
+    last two revolute. Joints 2-4 turn about ``h`` only, so the height along ``h`` of joint 6's point ``W`` seen
+    from joint 1 depends on joints 1 and 5 only, and so does the angle of joint 6's axis to ``h``. When the last
+    two axes meet at ``W``: joint 1 from ``sp4`` on the height (or ``lp4`` for a slide; 2 branches), joint 5 from
+    ``sp4`` on the angle (2); with an offset between them, both from ``sp6`` (up to 4 pairs). Joint 6 and the sum
+    of joints 2-4 follow from ``sp1``, and the planar arm of joints 2-4 places ``W``: joint 3 from ``sp3`` (2),
+    joint 2 from ``sp1``, joint 4 from the sum. 8 branches (4 with a slide first). Where joint 6's axis turns onto
+    ``h`` the last joints' rotations combine (a continuum, as a singular wrist).
 
 A structure at the base is the same structure at the tool of the reversed chain solving the inverse pose
 (``Chain.reversed``): the parameter row then holds the reversed chain and the kernel writes the joints back in
@@ -36,7 +37,7 @@ import numpy as np
 from numba import float64, int64, njit, prange, types
 from numpy.typing import NDArray
 
-from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs
+from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
 from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, first_class
 from .position import angle, motion, place, reduce_chain
@@ -264,23 +265,33 @@ def _parallel_g(p, m0, v):
 
 @njit(cache=True)
 def _parallel_first(p, branch):
-    """The parallel family's first steps: motion of joint 1, ``(cos, sin)`` of joint 5, and their cosines
-    ``(c0, c4)`` (``|c| <= 1`` inside the branch's domain)."""
+    """The parallel family's first steps: motion of joint 1, ``(cos, sin)`` of joint 5, and cosines ``(c0, c4)``
+    (``|c| <= 1`` inside the branch's domain; NaN: no such branch). Joint 5 moves ``W`` (joint 6's point) by
+    ``s5 = W - O`` (``O`` on joint 5's axis): zero when the last two axes meet."""
     h0, h, h4, h5 = _h(p, 0), _h(p, 1), _h(p, 4), _h(p, 5)
-    s0 = _v(p, _P)
-    v = sub(_v(p, _T), s0)
-    # the height of W along h seen from joint 1 does not depend on joints 2-4
-    height = dot(h, add(add(add(_v(p, _P + 3), _v(p, _P + 6)), _v(p, _P + 9)), sub(_v(p, _W), _o3(p))))
-    b0, b4 = branch // 4, (branch // 2) % 2
-    if p[_REV] > 0.5:
-        ua, va, ub, vb, c0, _ = sp4_cs(h, v, h0, height)
-        m0 = (ua, -va, 0.0) if b0 == 0 else (ub, -vb, 0.0)
-    else:
-        m0 = (1.0, 0.0, lp4(h, v, scale(-1.0, h0), height))
-        c0 = 0.0 if b0 == 0 else math.nan
+    v = sub(_v(p, _T), _v(p, _P))
+    o4 = _v(p, _O)
+    s5 = sub(_v(p, _W), o4)
+    # the height of W along h seen from joint 1 does not depend on joints 2-4: that of O plus h . R_4 s5
+    height = dot(h, add(add(add(_v(p, _P + 3), _v(p, _P + 6)), _v(p, _P + 9)), sub(o4, _o3(p))))
+    b4 = (branch // 2) % 2
+    if p[_REV] < 0.5:  # a slide first: joint 5 from the angle of joint 6's axis to h, then the slide
+        ua, va, ub, vb, c4, _ = sp4_cs(h, h5, h4, dot(h, _mat(p, h5)))
+        m4 = (ua, va) if b4 == 0 else (ub, vb)
+        m0 = (1.0, 0.0, lp4(h, v, scale(-1.0, h0), height + dot(h, rot_cs(h4, m4[0], m4[1], s5))))
+        return m0, m4, 0.0, c4
+    if dot(s5, s5) > 0.0:  # an offset wrist: joints 1 and 5 together (sp6), up to 4 pairs
+        nh = scale(-1.0, h)
+        a, b, n = sp6(h, h0, v, nh, h4, s5, h, h0, _mat(p, h5), nh, h4, h5, height, 0.0)
+        k = branch // 2
+        if k >= n:
+            nan = (math.nan, math.nan, math.nan)
+            return nan, (math.nan, math.nan), math.nan, math.nan
+        return (math.cos(a[k]), -math.sin(a[k]), 0.0), (math.cos(b[k]), math.sin(b[k])), 0.0, 0.0
+    ua, va, ub, vb, c0, _ = sp4_cs(h, v, h0, height)
+    m0 = (ua, -va, 0.0) if branch // 4 == 0 else (ub, -vb, 0.0)
     # the angle of joint 6's axis to h does not depend on joints 2-4 or 6
-    u = _parallel_g(p, m0, h5)
-    ua, va, ub, vb, c4, _ = sp4_cs(h, h5, h4, dot(h, u))
+    ua, va, ub, vb, c4, _ = sp4_cs(h, h5, h4, dot(h, _parallel_g(p, m0, h5)))
     m4 = (ua, va) if b4 == 0 else (ub, vb)
     return m0, m4, c0, c4
 
@@ -299,9 +310,10 @@ def _parallel_configuration(p, x, branch, out):
     # the sum phi of joints 2-4: R(h, phi) = R_0^T M R_5^T R_4^T
     e = orthogonal(h)
     cf, sf = sp1_cs(e, _parallel_g(p, m0, rot_cs(h5, c5, -s5, rot_cs(h4, m4[0], -m4[1], e))), h)
-    # the planar arm: R_1 (s2 + R_2 s3) = R_0^T (t - s0) - s1 - R(h, phi) s4
+    # the planar arm: R_1 (s2 + R_2 s3) = R_0^T (t - s0) - s1 - R(h, phi) (s4 + R_4 s5)
     s1, s2, s3 = _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
-    s4 = sub(_v(p, _W), _o3(p))
+    o4 = _v(p, _O)
+    s4 = add(sub(o4, _o3(p)), rot_cs(h4, m4[0], m4[1], sub(_v(p, _W), o4)))
     t0 = sub(_v(p, _T), _v(p, _P))
     if p[_REV] > 0.5:
         t0 = rot_cs(h0, m0[0], -m0[1], t0)
@@ -500,7 +512,7 @@ def parallel_singular(params, out):
     for i in range(params.shape[0]):
         p = params[i]
         out[i] = False
-        for b in (0, 4):
+        for b in range(0, 8, 2):
             m0, _, c0, _ = _parallel_first(p, b)
             if math.isnan(m0[0] + m0[2]) or not in_domain(c0):
                 continue
