@@ -7,6 +7,7 @@ Public API: robots (``load_robot``, ``Robot``, ``Joint``), pose helpers and erro
 from importlib.metadata import PackageNotFoundError, version
 
 from .analysis import analyze
+from .batch import SolutionBatch
 from .errors import (
     InvalidPoseError,
     NonFiniteError,
@@ -51,6 +52,7 @@ __all__ = [
     "solve_many",
     "iter_solve",
     "Solutions",
+    "SolutionBatch",
     "Family",
     "STRATEGIES",
     "Reduction",

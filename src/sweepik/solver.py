@@ -7,7 +7,6 @@ configurations -> FK check against the target -> joint limits -> duplicates remo
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import replace
 from typing import Literal
 
 import numpy as np
@@ -15,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import fastcertify, fastsweep
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
+from .batch import Block, SolutionBatch
 from .errors import ShapeError, UnknownOptionError
 from .families import collapse_continua, families_of, off_families, unique_families
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
@@ -222,7 +222,7 @@ def _solve_chunk(
     limits: bool,
     n_samples: int,
     use_fallback: bool = True,
-) -> list[Solutions]:
+) -> Block:
     chain = _chain_poses(robot, poses)
     lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
     weight = orientation_weight(robot.length_unit)
@@ -327,7 +327,7 @@ def _solve_chunk(
         rescued = _solve_chunk(
             robot, get_reduction(robot, red.fallback), poses[rescue], strategy, limits, n_samples, False
         )
-        for r_pose, r_sol in zip(rescue, rescued, strict=True):
+        for r_pose, r_sol in zip(rescue, rescued, strict=True):  # (a block iterates its poses' Solutions)
             if len(r_sol):
                 pose_idx = np.concatenate([pose_idx, np.full(len(r_sol), r_pose, dtype=pose_idx.dtype)])
                 q = np.concatenate([q, r_sol.q])
@@ -353,66 +353,56 @@ def _solve_chunk(
             alt = _solve_chunk(
                 robot, get_reduction(robot, red.fallback), poses[idx], strategy, limits, n_samples, False
             )
-            fallback = {int(i): a for i, a in zip(idx, alt, strict=True) if a.families}
-    order = np.argsort(pose_idx, kind="stable")
-    pose_idx, q, err_paper, err_geo, inside, mult = (
-        pose_idx[order],
-        q[order],
-        err_paper[order],
-        err_geo[order],
-        inside[order],
-        mult[order],
-    )
-    bounds = np.searchsorted(pose_idx, np.arange(len(poses) + 1))
-    results = []
-    for i in range(len(poses)):
-        s, e = bounds[i], bounds[i + 1]
-        other = fallback.get(i)
-        # the reduction's blind spot: the fallback reduction's families are added
+            fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)}
+    # poses with families (few): their isolated solutions lying on a family are reported by the family; the
+    # reduction's blind spot: the fallback reduction's families are added, and its isolated solutions when this
+    # reduction has none
+    families: dict[int, tuple[Family, ...]] = {}
+    keep = np.ones(pose_idx.size, dtype=bool)
+    extra: list[tuple[int, Solutions, NDArray[np.bool_]]] = []
+    for i in sorted(set(fams) | set(fallback)):
         fam = tuple(fams.get(i, ()))
+        other = fallback.get(i)
         if other is not None:
             fam = unique_families(fam + other.families)
-        reason = None
-        if e == s and not fam:
-            if strategy == "paper" and not red.closed_form:  # its final resolution decides nothing about reachability
-                step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"
-                reason = (
-                    f"no solution with J < 1e-5 mm found by the paper's strategy (its final {step} step "
-                    "misses roots off its grid); strategy='precise' finds every solution"
-                )
-            elif n_reachable[i] > 0:
-                reason = f"out of joint limits: {n_reachable[i]} solution(s) reach the pose but violate the limits"
-            else:
-                reason = "unreachable: no configuration of the arm reaches this pose"
-        if other is not None and e == s:  # ... and its isolated solutions when this reduction has none
-            keep_o = off_families(robot, other.q, fam)
-            results.append(
-                replace(
-                    other,
-                    q=other.q[keep_o],
-                    error=other.error[keep_o],
-                    error_geodesic=other.error_geodesic[keep_o],
-                    within_limits=other.within_limits[keep_o],
-                    multiplicity=other.multiplicity[keep_o],
-                    families=fam,
-                )
-            )
-            continue
-        keep = off_families(robot, q[s:e], fam)  # points on a family are reported by the family
-        results.append(
-            Solutions(
-                q=q[s:e][keep],
-                error=err_paper[s:e][keep],
-                error_geodesic=err_geo[s:e][keep],
-                within_limits=inside[s:e][keep],
-                multiplicity=mult[s:e][keep],
-                families=fam,
-                reason=reason,
-                pose=poses[i].copy(),
-                robot=robot,
-            )
+        families[i] = fam
+        rows = np.nonzero(pose_idx == i)[0]
+        if other is not None and rows.size == 0:
+            extra.append((i, other, off_families(robot, other.q, fam)))
+        else:
+            keep[rows] = off_families(robot, q[rows], fam)
+    p_parts, q_parts, e_parts = [pose_idx[keep]], [q[keep]], [err_paper[keep]]
+    g_parts, in_parts, m_parts = [err_geo[keep]], [inside[keep]], [mult[keep]]
+    for i, other, k in extra:
+        p_parts.append(np.full(int(k.sum()), i, dtype=pose_idx.dtype))
+        q_parts.append(other.q[k])
+        e_parts.append(other.error[k])
+        g_parts.append(other.error_geodesic[k])
+        in_parts.append(other.within_limits[k])
+        m_parts.append(other.multiplicity[k])
+    pose_idx, q, err_paper = np.concatenate(p_parts), np.concatenate(q_parts), np.concatenate(e_parts)
+    err_geo, inside, mult = np.concatenate(g_parts), np.concatenate(in_parts), np.concatenate(m_parts)
+    order = np.argsort(pose_idx, kind="stable")
+    empty_reason = None
+    if strategy == "paper" and not red.closed_form:  # its final resolution decides nothing about reachability
+        step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"
+        empty_reason = (
+            f"no solution with J < 1e-5 mm found by the paper's strategy (its final {step} step "
+            "misses roots off its grid); strategy='precise' finds every solution"
         )
-    return results
+    return Block(
+        robot=robot,
+        poses=poses.copy(),
+        bounds=np.searchsorted(pose_idx[order], np.arange(len(poses) + 1)).astype(np.intp),
+        q=q[order],
+        error=err_paper[order],
+        error_geodesic=err_geo[order],
+        within_limits=inside[order],
+        multiplicity=mult[order].astype(np.intp),
+        families=families,
+        n_reachable=n_reachable.astype(np.intp),
+        empty_reason=empty_reason,
+    )
 
 
 def _errors(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array, Array]:
@@ -466,26 +456,25 @@ def solve_many(
     limits: bool = True,
     n_samples: int = N_SAMPLES,
     chunk_size: int = CHUNK,
-) -> list[Solutions]:
+) -> SolutionBatch:
     """All IK solutions of each pose in ``poses (N, 4, 4)`` (world frame, robot's length unit).
 
     Vectorised over poses, samples and branches, in chunks of at most ``chunk_size`` poses (an integer in
     [1, ``MAX_CHUNK``]; a large ``n_samples`` or the paper's strategy on a long range use smaller chunks, so that
-    memory stays bounded). Results are identical to calling :func:`solve` on each pose. An empty batch (``[]``
-    or an array ``(0, 4, 4)``) gives ``[]``, after the other arguments are checked. Other arguments and errors:
-    see :func:`solve`; :func:`iter_solve` yields the same results without holding them all.
+    memory stays bounded). Returns a :class:`~sweepik.batch.SolutionBatch`: a sequence of one :class:`Solutions`
+    per pose (identical to calling :func:`solve` on each pose; built when indexed or iterated), whose columns
+    (``offsets``, ``q``, ``error``, ...) hold every solution without a Python object per pose. An empty batch
+    (``[]`` or an array ``(0, 4, 4)``) gives an empty one, after the other arguments are checked. Other arguments
+    and errors: see :func:`solve`; :func:`iter_solve` yields the same results without holding them all.
     """
-    it = iter_solve(
-        robot,
-        poses,
-        reduction=reduction,
-        free_joint=free_joint,
-        strategy=strategy,
-        limits=limits,
-        n_samples=n_samples,
-        chunk_size=chunk_size,
-    )
-    return list(it)
+    _check_strategy(strategy)
+    arr = as_float_array(poses, "poses")
+    P = np.zeros((0, 4, 4)) if arr.size == 0 else check_poses(arr, "poses")
+    if P.ndim != 3:
+        raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
+    red, strat, lim, ns, cs = _prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size, free_joint)
+    blocks = [_solve_chunk(robot, red, P[s : s + cs], strat, lim, ns) for s in range(0, P.shape[0], cs)]
+    return SolutionBatch(robot, blocks)
 
 
 def iter_solve(
