@@ -36,6 +36,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sweepik.peers import chain_arrays as _chain_arrays
+from sweepik.peers import eaik_robot as _eaik_robot
+from sweepik.peers import ikgeo_setup as _ikgeo_setup
+
 Array = NDArray[np.float64]
 
 __all__ = [
@@ -55,8 +59,6 @@ __all__ = [
 #: The wrappers keep a returned solution when its FK matches the pose this closely (relative position error,
 #: i.e. divided by ``length_scale``, and rotation angle in radians).
 FK_TOL = 1e-6
-#: Axes count as parallel / intersecting below this (sine of the angle; distance / ``length_scale``).
-STRUCT_TOL = 1e-9
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -349,16 +351,6 @@ def numerical_solutions(
 # ----------------------------------------------------------------------------------------------------------
 
 
-def _chain_arrays(robot: Any) -> tuple[Array, Array, Array, np.ndarray]:
-    c = robot.chain
-    return (
-        np.array(c.H, dtype=np.float64),
-        np.array(c.P, dtype=np.float64),
-        np.array(c.R_end, dtype=np.float64),
-        np.array(c.revolute, dtype=bool),
-    )
-
-
 def _rot(k: Array, t: float) -> Array:
     K = _skew(np.asarray(k, dtype=np.float64))
     return np.eye(3) + np.sin(t) * K + (1.0 - np.cos(t)) * (K @ K)
@@ -372,11 +364,6 @@ def _poe_fk(H: Array, P: Array, q: Array) -> tuple[Array, Array]:
         R = R @ _rot(H[i], q[i])
         p = p + R @ P[i + 1]
     return R, p
-
-
-def _reversed(H: Array, P: Array, R_end: Array) -> tuple[Array, Array, Array]:
-    """The chain of the inverse pose (joints in reverse order, same joint values), seen from the tool at q = 0."""
-    return -(H[::-1] @ R_end), -(P[::-1] @ R_end), R_end.T.copy()
 
 
 def _filter(
@@ -416,17 +403,6 @@ def _filter(
 # 2a. EAIK
 # ----------------------------------------------------------------------------------------------------------
 
-_EAIK_CACHE: dict[bytes, Any] = {}
-
-
-def _eaik_robot(H: Array, P: Array) -> Any:
-    key = H.tobytes() + P.tobytes()
-    if key not in _EAIK_CACHE:
-        from eaik.IK_HP import HPRobot
-
-        _EAIK_CACHE[key] = HPRobot(H, P)
-    return _EAIK_CACHE[key]
-
 
 def eaik_solutions(robot: Any, pose: np.ndarray, *, info: dict[str, Any] | None = None) -> Array | None:
     """EAIK's IK solutions of ``pose`` (``(k, n)``, FK-checked), or None (no EAIK, not 6R, no decomposition).
@@ -463,90 +439,7 @@ def eaik_solutions(robot: Any, pose: np.ndarray, *, info: dict[str, Any] | None 
 # 2b. IK-Geo
 # ----------------------------------------------------------------------------------------------------------
 
-#: IK-Geo's decompositions in order of preference (closed form, then 1D search, then 2D search), with what
-#: each needs (0-based joints): a spherical wrist = joints 3, 4, 5 through one point; "par" = parallel axes;
-#: "int" = intersecting axes.
-_IKGEO_KINDS: tuple[tuple[str, str, tuple[tuple[str, tuple[int, ...]], ...]], ...] = (
-    ("spherical_two_parallel", "closed", (("int", (3, 4, 5)), ("par", (1, 2)))),
-    ("spherical_two_intersecting", "closed", (("int", (3, 4, 5)), ("int", (0, 1)))),
-    ("spherical", "closed", (("int", (3, 4, 5)),)),
-    ("three_parallel_two_intersecting", "closed", (("par", (1, 2, 3)), ("int", (4, 5)))),
-    ("three_parallel", "closed", (("par", (1, 2, 3)),)),
-    ("two_parallel", "1d", (("par", (1, 2)),)),
-    ("two_intersecting", "1d", (("int", (4, 5)),)),
-    ("gen_six_dof", "2d", ()),
-)
-
-
-def _common_point(H: Array, pts: Array, joints: tuple[int, ...], tol: float) -> Array | None:
-    """The point where the axes of ``joints`` (directions H, through points pts) meet, or None."""
-    hs = H[list(joints)]
-    # Lines meet in one point only if not all parallel (two of three may be, on one line: a wrist at q = 0).
-    if max(np.linalg.norm(np.cross(hs[0], h)) for h in hs[1:]) < 1e-6:
-        return None
-    A = np.zeros((3, 3))
-    b = np.zeros(3)
-    for j in joints:
-        M = np.eye(3) - np.outer(H[j], H[j])
-        A += M
-        b += M @ pts[j]
-    x = np.linalg.solve(A, b)
-    for j in joints:
-        d = x - pts[j]
-        if np.linalg.norm(d - H[j] * (H[j] @ d)) > tol:
-            return None
-    return x
-
-
-def _ikgeo_model(H: Array, P: Array, kinds: set[str], tol_len: float) -> tuple[str, str, Array] | None:
-    """First IK-Geo decomposition (from ``_IKGEO_KINDS``, restricted to ``kinds``) that fits the chain, and
-    the link vectors remodelled for it (points of intersecting axes moved to their common point)."""
-    pts = np.cumsum(P[:-1], axis=0)  # a point of each axis
-    tool = np.sum(P, axis=0)
-    for name, kind, needs in _IKGEO_KINDS:
-        if kind not in kinds:
-            continue
-        points = pts.copy()
-        fits = True
-        for what, joints in needs:
-            if what == "par":
-                h0 = H[joints[0]]
-                fits = all(np.linalg.norm(np.cross(h0, H[j])) <= STRUCT_TOL for j in joints[1:])
-            else:
-                x = _common_point(H, pts, joints, tol_len)
-                fits = x is not None
-                if fits:
-                    points[list(joints)] = x
-            if not fits:
-                break
-        if fits:
-            P_new = np.diff(np.concatenate([np.zeros((1, 3)), points, tool[None]]), axis=0)
-            return name, kind, P_new
-    return None
-
-
 _IKGEO_CACHE: dict[tuple[bytes, bytes, bytes, str], Any] = {}
-
-
-def _ikgeo_setup(ik_geo: Any, H: Array, P: Array, R_end: Array, kinds: set[str], L: float) -> Any:
-    """(ik_geo robot, decomposition, kind, reversed, R_end of the chain used), or None when nothing fits."""
-    candidates = []
-    for reverse in (False, True):
-        Hc, Pc, Rc = _reversed(H, P, R_end) if reverse else (H, P, R_end)
-        model = _ikgeo_model(Hc, Pc, kinds, STRUCT_TOL * L)
-        if model is not None:
-            order = [k for k, _, _ in _IKGEO_KINDS].index(model[0])
-            candidates.append((order, reverse, model, Hc, Pc, Rc))
-    if not candidates:
-        return None
-    _, reverse, (name, kind, P_new), Hc, Pc, Rc = min(candidates, key=lambda c: (c[0], c[1]))
-    # Self-check of the remodelled chain (same FK as the original one).
-    q_chk = np.linspace(-2.5, 2.9, 6)
-    Ra, pa = _poe_fk(Hc, Pc, q_chk)
-    Rb, pb = _poe_fk(Hc, P_new, q_chk)
-    if np.max(np.abs(Ra - Rb)) > 1e-9 or np.max(np.abs(pa - pb)) > 1e-9 * L:  # pragma: no cover
-        raise AssertionError("ik_geo wrapper: remodelled chain does not reproduce the FK")
-    return getattr(ik_geo.Robot, name)(Hc, P_new), name, kind, reverse, Rc
 
 
 def ikgeo_solutions(
@@ -579,11 +472,10 @@ def ikgeo_solutions(
     H, P, R_end, rev = _chain_arrays(robot)
     if len(rev) != 6 or not np.all(rev):
         return None
-    L = float(robot.length_scale)
     target = np.asarray(pose, dtype=np.float64)
     key = (H.tobytes(), P.tobytes(), R_end.tobytes(), allow_search)
     if key not in _IKGEO_CACHE:
-        _IKGEO_CACHE[key] = _ikgeo_setup(ik_geo, H, P, R_end, kinds, L)
+        _IKGEO_CACHE[key] = _ikgeo_setup(ik_geo, robot, kinds)
     setup = _IKGEO_CACHE[key]
     if setup is None:
         if info is not None:

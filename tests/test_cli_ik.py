@@ -113,6 +113,26 @@ def test_bench_runs_small(capsys: pytest.CaptureFixture[str], monkeypatch: pytes
     assert out["grid_precise"]["us_per_pose"] > 0
 
 
+def test_bench_arms_small(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["bench", "--arms", "ur5", "carm", "--single", "5", "--batch", "16", "--memory", "200", "--repeats", "1"]
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out["arms"]) == {"ur5", "carm"}
+    ur5, carm = out["arms"]["ur5"], out["arms"]["carm"]
+    assert ur5["plan"] == "closed form" and carm["plan"] == "sweep joint 1"
+    assert ur5["sweepik"]["batched_us"] > 0 and ur5["sweepik"]["single_us"] > 0 and ur5["peak_rss_mib"] > 0
+    assert "sweepik carm-d1" in carm and isinstance(carm["misses"], list)
+    assert main(argv[:3] + ["--single", "0", "--batch", "16", "--memory", "0", "--repeats", "1"]) == 0
+    table = capsys.readouterr().out
+    assert table.splitlines()[0].startswith("arm") and "ur5" in table
+
+
+def test_bench_arms_unknown_robot_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bench", "--arms", "ur5", "nosuchbot", "--single", "1"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and len(captured.err.strip().splitlines()) == 1 and "nosuchbot" in captured.err
+
+
 def bench_grid_small() -> np.ndarray:
     from sweepik.verify import grid_configurations
 

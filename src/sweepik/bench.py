@@ -1,9 +1,14 @@
-"""Benchmarks (``sweepik bench``): speed and memory of the solver on the bundled C-Arm.
+"""Benchmarks (``sweepik bench``): speed and memory of the solver.
 
+On the bundled C-Arm (the default):
 (a) ``solve_many`` on the paper's 15,900 grid poses, precise strategy: wall time and us per pose;
 (b) single-pose ``solve`` latency, median and 95th percentile over random in-limit poses;
 (c) the paper strategy, seconds per pose (on a subset of the grid);
 (d) peak memory (resident set) of ``solve_many`` on 100,000 random poses, measured in a child process.
+
+On every bundled arm (``sweepik bench --arms``, :func:`bench_arms`): single-pose median, batched time per pose and
+peak memory, side by side with the other all-solutions solvers installed (:mod:`sweepik.peers`) on the same poses,
+each row flagged against the speed targets (``ARM_TARGETS``).
 
 Benchmarks are not tests: nothing here asserts a speed.
 """
@@ -17,10 +22,13 @@ import time
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .robot_file import load_robot
 from .solver import Progress, solve, solve_many
 from .verify import grid_configurations, random_configurations
+
+Array = NDArray[np.float64]
 
 #: The paper's figure: 0.098 s per pose in Matlab.
 PAPER_SECONDS_PER_POSE = 0.098
@@ -30,7 +38,7 @@ import resource, sys, json
 import numpy as np
 import sweepik
 from sweepik.verify import random_configurations
-robot = sweepik.load_robot("carm")
+robot = sweepik.load_robot({robot!r})
 poses = robot.fk(random_configurations(robot, {n}, np.random.default_rng(0)))
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 sols = sweepik.solve_many(robot, poses)
@@ -90,10 +98,11 @@ def bench_paper(count: int = 500) -> dict[str, Any]:
     return {"poses": len(poses), "seconds_per_pose": dt / len(poses), "paper_seconds_per_pose": PAPER_SECONDS_PER_POSE}
 
 
-def bench_memory(count: int = 100_000) -> dict[str, Any]:
-    """(d) Peak resident memory of a child process running ``solve_many`` on ``count`` random poses."""
+def bench_memory(count: int = 100_000, robot: str = "carm") -> dict[str, Any]:
+    """(d) Peak resident memory of a child process running ``solve_many`` on ``count`` random poses of ``robot``
+    (a bundled name or a robot file)."""
     out = subprocess.run(
-        [sys.executable, "-c", _MEMORY_SCRIPT.format(n=count)], capture_output=True, text=True, check=True
+        [sys.executable, "-c", _MEMORY_SCRIPT.format(n=count, robot=robot)], capture_output=True, text=True, check=True
     )
     return dict(json.loads(out.stdout.strip().splitlines()[-1]))
 
@@ -150,3 +159,127 @@ def format_bench(result: dict[str, Any]) -> str:
     lines = [f"{'benchmark':<{w0}}  {'measured':<{w1}}  target", "-" * (w0 + w1 + 20)]
     lines += [f"{a:<{w0}}  {b:<{w1}}  {c}" for a, b, c in rows]
     return "\n".join(lines)
+
+
+#: Targets of the speed issue per kind of arm (us per pose): closed forms batched; the C-Arm single and batched.
+#: Swept arms are judged against ssik (single <= 1/3, batched <= 1/10 of its time) when it is installed.
+ARM_TARGETS = {"closed_batched_us": 10.0, "carm_single_us": 150.0, "carm_batched_us": 22.0}
+
+
+def _median_us(fn: Any, poses: Array) -> float:
+    fn(poses[0])
+    lat = np.empty(len(poses))
+    for i, T in enumerate(poses):
+        t0 = time.perf_counter()
+        fn(T)
+        lat[i] = time.perf_counter() - t0
+    return float(np.median(lat) * 1e6)
+
+
+def _batch_us(fn: Any, poses: Array, repeats: int) -> float:
+    fn(poses[:8])
+    best = np.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn(poses)
+        best = min(best, time.perf_counter() - t0)
+    return float(best / len(poses) * 1e6)
+
+
+def _flags(name: str, closed: bool, cell: dict[str, Any], peers: dict[str, dict[str, Any]]) -> list[str]:
+    """The targets a row misses (plain words)."""
+    out = []
+    if closed and cell["batched_us"] > ARM_TARGETS["closed_batched_us"]:
+        out.append(f"closed form batched > {ARM_TARGETS['closed_batched_us']:g} us")
+    if name == "carm":
+        if cell["single_us"] > ARM_TARGETS["carm_single_us"]:
+            out.append(f"single > {ARM_TARGETS['carm_single_us']:g} us")
+        if cell["batched_us"] > ARM_TARGETS["carm_batched_us"]:
+            out.append(f"batched > {ARM_TARGETS['carm_batched_us']:g} us")
+    for peer, t in peers.items():
+        if t["single_us"] < cell["single_us"] or t["batched_us"] < cell["batched_us"]:
+            out.append(f"slower than {peer}")
+    if not closed and "ssik" not in peers:
+        out.append("ssik not installed: its targets not measured")
+    return out
+
+
+def bench_arms(
+    names: list[str] | None = None,
+    single: int = 300,
+    batch: int = 2000,
+    memory: int = 10_000,
+    repeats: int = 3,
+    progress: Progress = _no_progress,
+) -> dict[str, Any]:
+    """Per arm (every bundled one by default; names or robot files): sweepik's plan, single-pose median (us),
+    batched time per pose (best of ``repeats``, us), peak memory of ``solve_many`` on ``memory`` poses (a child
+    process; 0 skips it), the installed peers on the same poses (raw calls: their answers are not FK-checked), and
+    the targets missed. Random in-limit configurations, seed 1."""
+    from .analysis import analyze
+    from .peers import peers_for
+    from .robot_file import bundled_robots
+
+    rows: dict[str, Any] = {}
+    arms = list(names) if names else list(bundled_robots())
+    robots = [load_robot(n) for n in arms]  # bad names fail before anything is timed
+    for k, (name, robot) in enumerate(zip(arms, robots, strict=True)):
+        progress("bench: arms", k, len(arms))
+        poses = robot.fk(random_configurations(robot, max(single, batch, 8), np.random.default_rng(1)))
+        plan = analyze(robot)["chosen"]
+        closed = bool(plan["closed_form"])
+        row: dict[str, Any] = {"plan": "closed form" if closed else f"sweep joint {plan['free_joint_number']}"}
+        variants = {"sweepik": {"reduction": "auto"}}
+        if robot.default_reduction:
+            variants[f"sweepik {robot.default_reduction}"] = {"reduction": robot.default_reduction}
+        for label, kw in variants.items():
+            row[label] = {
+                "single_us": _median_us(lambda T, kw=kw, r=robot: solve(r, T, **kw), poses[:single])
+                if single
+                else None,
+                "batched_us": _batch_us(lambda Ts, kw=kw, r=robot: solve_many(r, Ts, **kw), poses[:batch], repeats),
+            }
+        fastest = min((row[v] for v in variants), key=lambda c: c["batched_us"])
+        peers = {}
+        for peer, (one, many) in peers_for(robot).items():
+            peers[peer] = {
+                "single_us": _median_us(one, poses[:single]) if single else None,
+                "batched_us": _batch_us(many, poses[:batch], repeats),
+            }
+        row["peers"] = peers
+        if memory:
+            row["peak_rss_mib"] = bench_memory(memory, name)["peak_rss_mib"]
+        if single:
+            row["misses"] = _flags(name, closed, fastest, peers)
+        rows[name] = row
+    progress("bench: arms", len(arms), len(arms))
+    return {"arms": rows, "single_poses": single, "batch_poses": batch, "memory_poses": memory}
+
+
+def format_arms(result: dict[str, Any]) -> str:
+    """Human-readable table of ``bench_arms``'s result."""
+    peers = sorted({p for r in result["arms"].values() for p in r["peers"]})
+    head = ["arm", "plan", "sweepik single/batched [us]"] + [f"{p} single/batched [us]" for p in peers]
+    head += ["peak MiB", "misses"]
+    lines = []
+
+    def cell(c: dict[str, Any] | None) -> str:
+        if c is None:
+            return "-"
+        single = "-" if c["single_us"] is None else f"{c['single_us']:.0f}"
+        return f"{single} / {c['batched_us']:.1f}"
+
+    for name, r in result["arms"].items():
+        ours = cell(r["sweepik"])
+        extra = [k for k in r if k.startswith("sweepik ")]
+        if extra:
+            ours += "; " + ", ".join(f"{k[8:]}: {cell(r[k])}" for k in extra)
+        mem = f"{r['peak_rss_mib']:.0f}" if "peak_rss_mib" in r else "-"
+        lines.append(
+            [name, r["plan"], ours] + [cell(r["peers"].get(p)) for p in peers] + [mem, "; ".join(r.get("misses", []))]
+        )
+    widths = [max(len(x) for x in col) for col in zip(head, *lines, strict=True)]
+    out = ["  ".join(h.ljust(w) for h, w in zip(head, widths, strict=True)).rstrip()]
+    out.append("-" * (sum(widths) + 2 * (len(widths) - 1)))
+    out += ["  ".join(v.ljust(w) for v, w in zip(line, widths, strict=True)).rstrip() for line in lines]
+    return "\n".join(out)

@@ -87,15 +87,32 @@ def add_bench_parser(sub: _SubParsers) -> None:
     p = _subparser(
         sub,
         "bench",
-        help="benchmarks: grid throughput, single-pose latency, paper strategy, peak memory",
-        description="Measure sweepik on the bundled C-Arm (see docs/performance.md). Benchmarks are not tests.",
+        help="benchmarks: grid throughput, single-pose latency, paper strategy, peak memory; --arms: every arm",
+        description="Measure sweepik on the bundled C-Arm, or with --arms on every bundled arm (or those named) side "
+        "by side with the other all-solutions solvers installed (pip install 'sweepik[bench]'); see "
+        "docs/performance.md. Benchmarks are not tests.",
+    )
+    p.add_argument(
+        "--arms",
+        nargs="*",
+        metavar="ROBOT",
+        default=None,
+        help="benchmark these arms (bundled names or robot files; none given: every bundled arm) instead of the "
+        "C-Arm's four benchmarks",
+    )
+    p.add_argument(
+        "--batch",
+        type=_count(8, MAX_BENCH_MEMORY),
+        default=2000,
+        metavar="N",
+        help="with --arms: poses of the batched run per arm (default 2000)",
     )
     p.add_argument(
         "--single",
         type=_count(0, MAX_BENCH_SINGLE),
-        default=1000,
+        default=None,
         metavar="N",
-        help=f"poses for the latency test, up to {MAX_BENCH_SINGLE:,} (0: skip; default 1000)",
+        help=f"poses for the latency test, up to {MAX_BENCH_SINGLE:,} (0: skip; default 1000, with --arms 300)",
     )
     p.add_argument(
         "--paper",
@@ -107,9 +124,10 @@ def add_bench_parser(sub: _SubParsers) -> None:
     p.add_argument(
         "--memory",
         type=_count(0, MAX_BENCH_MEMORY),
-        default=100_000,
+        default=None,
         metavar="N",
-        help=f"poses for peak memory, up to {MAX_BENCH_MEMORY:,} (0: skip; default 100,000)",
+        help=f"poses for peak memory, up to {MAX_BENCH_MEMORY:,} (0: skip; default 100,000; with --arms 10,000 per "
+        "arm)",
     )
     p.add_argument(
         "--repeats",
@@ -122,17 +140,21 @@ def add_bench_parser(sub: _SubParsers) -> None:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from .bench import format_bench, run_bench
+    from .bench import bench_arms, format_arms, format_bench, run_bench
 
     progress = _Progress()
+    arms = args.arms is not None
+    single = args.single if args.single is not None else (300 if arms else 1000)
+    memory = args.memory if args.memory is not None else (10_000 if arms else 100_000)
     try:
-        result = run_bench(
-            single=args.single, paper=args.paper, memory=args.memory, repeats=args.repeats, progress=progress
-        )
+        if arms:
+            result = bench_arms(args.arms, single, args.batch, memory, args.repeats, progress)
+        else:
+            result = run_bench(single=single, paper=args.paper, memory=memory, repeats=args.repeats, progress=progress)
     finally:
         progress.close()
     if args.json:
         _print_json(result)
     else:
-        print(format_bench(result))
+        print(format_arms(result) if arms else format_bench(result))
     return 0
