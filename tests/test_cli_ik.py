@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import sweepik
 from sweepik import load_robot
 from sweepik.cli import main
 from sweepik.pose import xyz_zyz_from_pose
@@ -107,10 +108,15 @@ def test_bench_runs_small(capsys: pytest.CaptureFixture[str], monkeypatch: pytes
     import sweepik.bench as bench
 
     monkeypatch.setattr(bench, "grid_configurations", lambda include_singular=False: bench_grid_small())
-    assert main(["bench", "--single", "20", "--paper", "5", "--memory", "0", "--repeats", "1", "--json"]) == 0
+    argv = ["bench", "--single", "20", "--paper", "5", "--memory", "0", "--repeats", "1", "--batch", "8", "--json"]
+    assert main(argv) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["grid_precise"]["poses"] == 100 and out["single_pose"]["poses"] == 20
     assert out["grid_precise"]["us_per_pose"] > 0
+    # then every bundled arm, each with its plan, times and the targets it misses
+    assert set(out["arms"]) == set(sweepik.bundled_robots())
+    for row in out["arms"].values():
+        assert row["sweepik"]["single_us"] > 0 and row["sweepik"]["batched_us"] > 0 and isinstance(row["misses"], list)
 
 
 def test_bench_arms_small(capsys: pytest.CaptureFixture[str]) -> None:

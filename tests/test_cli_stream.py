@@ -222,7 +222,8 @@ def test_bench_progress_on_a_terminal(capsys: pytest.CaptureFixture[str], monkey
     monkeypatch.setattr(cli_common, "PROGRESS_AFTER_S", 0.0)
     tty = _FakeTTY()
     monkeypatch.setattr(sys, "stderr", tty)
-    assert main(["bench", "--single", "5", "--paper", "2", "--memory", "0", "--repeats", "2", "--json"]) == 0
+    argv = ["bench", "--single", "5", "--paper", "2", "--memory", "0", "--repeats", "2", "--batch", "8", "--json"]
+    assert main(argv) == 0
     assert json.loads(capsys.readouterr().out)["grid_precise"]["poses"] == 20
     text = tty.getvalue()
     assert "bench: grid" in text and "2/2" in text and "bench: paper strategy" in text

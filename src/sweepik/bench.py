@@ -116,9 +116,13 @@ def run_bench(
     memory: int = 100_000,
     repeats: int = 3,
     progress: Progress | None = None,
+    arms: bool = True,
+    batch: int = 2000,
 ) -> dict[str, Any]:
-    """All four benchmarks; sizes can be reduced for a quick look (0 skips a benchmark). ``progress(stage, done,
-    total)`` is called as they advance (the memory benchmark, one child process, reports only its start and end).
+    """The C-Arm's four benchmarks, then (``arms``) :func:`bench_arms` on every bundled arm with ``batch`` poses
+    per batched run, ``min(single, 300)`` single poses and ``min(memory, 10,000)`` poses for peak memory. Sizes
+    can be reduced for a quick look (0 skips a benchmark). ``progress(stage, done, total)`` is called as they
+    advance (a memory benchmark, one child process, reports only its start and end).
     """
     report = progress or _no_progress
     result: dict[str, Any] = {"grid_precise": bench_grid(repeats, report)}
@@ -132,6 +136,8 @@ def run_bench(
         report("bench: memory", 0, 1)
         result["memory"] = bench_memory(memory)
         report("bench: memory", 1, 1)
+    if arms:
+        result.update(bench_arms(None, min(single, 300), batch, min(memory, 10_000), repeats, report))
     return result
 
 
@@ -161,6 +167,8 @@ def format_bench(result: dict[str, Any]) -> str:
     w1 = max(len(r[1]) for r in rows)
     lines = [f"{'benchmark':<{w0}}  {'measured':<{w1}}  target", "-" * (w0 + w1 + 20)]
     lines += [f"{a:<{w0}}  {b:<{w1}}  {c}" for a, b, c in rows]
+    if "arms" in result:
+        lines += ["", "every bundled arm:", format_arms(result)]
     return "\n".join(lines)
 
 

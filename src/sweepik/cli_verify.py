@@ -88,24 +88,24 @@ def add_bench_parser(sub: _SubParsers) -> None:
         sub,
         "bench",
         help="benchmarks: grid throughput, single-pose latency, paper strategy, peak memory; --arms: every arm",
-        description="Measure sweepik on the bundled C-Arm, or with --arms on every bundled arm (or those named) side "
-        "by side with the other all-solutions solvers installed (pip install 'sweepik[bench]'); see "
-        "docs/performance.md. Benchmarks are not tests.",
+        description="Measure sweepik on the bundled C-Arm (grid, single pose, paper strategy, memory), then on every "
+        "bundled arm side by side with the other all-solutions solvers installed (pip install 'sweepik[bench]'); "
+        "--arms runs the per-arm part alone. See docs/performance.md. Benchmarks are not tests.",
     )
     p.add_argument(
         "--arms",
         nargs="*",
         metavar="ROBOT",
         default=None,
-        help="benchmark these arms (bundled names or robot files; none given: every bundled arm) instead of the "
-        "C-Arm's four benchmarks",
+        help="only the per-arm benchmark, on these arms (bundled names or robot files; none given: every bundled "
+        "arm); without --arms, the C-Arm's four benchmarks run first, then every bundled arm",
     )
     p.add_argument(
         "--batch",
         type=_count(8, MAX_BENCH_MEMORY),
         default=2000,
         metavar="N",
-        help="with --arms: poses of the batched run per arm (default 2000)",
+        help="poses of the batched run per arm (default 2000)",
     )
     p.add_argument(
         "--single",
@@ -150,7 +150,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         if arms:
             result = bench_arms(args.arms, single, args.batch, memory, args.repeats, progress)
         else:
-            result = run_bench(single=single, paper=args.paper, memory=memory, repeats=args.repeats, progress=progress)
+            result = run_bench(single, args.paper, memory, args.repeats, progress, batch=args.batch)
     finally:
         progress.close()
     if args.json:
