@@ -15,6 +15,7 @@ from oracles import (
     ikgeo_solutions,
     in_limit_configurations,
     numerical_solutions,
+    pose_errors,
     recovers,
     same_solution_set,
 )
@@ -192,6 +193,15 @@ FAMILIES = {
         ("revolute", _L(g), -60, _L(g), 0),
         ("revolute", 0, 0, _L(g), 0),
     ],
+    # the same with joint 6's axis able to turn parallel to joints 2-4 (a continuum at q5 = 0, swept by joint 6)
+    "three_parallel_offset_90": lambda g: [
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", -_L(g), 0, 0, 0),
+        ("revolute", -_L(g), 0, 0, 0),
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", _L(g), -90, _L(g), 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
     # the same after an oblique slide
     "slide_parallel_offset": lambda g: [
         ("prismatic", _L(g), 30, 0, 0),
@@ -253,27 +263,73 @@ def test_random_family_arm(family, seed):
 @pytest.mark.parametrize("family", ["three_parallel", "slide_parallel", "three_parallel_offset"])
 def test_parallel_closed_form_agrees_with_a_sweep(family):
     """The parallel family's closed form and a sweep give the same sets, also where joint 6's axis turns onto the
-    parallel axes (q5 = 0 on the UR-like arm: a continuum, reported by the sweep as a family) and at a straight
-    elbow (q3 = 0)."""
+    parallel axes (q5 = 0 on the UR-like arms: a continuum, reported by the sweep as a family), next to it (q5 =
+    1e-7: the closed form's angles lose half their digits there, the sweep answers) and at a straight elbow."""
     rng = np.random.default_rng(23)
     robot = _arm(FAMILIES[family](rng), rng)
     assert plans(robot)[0].family == "parallel"
     free = min(p.free_joint for p in plans(robot) if not p.closed_form and not p.conditional)
-    Q = in_limit_configurations(robot, 20, rng)
+    Q = in_limit_configurations(robot, 24, rng)
     Q[:5, 4] = 0.0
     Q[5:10, 2] = 0.0
+    Q[20:, 4] = 1e-7
     T = robot.fk(Q)
     closed = sweepik.solve_many(robot, T)
     swept = sweepik.solve_many(robot, T, free_joint=free)
     for q, a, b in zip(Q, closed, swept, strict=True):
         assert recovers(robot, a, q) and recovers(robot, b, q)
         _check_set(robot, a)
-        assert same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale)
         assert bool(a.families) == bool(b.families)
-        for x, y in ((a, b), (b, a)):  # the continua agree: members of one lie on the other's
-            for fam in x.families:
-                for m in fam.sample(5):
-                    assert recovers(robot, y, m)
+        if not a.families:
+            assert same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale)
+        # with continua (cut into pieces differently by different sweeps), every solution and family member of one
+        # side is a solution or family member of the other
+        for x, y in ((a, b), (b, a)):
+            for m in [*x.q, *(m for fam in x.families for m in fam.sample(5))]:
+                assert recovers(robot, y, m)
+
+
+def test_parallel_offset_singular_wrist_is_a_family():
+    """Offset wrist whose joint 6 turns parallel to joints 2-4 at q5 = 0: the closed form hands those poses (and
+    those next to them) to a sweep of joint 6, which recovers q and reports the continuum as a family."""
+    rng = np.random.default_rng(23)
+    robot = _arm(FAMILIES["three_parallel_offset_90"](rng), rng)
+    assert plans(robot)[0].family == "parallel"
+    Q = in_limit_configurations(robot, 16, rng)
+    Q[:6, 4] = 0.0
+    Q[6:10, 4] = 1e-7
+    for k, (q, sols) in enumerate(zip(Q, sweepik.solve_many(robot, robot.fk(Q)), strict=True)):
+        assert recovers(robot, sols, q), q.tolist()
+        _check_set(robot, sols)
+        if k < 6:
+            assert sols.families
+            for m in (m for fam in sols.families for m in fam.sample(5)):
+                assert np.all(pose_errors_ok(robot, m, robot.fk(q)))
+
+
+def pose_errors_ok(robot, q, T):
+    dp, ang = pose_errors(robot.fk(q), T, robot.length_scale)
+    return (dp <= 1e-9) & (ang <= 1e-9)
+
+
+def test_slide_parallel_offset_with_a_singular_wrist_is_refused():
+    """After a slide, three parallel axes and an offset wrist whose joint 6 can turn parallel to them: no sweep
+    can describe that continuum, so the closed form is not offered (it would answer "unreachable" there)."""
+    rows = FAMILIES["slide_parallel_offset"](np.random.default_rng(2))
+    rows[4] = ("revolute", rows[4][1], -90, rows[4][3], 0)
+    robot = _arm(rows, np.random.default_rng(2))
+    with pytest.raises(NoReductionError, match="UR family"):
+        sweepik.solve(robot, robot.fk(np.full(6, 0.3)))
+
+
+def test_near_singular_ur5_wrist():
+    """UR5 with joint 5 next to 0 (where its closed form's angles lose half their digits): answered by the sweep."""
+    robot = sweepik.load_robot("ur5")
+    Q = in_limit_configurations(robot, 30, np.random.default_rng(29))
+    Q[:10, 4], Q[10:20, 4], Q[20:, 4] = 1e-7, -3e-8, 0.0
+    for q, sols in zip(Q, sweepik.solve_many(robot, robot.fk(Q)), strict=True):
+        assert recovers(robot, sols, q), q.tolist()
+        _check_set(robot, sols)
 
 
 def test_arm_outside_the_catalogue_is_refused():

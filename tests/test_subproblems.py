@@ -183,6 +183,15 @@ def test_trig2_roots_double_root_and_degenerate():
     roots, n = trig2_roots(0.5 + c0 * c0, -2 * c0, 0.0, 0.5 * c1, 0.0)
     assert n == 2 and np.allclose(np.sort(np.abs(roots[:2])), [np.arccos(0.3)] * 2, atol=1e-7)
     assert trig2_roots(0.0, 0.0, 0.0, 0.0, 0.0)[1] == -1
+    # two distinct roots 6e-7 apart are two: (cos(t - 0.4) - cos(3e-7)) (cos(t + 2) - 0.3)
+    d = 3e-7
+    t = np.linspace(-np.pi, np.pi, 9)[:-1]
+    vals = (np.cos(t - 0.4) - np.cos(d)) * (np.cos(t + 2) - 0.3)
+    basis = np.stack([np.ones_like(t), np.cos(t), np.sin(t), np.cos(2 * t), np.sin(2 * t)], axis=1)
+    coef = np.linalg.lstsq(basis, vals, rcond=None)[0]
+    roots, n = trig2_roots(*coef)
+    assert n == 4
+    assert np.sum(np.abs(roots[:n] - (0.4 - d)) < 1e-8) == 1 and np.sum(np.abs(roots[:n] - (0.4 + d)) < 1e-8) == 1
     assert trig2_roots(1.0, 0.0, 0.0, 0.0, 0.0)[1] == 0
 
 

@@ -10,6 +10,7 @@ rows ``offsets[i]:offsets[i + 1]``.
 from __future__ import annotations
 
 import bisect
+import operator
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -121,7 +122,7 @@ class SolutionBatch(Sequence[Solutions]):
     def __getitem__(self, i: int | slice) -> Solutions | list[Solutions]:
         if isinstance(i, slice):
             return [self[j] for j in range(*i.indices(len(self)))]
-        block, j = self._locate(int(i))
+        block, j = self._locate(operator.index(i))
         return block.solutions(j)
 
     def __iter__(self) -> Iterator[Solutions]:
@@ -132,7 +133,9 @@ class SolutionBatch(Sequence[Solutions]):
         return f"SolutionBatch({len(self)} poses, {int(self.offsets[-1])} solutions)"
 
     def __eq__(self, other: object) -> bool:
-        """As a list of :class:`Solutions` would compare (an empty batch equals ``[]``)."""
+        """Element by element with a list or tuple (an empty batch equals ``[]``). :class:`Solutions` compare by
+        identity and a batch builds them anew on each access, so a non-empty batch equals no list, and two batches
+        are equal only if they are the same object."""
         if isinstance(other, SolutionBatch):
             return other is self
         if isinstance(other, list | tuple):
@@ -143,7 +146,7 @@ class SolutionBatch(Sequence[Solutions]):
 
     def reason(self, i: int) -> str | None:
         """Why pose ``i`` has no solution (None when it has some, or a family)."""
-        block, j = self._locate(int(i))
+        block, j = self._locate(operator.index(i))
         return block.reason(j)
 
     def _stack(self, name: str, shape: tuple[int, ...], dtype: type) -> NDArray:

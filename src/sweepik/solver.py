@@ -353,10 +353,13 @@ def _solve_chunk(
             alt = _solve_chunk(
                 robot, get_reduction(robot, red.fallback), poses[idx], strategy, limits, n_samples, False
             )
-            fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)}
+            if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
+                fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx)}
+            else:  # the reduction's blind spot: the fallback's families
+                fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)}
     # poses with families (few): their isolated solutions lying on a family are reported by the family; the
     # reduction's blind spot: the fallback reduction's families are added, and its isolated solutions when this
-    # reduction has none
+    # reduction has none (a closed form: always)
     families: dict[int, tuple[Family, ...]] = {}
     keep = np.ones(pose_idx.size, dtype=bool)
     extra: list[tuple[int, Solutions, NDArray[np.bool_]]] = []
@@ -367,7 +370,8 @@ def _solve_chunk(
             fam = unique_families(fam + other.families)
         families[i] = fam
         rows = np.nonzero(pose_idx == i)[0]
-        if other is not None and rows.size == 0:
+        if other is not None and (rows.size == 0 or red.closed_form):
+            keep[rows] = False
             extra.append((i, other, off_families(robot, other.q, fam)))
         else:
             keep[rows] = off_families(robot, q[rows], fam)

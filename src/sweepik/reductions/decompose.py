@@ -254,7 +254,22 @@ def plans(robot: Robot) -> tuple[Plan, ...]:
             W = np.array(st.points[(4, 5)])
             found += _position_plans(robot, chain, rev_chain, W, (0, 1, 2, 3), "pair")
         found += _parallel_plans(robot, chain, rev_chain, st)
-    return tuple(sorted(found, key=_rank))
+    return tuple(sorted((p for p in found if _continuum_covered(p, found, robot)), key=_rank))
+
+
+def _continuum_covered(plan: Plan, found: list[Plan], robot: Robot) -> bool:
+    """A closed form whose wrist can turn singular needs a sweep for the continuum there (see
+    ``GeometricReduction._continua``); the one exception kept out is the parallel family with an offset wrist and
+    no such sweep (a slide first): at its singular wrist the closed form's single member may not even reach the
+    pose, so the plan is not offered rather than give a wrong "unreachable"."""
+    if plan.family != "parallel" or plan.W == plan.meet:
+        return True
+    chain = robot.chain.reversed() if plan.reversed else robot.chain
+    h, h4, h5 = chain.H[1], chain.H[4], chain.H[5]
+    if abs(abs(float(h4 @ h5)) - abs(float(h4 @ h))) > PARALLEL_TOL:  # joint 6's axis never turns onto h
+        return True
+    moving = {plan.joint(j) for j in (1, 2, 3, 5)}
+    return any(p.family == "pair" and not p.conditional and p.free_joint in moving for p in found)
 
 
 def _missing(robot: Robot) -> str:
@@ -264,7 +279,8 @@ def _missing(robot: Robot) -> str:
     return (
         f"robot {robot.name!r} ({st.describe()}) is outside sweepik's catalogue: a decomposition needs the last two "
         "axes (or the first two) revolute and meeting at a point, with the other joints placing that point by "
-        "subproblems (two of them parallel or intersecting, or prismatic)"
+        "subproblems (two of them parallel or intersecting, or prismatic), or axes 2-4 parallel (the UR family; "
+        "after a slide with an offset wrist only if joint 6's axis can never turn parallel to them)"
     )
 
 

@@ -176,16 +176,20 @@ class GeometricReduction(Reduction):
 
     @cached_property
     def _continua(self) -> GeometricReduction | None:
-        """For a closed form: the pair plan sweeping joint 4 (the wrist's first joint; for the parallel family the
-        last of the parallel ones), which reports the continuum of a singular wrist as a family (the closed form
-        gives one member)."""
+        """For a closed form: a pair plan sweeping a joint that moves along the continuum of a singular wrist (joint
+        4 preferred, then joint 6; for the parallel family also joints 2, 3), which solves the poses at or near it
+        and reports the continuum as a family (the closed form would give one member, and near it loses digits).
+        None when the arm has no such plan (the slide-first parallel arm with an offset wrist)."""
         if not self.plan.closed_form:
             return None
         from .decompose import plans  # local: decompose imports this module
 
-        for p in plans(self.robot):
-            if p.family == "pair" and p.free_joint == self.plan.joint(3) and not p.conditional:
-                return GeometricReduction(self.robot, p)
+        moving = [3, 5] + ([1, 2] if self.plan.family == "parallel" else [])
+        pairs = [p for p in plans(self.robot) if p.family == "pair" and not p.conditional]
+        for j in moving:
+            for p in pairs:
+                if p.free_joint == self.plan.joint(j):
+                    return GeometricReduction(self.robot, p)
         return None
 
     @property
@@ -193,7 +197,8 @@ class GeometricReduction(Reduction):
         return self._continua
 
     def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
-        """Closed form: poses where a branch's wrist is singular (its solutions form a continuum)."""
+        """Closed form: poses where a branch's wrist is singular or nearly so (``geometric.WRIST_SINGULAR``): the
+        solver answers them with the fallback sweep."""
         if not self.plan.closed_form or poses.shape[0] == 0:
             return None
         out = np.zeros(poses.shape[0], dtype=np.bool_)

@@ -483,9 +483,11 @@ def configure(cfg, params, pose, theta, branch, out):
     _configure(first_class(cfg), params, pose, theta, branch, out)
 
 
-#: A wrist is singular (joint 6's target axis along joint 4's: a continuum of solutions) when the sine of the
-#: angle between them is below this.
-WRIST_SINGULAR = 1e-9
+#: A closed form's wrist is singular (joint 6's target axis along joint 4's, or along the parallel axes: a continuum
+#: of solutions) when the sine of the angle between them is below 1e-9; within this of it the closed form's angles
+#: carry the square root of the rounding (~1e-8) and can miss the pose by far more than the certification accepts.
+#: Poses that near are solved by the fallback sweep instead (``GeometricReduction.degenerate``).
+WRIST_SINGULAR = 1e-6
 
 
 @njit(cache=True)

@@ -23,9 +23,13 @@ UNIT_TOL = 1e-4
 NEWTON_STEPS = 8
 #: A candidate is a root when ``|f|`` ends below this times the size of ``f``'s coefficients.
 ROOT_TOL = 1e-10
-#: Two roots closer than this (radians) are one, at their midpoint: a double root (f tangent to zero) comes out of
-#: the eigenvalues as two roots ~sqrt(rounding) apart.
+#: Two polished roots closer than this (radians) ...
 SAME_ROOT = 1e-6
+#: ... are one double root, at their midpoint, when ``|f|`` there is below this times the size of the coefficients
+#: (a double root, f tangent to zero, comes out of the eigenvalues as two roots ~1e-8 apart with f at rounding
+#: level between them; two distinct roots g apart have ``|f| ~ f'' g^2 / 8`` between them, so they stay two down to
+#: g ~ 3e-7).
+DOUBLE_FLAT = 1e-14
 
 
 @njit(cache=True)
@@ -79,9 +83,11 @@ def trig2_roots(a0, a1, b1, a2, b2):
         dup = False
         for j in range(n):
             gap = math.atan2(math.sin(t - out[j]), math.cos(t - out[j]))
-            if abs(gap) < SAME_ROOT:
-                out[j] += 0.5 * gap
+            mid = out[j] + 0.5 * gap
+            if abs(gap) < SAME_ROOT and abs(trig2(a0, a1, b1, a2, b2, mid)[0]) <= DOUBLE_FLAT * scale:
+                out[j] = math.atan2(math.sin(mid), math.cos(mid))
                 dup = True
+                break
         if not dup and n < 4:
             out[n] = t
             n += 1
