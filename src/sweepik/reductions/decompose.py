@@ -259,10 +259,11 @@ def plans(robot: Robot) -> tuple[Plan, ...]:
 
 def _continuum_covered(plan: Plan, found: list[Plan], robot: Robot) -> bool:
     """A closed form whose wrist can turn singular needs a sweep for the continuum there (see
-    ``GeometricReduction._continua``); the one exception kept out is the parallel family with an offset wrist and
-    no such sweep (a slide first): at its singular wrist the closed form's single member may not even reach the
-    pose, so the plan is not offered rather than give a wrong "unreachable"."""
-    if plan.family != "parallel" or plan.W == plan.meet:
+    ``GeometricReduction._continua``). A spherical wrist's single member is always a solution (the position was
+    solved first); the parallel family's is not (the planar arm's target turns with the sum of joints 2-4), so a
+    parallel plan without such a sweep (e.g. after a slide, with an offset wrist) is not offered rather than answer
+    "unreachable" at a reachable singular pose."""
+    if plan.family != "parallel":
         return True
     chain = robot.chain.reversed() if plan.reversed else robot.chain
     h, h4, h5 = chain.H[1], chain.H[4], chain.H[5]
