@@ -54,19 +54,40 @@ def _no_progress(stage: str, done: int, total: int) -> None:
     pass
 
 
+def _latencies(fn: Any, poses: Array, progress: Progress = _no_progress, stage: str = "") -> Array:
+    """Seconds of ``fn(T)`` for each pose (after one warm-up call); ``progress`` every 100 poses, outside the
+    timed region."""
+    fn(poses[0])
+    lat = np.empty(len(poses))
+    for i, T in enumerate(poses):
+        t0 = time.perf_counter()
+        fn(T)
+        lat[i] = time.perf_counter() - t0
+        if (i + 1) % 100 == 0 or i + 1 == len(poses):
+            progress(stage, i + 1, len(poses))
+    return lat
+
+
+def _best_seconds(
+    fn: Any, poses: Array, repeats: int, warm: int = 8, progress: Progress = _no_progress, stage: str = ""
+) -> float:
+    """Best of ``repeats`` wall times of ``fn(poses)`` (after a warm-up on ``warm`` poses: imports, caches)."""
+    fn(poses[:warm])
+    best = np.inf
+    progress(stage, 0, repeats)
+    for r in range(repeats):
+        t0 = time.perf_counter()
+        fn(poses)
+        best = min(best, time.perf_counter() - t0)
+        progress(stage, r + 1, repeats)
+    return float(best)
+
+
 def bench_grid(repeats: int = 3, progress: Progress = _no_progress) -> dict[str, Any]:
     """(a) Best of ``repeats`` wall times of ``solve_many`` on the 15,900 grid poses (precise)."""
     robot = load_robot("carm")
     poses = robot.fk(grid_configurations(include_singular=False))
-    progress("bench: grid", 0, repeats)
-    solve_many(robot, poses[:64])  # warm-up (imports, caches)
-    times = []
-    for r in range(repeats):
-        t0 = time.perf_counter()
-        solve_many(robot, poses)
-        times.append(time.perf_counter() - t0)
-        progress("bench: grid", r + 1, repeats)
-    best = min(times)
+    best = _best_seconds(lambda P: solve_many(robot, P), poses, repeats, 64, progress, "bench: grid")
     return {
         "poses": len(poses),
         "seconds": best,
@@ -79,14 +100,7 @@ def bench_single(count: int = 1000, seed: int = 0, progress: Progress = _no_prog
     """(b) Latency of ``solve`` on ``count`` random in-limit poses: median and 95th percentile."""
     robot = load_robot("carm")
     poses = robot.fk(random_configurations(robot, count, np.random.default_rng(seed)))
-    solve(robot, poses[0])
-    lat = np.empty(count)
-    for i, T in enumerate(poses):
-        t0 = time.perf_counter()
-        solve(robot, T)
-        lat[i] = time.perf_counter() - t0
-        if (i + 1) % 100 == 0 or i + 1 == count:  # the progress call stays out of the timed region
-            progress("bench: single pose", i + 1, count)
+    lat = _latencies(lambda T: solve(robot, T), poses, progress, "bench: single pose")
     return {"poses": count, "median_us": float(np.median(lat) * 1e6), "p95_us": float(np.percentile(lat, 95) * 1e6)}
 
 
@@ -179,23 +193,11 @@ ARM_TARGETS = {"closed_batched_us": 10.0, "carm_single_us": 150.0, "carm_batched
 
 
 def _median_us(fn: Any, poses: Array) -> float:
-    fn(poses[0])
-    lat = np.empty(len(poses))
-    for i, T in enumerate(poses):
-        t0 = time.perf_counter()
-        fn(T)
-        lat[i] = time.perf_counter() - t0
-    return float(np.median(lat) * 1e6)
+    return float(np.median(_latencies(fn, poses)) * 1e6)
 
 
 def _batch_us(fn: Any, poses: Array, repeats: int) -> float:
-    fn(poses[:8])
-    best = np.inf
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn(poses)
-        best = min(best, time.perf_counter() - t0)
-    return float(best / len(poses) * 1e6)
+    return _best_seconds(fn, poses, repeats) / len(poses) * 1e6
 
 
 def _flags(name: str, closed: bool, cell: dict[str, Any], peers: dict[str, dict[str, Any]]) -> list[str]:
