@@ -104,7 +104,7 @@ def _robot_corpus() -> dict[str, tuple[bytes, bool]]:
         "limits_reversed": _field(CARM_TOML, "limits", "[2000.0, 0.0]").encode(),
         "base_xyz_huge": (CARM_TOML + "\n[base]\nxyz = [1e300, 0, 0]\n").encode(),
         "tool_zyz_huge": (CARM_TOML + "\n[tool]\nzyz = [0, 1e308, 0]\n").encode(),
-        "tool_extra_key": (CARM_TOML + "\n[tool]\nrpy = [0, 0, 0]\n").encode(),
+        "tool_extra_key": (CARM_TOML + "\n[tool]\nrpw = [0, 0, 0]\n").encode(),
         "tool_not_table": (CARM_TOML.replace('name = "carm"', 'name = "carm"\ntool = 3')).encode(),
         "digits": CARM_TOML.replace("a = 350.0", "a = " + "9" * 5000).encode(),
         "digits_name": CARM_TOML.replace('name = "carm"', "name = " + "7" * 5000).encode(),

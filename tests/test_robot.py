@@ -403,7 +403,11 @@ def test_malformed_joint_names_file_joint_and_field(tmp_path: Path, body: str, n
             ["dh_convention", "craig"],
         ),
         ('[[joints]]\ntype = "revolute"\nlimits = [0, 1]\n[base]\nxyz = [1, 2]\n', ["[base]", "xyz"]),
-        ('[[joints]]\ntype = "revolute"\nlimits = [0, 1]\n[tool]\nrpy = [1, 2, 3]\n', ["[tool]", "rpy"]),
+        (
+            '[[joints]]\ntype = "revolute"\nlimits = [0, 1]\n[tool]\nrpy = [1, 2, 3]\nzyz = [1, 2, 3]\n',
+            ["[tool]", "not both"],
+        ),
+        ('[[joints]]\ntype = "revolute"\nlimits = [0, 1]\n[tool]\nxyw = [1, 2, 3]\n', ["[tool]", "xyw"]),
         ('tool = 5\n[[joints]]\ntype = "revolute"\nlimits = [0, 1]\n', ["[tool]"]),
     ],
 )

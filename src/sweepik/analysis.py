@@ -2,17 +2,59 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
 from .errors import UnknownOptionError
+from .origin_axis import hold_joints
 from .reductions.decompose import explain
 from .robot import Robot
 from .robot_file import load_robot
 
-__all__ = ["analyze"]
+__all__ = ["analyze", "lock_options"]
+
+#: Where in a joint's range the "generic value" of a lock lies (a fraction of the range from the lower limit, not
+#: a simple ratio, so that it is no special angle such as 0 or 90 degrees).
+GENERIC_LOCK_FRACTION = 0.381966
 
 
-def analyze(robot: Robot | str) -> dict[str, Any]:
+def _generic_value(robot: Robot, k: int) -> float:
+    lo, hi = float(robot.lower[k]), float(robot.upper[k])
+    if robot.is_revolute[k]:
+        lo, hi = max(lo, -np.pi), min(hi, np.pi)
+    elif hi - lo > 10.0 * robot.length_scale:  # a rail without a practical end: stay near its start
+        hi = lo + robot.length_scale
+    return lo + GENERIC_LOCK_FRACTION * (hi - lo)
+
+
+def lock_options(robot: Robot) -> list[dict[str, Any]]:
+    """For an arm with seven joints: for each joint, what locking it leaves (the six-joint arm's structure and the
+    decomposition ``solve`` would use), at a generic value and at 0 (when 0 is inside its limits; the structure
+    can differ there, e.g. two axes turn parallel). Arms with six joints or fewer (or more than seven) give [].
+
+    Each entry: ``joint`` (index from 0), ``joint_number``, ``joint_name``, and ``values``: a list of
+    ``{"value", "structure", "chosen", "reason"}`` (``chosen`` as in :func:`analyze`, None with a ``reason``).
+    """
+    if robot.n_joints != 7:
+        return []
+    out = []
+    for k in range(robot.n_joints):
+        values = [_generic_value(robot, k)]
+        if robot.lower[k] - robot.limit_tol[k] <= 0.0 <= robot.upper[k] + robot.limit_tol[k]:
+            values.insert(0, 0.0)
+        rows = []
+        for v in values:
+            info = explain(hold_joints(robot, {k: v}).arm)
+            rows.append(
+                {"value": v, "structure": info["structure"], "chosen": info["chosen"], "reason": info["reason"]}
+            )
+        out.append({"joint": k, "joint_number": k + 1, "joint_name": robot.joint_names[k], "values": rows})
+    return out
+
+
+def analyze(robot: Robot | str, locked: Mapping[Any, float] | None = None) -> dict[str, Any]:
     """The arm's structure, every decomposition in sweepik's catalogue that solves it, and the one the automatic
     decomposition (``solve(..., reduction="auto")``, the default unless the robot file names a reduction) uses, or
     why there is none, as plain values.
@@ -22,7 +64,10 @@ def analyze(robot: Robot | str) -> dict[str, Any]:
     ``free_joint`` takes it; None for a closed form), ``free_joint_number`` (from 1), ``free_joint_name``,
     ``chain`` ('forward' or 'reversed'), ``case``, ``branches``, ``blind_spot`` and ``steps``, the subproblem
     chain in words, joints numbered from 1), ``chosen`` (a plan or None) and ``reason`` (why none, else None).
-    ``robot``: a Robot, or a bundled name or robot file path.
+    ``robot``: a Robot, or a bundled name or robot file path. ``locked`` (joint name or index -> value, as
+    :func:`~sweepik.solve` takes it): analyse the arm with those joints held (joints then numbered in the smaller
+    arm). A seven-joint arm without ``locked`` has no plans of its own; its ``locks`` key (see
+    :func:`lock_options`) tells, joint by joint, which lock gives a closed form or a sweep.
 
     >>> from sweepik import analyze
     >>> info = analyze("puma560")
@@ -33,4 +78,13 @@ def analyze(robot: Robot | str) -> dict[str, Any]:
         robot = load_robot(robot)
     if not isinstance(robot, Robot):
         raise UnknownOptionError(f"robot must be a sweepik.Robot or a name/path, got {type(robot).__name__}")
-    return explain(robot)
+    if locked:
+        return explain(hold_joints(robot, locked).arm)
+    info = explain(robot)
+    if robot.n_joints == 7:
+        info["locks"] = lock_options(robot)
+        info["reason"] = (
+            f"robot {robot.name!r} has 7 joints: lock one (solve(..., locked={{name: value}}), --lock NAME=VALUE); "
+            "'locks' tells which lock gives a closed form or a sweep"
+        )
+    return info

@@ -37,7 +37,7 @@ from .analysis import analyze
 from .errors import SweepikError
 from .pose import GIMBAL_TOL, zyz_from_matrix
 from .robot import Robot
-from .robot_file import bundled_robots, load_robot
+from .robot_file import bundled_robots
 
 __all__ = ["main", "build_parser"]
 
@@ -50,12 +50,14 @@ from .cli_common import (
     VERBOSE_HELP,
     _add_json,
     _add_precision,
+    _add_robot_options,
     _clean,
     _config_from_cli,
     _format_matrix,
     _format_table,
     _is_number,
     _joint_units,
+    _load_robot,
     _num,
     _print_json,
     _protect_negative_numbers,
@@ -63,6 +65,7 @@ from .cli_common import (
     _subparser,
     _SubParsers,
 )
+from .cli_convert import add_convert_parser, cmd_convert
 from .cli_solve import add_path_parser, add_solve_parser, cmd_path, cmd_solve
 from .cli_verify import add_bench_parser, add_verify_parser, cmd_bench, cmd_verify
 
@@ -82,13 +85,14 @@ def _add_fk_parser(sub: _SubParsers) -> None:
     )
     p.add_argument("values", nargs="+", metavar="[ROBOT] Q1 ... Qn", help="robot (optional), then one value per joint")
     p.add_argument("--rad", action="store_true", help="revolute joint values are in radians")
+    _add_robot_options(p)
     _add_json(p, ": robot, joint_names, q (radians / length unit), pose, xyz, zyz_deg, ...")
     _add_precision(p)
 
 
 def _cmd_fk(args: argparse.Namespace) -> int:
     name, tokens = _split_robot(args.values)
-    robot = load_robot(name)
+    robot = _load_robot(name, args)
     q = _config_from_cli(robot, tokens, args.rad)
     T = robot.fk(q)
     xyz = T[:3, 3]
@@ -160,6 +164,7 @@ def _add_robots_parser(sub: _SubParsers) -> None:
         description="Show robots: the bundled ones, or the named robots / robot files.",
     )
     p.add_argument("robots", nargs="*", metavar="ROBOT", help="robot names or files (default: all bundled)")
+    _add_robot_options(p)
     _add_json(p)
     _add_precision(p)
 
@@ -182,7 +187,7 @@ def _robot_summary(robot: Robot) -> dict[str, Any]:
 
 
 def _cmd_robots(args: argparse.Namespace) -> int:
-    robots = [load_robot(name) for name in (args.robots or bundled_robots())]
+    robots = [_load_robot(name, args) for name in (args.robots or bundled_robots())]
     if args.json:
         _print_json([_robot_summary(r) for r in robots])
         return 0
@@ -241,6 +246,7 @@ _COMMANDS: dict[str, tuple[_AddParser, _Run]] = {
     "path": (add_path_parser, cmd_path),
     "verify": (add_verify_parser, cmd_verify),
     "bench": (add_bench_parser, cmd_bench),
+    "convert": (add_convert_parser, cmd_convert),
 }
 
 

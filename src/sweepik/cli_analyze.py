@@ -5,9 +5,19 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+import numpy as np
+
 from .analysis import analyze
-from .cli_common import _add_json, _format_table, _print_json, _subparser, _SubParsers
-from .robot_file import load_robot
+from .cli_common import (
+    _add_json,
+    _add_robot_options,
+    _format_table,
+    _load_robot,
+    _locked_from_args,
+    _print_json,
+    _subparser,
+    _SubParsers,
+)
 
 __all__ = ["add_analyze_parser", "cmd_analyze", "plan_line"]
 
@@ -23,7 +33,9 @@ def add_analyze_parser(sub: _SubParsers) -> None:
             "the number of branches), and the one 'sweepik solve' uses; or why none applies."
         ),
     )
-    p.add_argument("robot", metavar="ROBOT", help="robot name or file")
+    p.add_argument("robot", metavar="ROBOT", help="robot name or file (TOML or URDF)")
+    p.add_argument("--rad", action="store_true", help="--lock values of revolute joints in radians")
+    _add_robot_options(p, lock=True)
     _add_json(p)
 
 
@@ -39,12 +51,37 @@ def plan_line(plan: dict[str, Any]) -> str:
     return f"{head}, {plan['branches']} branches{chain}{blind}"
 
 
+def _print_locks(robot: Any, locks: list[dict[str, Any]]) -> None:
+    """The table of a 7-joint arm: for each joint, what locking it (at 0 and at a generic value) leaves."""
+    print(f"{robot.n_joints} joints: solve with one locked (--lock NAME=VALUE); what each lock leaves:")
+    rows = []
+    for lock in locks:
+        k = lock["joint"]
+        for v in lock["values"]:
+            value = np.degrees(v["value"]) if robot.is_revolute[k] else v["value"]
+            unit = "deg" if robot.is_revolute[k] else robot.length_unit
+            chosen = v["chosen"]
+            rows.append(
+                [
+                    f"{lock['joint_number']} ({lock['joint_name']})",
+                    f"{value:.4g} {unit}",
+                    v["structure"],
+                    plan_line(chosen) if chosen else "none in the catalogue",
+                ]
+            )
+    print(_format_table(["lock joint", "at", "structure of the other six", "decomposition"], rows))
+
+
 def cmd_analyze(args: argparse.Namespace) -> int:
-    info = analyze(load_robot(args.robot))
+    robot = _load_robot(args.robot, args)
+    info = analyze(robot, locked=_locked_from_args(robot, args))
     if args.json:
         _print_json(info)
         return 0
     print(f"{info['robot']}: {info['structure']}")
+    if "locks" in info:
+        _print_locks(robot, info["locks"])
+        return 0
     chosen = info["chosen"]
     if chosen is None:
         print(f"no decomposition: {info['reason']}")

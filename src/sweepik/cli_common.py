@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import SweepikError
 from .robot import Robot
+from .robot_file import load_robot
 
 PROG = "sweepik"
 #: Robot used when a subcommand's optional ROBOT argument is left out.
@@ -79,6 +80,62 @@ def _split_robot(tokens: Sequence[str]) -> tuple[str, list[str]]:
     if tokens and not _is_number(tokens[0]):
         return tokens[0], list(tokens[1:])
     return DEFAULT_ROBOT, list(tokens)
+
+
+def _add_robot_options(p: argparse.ArgumentParser, lock: bool = False) -> None:
+    """``--base-link``/``--tip-link`` (URDF robots) and, with ``lock``, ``--lock NAME=VALUE``."""
+    p.add_argument("--base-link", metavar="LINK", help="URDF robot: base link of the chain (default: the root link)")
+    p.add_argument(
+        "--tip-link",
+        metavar="LINK",
+        help="URDF robot: tip link of the chain (default: the child link of the last moving joint)",
+    )
+    if lock:
+        p.add_argument(
+            "--lock",
+            action="append",
+            metavar="NAME=VALUE",
+            help=(
+                "hold a joint at a value (degrees for revolute joints, radians with --rad; length unit for "
+                "prismatic ones), the joint by name or number from 1; repeatable. A 7-joint arm is solved with "
+                "one joint locked ('sweepik analyze' tells which lock gives a closed form or a sweep)"
+            ),
+        )
+
+
+def _load_robot(name: str, args: argparse.Namespace) -> Robot:
+    """The robot ``name`` with the ``--base-link``/``--tip-link`` options of :func:`_add_robot_options`."""
+    return load_robot(name, base_link=getattr(args, "base_link", None), tip_link=getattr(args, "tip_link", None))
+
+
+def _locked_from_args(robot: Robot, args: argparse.Namespace) -> dict[int, float] | None:
+    """``--lock NAME=VALUE`` options as ``solve``'s ``locked`` (joint index -> radians / length unit)."""
+    items = getattr(args, "lock", None)
+    if not items:
+        return None
+    rad = bool(getattr(args, "rad", False))
+    out: dict[int, float] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise CliInputError(
+                f"--lock takes NAME=VALUE (a joint name or number from 1, then its value), got {item!r}"
+            )
+        if name in robot.joint_names:
+            k = robot.joint_names.index(name)
+        elif name.isdecimal() and 1 <= int(name) <= robot.n_joints:
+            k = int(name) - 1
+        else:
+            raise CliInputError(
+                f"--lock {item!r}: {robot.name!r} has no joint {name!r} (joints: {', '.join(robot.joint_names)}, "
+                f"or numbers 1 to {robot.n_joints})"
+            )
+        if k in out:
+            raise CliInputError(f"--lock: joint {robot.joint_names[k]!r} is locked twice")
+        value = float(_parse_numbers([text], [f"--lock {robot.joint_names[k]}"])[0])
+        out[k] = float(np.radians(value)) if robot.is_revolute[k] and not rad else value
+    return out
 
 
 def _joint_units(robot: Robot, rad: bool) -> list[str]:

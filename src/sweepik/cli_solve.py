@@ -15,12 +15,15 @@ from .cli_common import (
     CliInputError,
     _add_json,
     _add_precision,
+    _add_robot_options,
     _check_output_path,
     _config_from_cli,
     _format_table,
     _is_number,
     _isatty,
     _joint_units,
+    _load_robot,
+    _locked_from_args,
     _parse_numbers,
     _print_json_stream,
     _Progress,
@@ -31,22 +34,30 @@ from .errors import UnknownOptionError
 from .pose import pose_from_xyz_zyz
 from .reductions import REDUCTIONS
 from .robot import Robot
-from .robot_file import bundled_robots, load_robot
+from .robot_file import bundled_robots
 from .solutions import Solutions
 from .solver import STRATEGIES, iter_solve
 
 Array = NDArray[np.float64]
 
 
-def _ik_kwargs(args: argparse.Namespace) -> dict[str, Any]:
+def _ik_kwargs(args: argparse.Namespace, robot: Robot) -> dict[str, Any]:
     """The solver's keyword arguments from the options of :func:`_add_ik_options`."""
     free = args.free_joint
     if free is not None and free.strip().isdecimal():
         number = int(free)
-        if not 1 <= number <= 6:
-            raise UnknownOptionError(f"--free-joint takes a joint number from 1 to 6 (or a joint name), got {free}")
+        if not 1 <= number <= robot.n_joints:
+            raise UnknownOptionError(
+                f"--free-joint takes a joint number from 1 to {robot.n_joints} (or a joint name), got {free}"
+            )
         free = number - 1  # the API numbers joints from 0
-    return {"reduction": args.reduction, "free_joint": free, "strategy": args.strategy, "limits": not args.no_limits}
+    return {
+        "reduction": args.reduction,
+        "free_joint": free,
+        "strategy": args.strategy,
+        "limits": not args.no_limits,
+        "locked": _locked_from_args(robot, args),
+    }
 
 
 def _add_ik_options(p: argparse.ArgumentParser) -> None:
@@ -66,6 +77,7 @@ def _add_ik_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--no-limits", action="store_true", help="keep solutions outside the joint limits (flagged)")
     p.add_argument("--rad", action="store_true", help="angles in and out in radians instead of degrees")
+    _add_robot_options(p, lock=True)
 
 
 def add_solve_parser(sub: _SubParsers) -> None:
@@ -190,13 +202,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
             f"unexpected number {args.robot.strip()!r} where the robot goes: --xyz takes 3 numbers, --zyz 3 angles, "
             "--matrix 16 numbers"
         )
-    robot = load_robot(args.robot)
+    robot = _load_robot(args.robot, args)
     nearest = None if args.nearest is None else _config_from_cli(robot, args.nearest, args.rad)
     poses = _poses_from_args(args)
     # the output streaming to the terminal shows the progress by itself: no progress line mixed into it
     progress = _Progress(enabled=not _isatty(sys.stdout))
     try:
-        sols = iter_solve(robot, poses, progress=progress, **_ik_kwargs(args))
+        sols = iter_solve(robot, poses, progress=progress, **_ik_kwargs(args, robot))
         if args.json:
             head = {
                 "robot": robot.name,
@@ -252,12 +264,12 @@ def cmd_path(args: argparse.Namespace) -> int:
         )
     if args.output:
         _check_output_path(args.output, suffixes=(".csv", ".json"))
-    robot = load_robot(robot_name)
+    robot = _load_robot(robot_name, args)
     start = None if args.start is None else _config_from_cli(robot, args.start, args.rad)
     poses = load_poses(path)
     progress = _Progress()
     try:
-        res = follow_path(robot, poses, start, progress=progress, **_ik_kwargs(args))
+        res = follow_path(robot, poses, start, progress=progress, **_ik_kwargs(args, robot))
     finally:
         progress.close()
     if args.output:

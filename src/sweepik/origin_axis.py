@@ -21,6 +21,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -143,7 +144,7 @@ def _joint_index(robot: Robot, key: object) -> int:
     return k
 
 
-def held_values(robot: Robot, locked: Mapping[object, object]) -> tuple[tuple[int, float], ...]:
+def held_values(robot: Robot, locked: Mapping[Any, Any]) -> tuple[tuple[int, float], ...]:
     """``locked`` (joint name or index -> value) checked against ``robot``: ``((index, value), ...)`` sorted.
 
     A value must be a finite number inside the joint's limits (with the solver's limit tolerance): a solution
@@ -176,7 +177,7 @@ def held_values(robot: Robot, locked: Mapping[object, object]) -> tuple[tuple[in
     return tuple(sorted(out.items()))
 
 
-def hold_joints(robot: Robot, locked: Mapping[object, object], n_free: int | None = 6) -> HeldJoints:
+def hold_joints(robot: Robot, locked: Mapping[Any, Any], n_free: int | None = 6) -> HeldJoints:
     """The arm with the joints in ``locked`` (name or index -> value, radians / length unit) held.
 
     ``n_free`` is how many joints must remain (6 for the solver; ``None`` for any number). Raises

@@ -23,6 +23,9 @@ __all__ = [
     "matrix_from_zyz",
     "pose_from_xyz_zyz",
     "xyz_zyz_from_pose",
+    "matrix_from_rpy",
+    "rpy_from_matrix",
+    "pose_from_xyz_rpy",
     "wrap_angle",
     "rotation_angle",
     "pose_error_paper",
@@ -96,12 +99,16 @@ def matrix_from_zyz(angles: ArrayLike) -> Array:
 
 def pose_from_xyz_zyz(xyz: ArrayLike, zyz: ArrayLike) -> Array:
     """Pose ``(..., 4, 4)`` from a position ``(..., 3)`` (length unit) and Z-Y-Z angles ``(..., 3)`` (radians)."""
-    xyz = np.asarray(xyz, dtype=np.float64)
-    R = matrix_from_zyz(zyz)
-    shape = np.broadcast_shapes(xyz.shape[:-1], R.shape[:-2])
+    return _pose(xyz, matrix_from_zyz(zyz))
+
+
+def _pose(xyz: ArrayLike, R: Array) -> Array:
+    """Poses ``(..., 4, 4)`` from positions ``(..., 3)`` and rotations ``(..., 3, 3)`` (broadcast)."""
+    p = np.asarray(xyz, dtype=np.float64)
+    shape = np.broadcast_shapes(p.shape[:-1], R.shape[:-2])
     T = np.zeros((*shape, 4, 4))
     T[..., :3, :3] = R
-    T[..., :3, 3] = xyz
+    T[..., :3, 3] = p
     T[..., 3, 3] = 1.0
     return T
 
@@ -110,6 +117,45 @@ def xyz_zyz_from_pose(T: ArrayLike) -> tuple[Array, Array]:
     """Split poses ``(..., 4, 4)`` into positions ``(..., 3)`` and Z-Y-Z angles ``(..., 3)`` (radians)."""
     T = np.asarray(T, dtype=np.float64)
     return T[..., :3, 3].copy(), zyz_from_matrix(T)
+
+
+def _rot_x(a: Array) -> Array:
+    c, s = np.cos(a), np.sin(a)
+    z, o = np.zeros_like(a), np.ones_like(a)
+    return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
+
+
+def matrix_from_rpy(rpy: ArrayLike) -> Array:
+    """Rotation matrices ``(..., 3, 3)`` from roll-pitch-yaw ``(..., 3)`` in radians, URDF's convention: fixed
+    axes x, then y, then z, i.e. ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``."""
+    a = np.asarray(rpy, dtype=np.float64)
+    return _rot_z(a[..., 2]) @ _rot_y(a[..., 1]) @ _rot_x(a[..., 0])
+
+
+def rpy_from_matrix(R: ArrayLike) -> Array:
+    """Roll-pitch-yaw ``(..., 3)`` (radians, pitch in [-pi/2, pi/2]) of rotations ``(..., 3, 3)``: the inverse of
+    :func:`matrix_from_rpy`. At pitch = +-pi/2 only roll -+ yaw is defined; roll is then 0.
+
+    >>> import numpy as np
+    >>> np.round(rpy_from_matrix(matrix_from_rpy([0.1, -0.2, 0.3])), 12).tolist()
+    [0.1, -0.2, 0.3]
+    """
+    R = np.asarray(R, dtype=np.float64)[..., :3, :3]
+    pitch = np.arctan2(-R[..., 2, 0], np.hypot(R[..., 0, 0], R[..., 1, 0]))
+    yaw = np.arctan2(R[..., 1, 0], R[..., 0, 0])
+    # roll from the last two columns rotated back by yaw and pitch: well conditioned for every pitch
+    cy, sy = np.cos(yaw), np.sin(yaw)
+    roll = np.arctan2(sy * R[..., 0, 2] - cy * R[..., 1, 2], cy * R[..., 1, 1] - sy * R[..., 0, 1])
+    gimbal = np.hypot(R[..., 0, 0], R[..., 1, 0]) <= _EXACT_GIMBAL
+    # gimbal: R = Rz(yaw) Ry(+-pi/2) with roll 0; yaw from the second column
+    yaw = np.where(gimbal, np.arctan2(-R[..., 0, 1], R[..., 1, 1]), yaw)
+    roll = np.where(gimbal, 0.0, roll)
+    return np.stack([roll, pitch, yaw], axis=-1)
+
+
+def pose_from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike) -> Array:
+    """Pose ``(..., 4, 4)`` from a position ``(..., 3)`` and roll-pitch-yaw ``(..., 3)`` (radians, URDF's)."""
+    return _pose(xyz, matrix_from_rpy(rpy))
 
 
 def rotation_angle(R: ArrayLike) -> Array:

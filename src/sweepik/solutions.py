@@ -13,6 +13,7 @@ from ._validate import check_configuration
 from .errors import SweepikError
 
 if TYPE_CHECKING:
+    from .origin_axis import HeldJoints
     from .reductions.base import Reduction
     from .robot import Robot
 
@@ -88,6 +89,8 @@ class Family:
         free_joint: index of the joint that parametrises the family (theta* of the reduction).
         interval: ``(lo, hi)`` in that joint's unit (radians or length unit), inside the joint limits
             when the solve applied limits.
+        held: for an arm solved with locked joints, how members of the smaller arm the reduction solves map
+            back to full length (``free_joint`` is then an index of the full arm).
     """
 
     free_joint: int
@@ -95,6 +98,7 @@ class Family:
     reduction: Reduction = field(repr=False)
     chain_pose: Array = field(repr=False)
     branch: int = 0
+    held: HeldJoints | None = field(default=None, repr=False)
 
     def at(self, theta: ArrayLike) -> Array:
         """Member configuration(s) ``(n,)`` (or ``(..., n)``) at theta* value(s) inside ``interval``."""
@@ -110,7 +114,10 @@ class Family:
         q = family_members(
             red.robot, red, self.chain_pose[None], np.zeros(flat.size, np.intp), np.full(flat.size, self.branch), flat
         )
-        return red.robot.wrap(q).reshape(*th.shape, -1)
+        q = red.robot.wrap(q)
+        if self.held is not None:
+            q = self.held.expand(q)
+        return q.reshape(*th.shape, -1)
 
     def sample(self, count: int = 50) -> Array:
         """``(count, n)`` member configurations evenly spaced over the interval."""

@@ -6,8 +6,9 @@ configurations -> FK check against the target -> joint limits -> duplicates remo
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from typing import Literal
+import dataclasses
+from collections.abc import Callable, Iterator, Mapping
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,6 +18,7 @@ from ._validate import as_float_array, check_bool, check_choice, check_int, chec
 from .batch import Block, SolutionBatch
 from .errors import ShapeError, UnknownOptionError
 from .families import collapse_continua, families_of, off_families, unique_families
+from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
 from .polish import polish
 from .pose import pose_error_geodesic, pose_error_paper
@@ -460,6 +462,7 @@ def solve_many(
     limits: bool = True,
     n_samples: int = N_SAMPLES,
     chunk_size: int = CHUNK,
+    locked: Mapping[Any, float] | None = None,
 ) -> SolutionBatch:
     """All IK solutions of each pose in ``poses (N, 4, 4)`` (world frame, robot's length unit).
 
@@ -476,9 +479,11 @@ def solve_many(
     P = np.zeros((0, 4, 4)) if arr.size == 0 else check_poses(arr, "poses")
     if P.ndim != 3:
         raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
-    red, strat, lim, ns, cs = _prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size, free_joint)
-    blocks = [_solve_chunk(robot, red, P[s : s + cs], strat, lim, ns) for s in range(0, P.shape[0], cs)]
-    return SolutionBatch(robot, blocks)
+    held = _held(robot, locked)
+    arm = robot if held is None else held.arm
+    red, strat, lim, ns, cs = _prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
+    blocks = [_solve_chunk(arm, red, P[s : s + cs], strat, lim, ns) for s in range(0, P.shape[0], cs)]
+    return SolutionBatch(robot, [_expanded(b, held) for b in blocks])
 
 
 def iter_solve(
@@ -492,6 +497,7 @@ def iter_solve(
     n_samples: int = N_SAMPLES,
     chunk_size: int = CHUNK,
     progress: Progress | None = None,
+    locked: Mapping[Any, float] | None = None,
 ) -> Iterator[Solutions]:
     """The solutions of each pose in ``poses (N, 4, 4)``, yielded one pose after the other as
     :func:`solve_many` computes them, a chunk of poses at a time: only one chunk's results are alive at once,
@@ -507,8 +513,10 @@ def iter_solve(
         raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
     if progress is not None and not callable(progress):
         raise UnknownOptionError(f"progress must be callable or None, got {type(progress).__name__}")
-    prepared = _prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size, free_joint)
-    return _iter_checked(robot, P, *prepared, progress)
+    held = _held(robot, locked)
+    arm = robot if held is None else held.arm
+    prepared = _prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
+    return _iter_checked(arm, P, *prepared, progress, held)
 
 
 def _prepare(
@@ -520,13 +528,24 @@ def _prepare(
     n_samples: int,
     chunk_size: int = CHUNK,
     free_joint: int | str | None = None,
+    held: HeldJoints | None = None,
 ) -> tuple[Reduction, str, bool, int, int]:
-    """Check the solver's arguments; the reduction and the checked (strategy, limits, n_samples, chunk size)."""
-    if not isinstance(robot, Robot):
-        hint = f"; load it with sweepik.load_robot({short_repr(robot, 40)})" if isinstance(robot, str) else ""
+    """Check the solver's arguments; the reduction and the checked (strategy, limits, n_samples, chunk size).
+
+    ``robot`` is the arm solved (with ``held``, the smaller arm; ``free_joint`` names a joint of the full one)."""
+    _check_robot(robot)
+    if held is None and robot.n_joints != 6:
         raise UnknownOptionError(
-            f"robot must be a sweepik.Robot (see load_robot), got {type(robot).__name__} {short_repr(robot, 40)}{hint}"
+            f"robot {robot.name!r} has {robot.n_joints} joints; sweepik solves six: "
+            + (
+                f"hold {robot.n_joints - 6} of them with locked={{joint name: value}} (sweepik.analyze tells which "
+                "joint to lock gives a closed form or a sweep)"
+                if robot.n_joints > 6
+                else "an arm with fewer joints is out of scope"
+            )
         )
+    if held is not None and free_joint is not None:
+        free_joint = _held_free_joint(held, free_joint)
     n_samples = check_int(n_samples, "n_samples", 8, MAX_SAMPLES)
     chunk_size = check_int(chunk_size, "chunk_size", 1, MAX_CHUNK)
     limits = check_bool(limits, "limits")
@@ -545,6 +564,44 @@ def _prepare(
     else:
         chunk_size = min(chunk_size, max(1, SAMPLE_BUDGET // n_samples))
     return red, strategy, limits, n_samples, chunk_size
+
+
+def _check_robot(robot: object) -> None:
+    if not isinstance(robot, Robot):
+        hint = f"; load it with sweepik.load_robot({short_repr(robot, 40)})" if isinstance(robot, str) else ""
+        raise UnknownOptionError(
+            f"robot must be a sweepik.Robot (see load_robot), got {type(robot).__name__} {short_repr(robot, 40)}{hint}"
+        )
+
+
+def _held(robot: Robot, locked: object) -> HeldJoints | None:
+    """``locked`` (joint name or index -> value) as the held arm, None when nothing is locked."""
+    _check_robot(robot)
+    if locked is None or (isinstance(locked, Mapping) and not locked):
+        return None
+    return hold_joints(robot, locked)  # type: ignore[arg-type]
+
+
+def _held_free_joint(held: HeldJoints, free_joint: object) -> int | str:
+    """A free joint of the full arm (index or name) as a joint of the held arm."""
+    full = held.robot
+    if isinstance(free_joint, str):
+        return free_joint  # names are kept by the held arm; an unknown or held one is refused there
+    k = check_int(free_joint, "free_joint", 0, full.n_joints - 1)
+    if k not in held.free:
+        raise UnknownOptionError(f"free_joint {full.joint_names[k]!r} is locked; sweep one of the others")
+    return held.free.index(k)
+
+
+def _expanded(block: Block, held: HeldJoints | None) -> Block:
+    """``block`` of the held arm as a block of the full arm: configurations full length, families too."""
+    if held is None:
+        return block
+    families = {
+        i: tuple(dataclasses.replace(f, free_joint=held.free[f.free_joint], held=held) for f in fams)
+        for i, fams in block.families.items()
+    }
+    return dataclasses.replace(block, robot=held.robot, q=held.expand(block.q), families=families)
 
 
 def _free_joint_index(robot: Robot, free_joint: object, reduction: object) -> int | None:
@@ -572,12 +629,13 @@ def _iter_checked(
     n_samples: int,
     chunk_size: int,
     progress: Progress | None = None,
+    held: HeldJoints | None = None,
 ) -> Iterator[Solutions]:
     total = P.shape[0]
     if progress is not None:
         progress("solve", 0, total)
     for s in range(0, total, chunk_size):
-        yield from _solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples)
+        yield from _expanded(_solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples), held)
         if progress is not None:
             progress("solve", min(s + chunk_size, total), total)
 
@@ -591,9 +649,12 @@ def _solve_checked(
     n_samples: int,
     chunk_size: int = CHUNK,
     free_joint: int | str | None = None,
+    locked: object = None,
 ) -> list[Solutions]:
-    prepared = _prepare(robot, P, reduction, strategy, limits, n_samples, chunk_size, free_joint)
-    return list(_iter_checked(robot, P, *prepared))
+    held = _held(robot, locked)
+    arm = robot if held is None else held.arm
+    prepared = _prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
+    return list(_iter_checked(arm, P, *prepared, None, held))
 
 
 def solve(
@@ -605,6 +666,7 @@ def solve(
     strategy: Strategy = "precise",
     limits: bool = True,
     n_samples: int = N_SAMPLES,
+    locked: Mapping[Any, float] | None = None,
 ) -> Solutions:
     """All IK solutions of one pose ``(4, 4)`` (world frame, robot's length unit).
 
@@ -623,6 +685,12 @@ def solve(
         n_samples: uniform theta* samples before refinement, an integer in [8, ``MAX_SAMPLES``] (100,000;
             not a bool or a float). The paper's strategy ignores it, and refuses a theta* range needing more
             than ``MAX_PAPER_SAMPLES`` (200,000) of its 10 mm samples.
+        locked: joints held at given values, ``{name or index: value}`` (radians / length unit, inside the
+            joint's limits): an arm with more than six joints is solved with enough of them held that six remain
+            (e.g. a 7-DOF arm with one locked). The solutions' configurations are full length, the held values
+            in place; ``free_joint`` and families name joints of the full arm. ``sweepik.analyze`` tells which
+            joint to lock gives a closed form or a sweep. LockedJointError for an unknown joint, a value outside
+            its limits, or other than six joints left.
 
     Raises:
         SweepikError subclasses: a pose that is not a rigid transform or not real numbers (ShapeError,
@@ -641,4 +709,4 @@ def solve(
     P = check_poses(pose, "pose")
     if P.shape != (4, 4):
         raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
-    return _solve_checked(robot, P[None], reduction, strategy, limits, n_samples, CHUNK, free_joint)[0]
+    return _solve_checked(robot, P[None], reduction, strategy, limits, n_samples, CHUNK, free_joint, locked)[0]

@@ -18,7 +18,7 @@ import math
 import os
 import tokenize
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
@@ -121,6 +121,7 @@ def follow_path(
     strategy: Literal["precise", "paper"] = "precise",
     limits: bool = True,
     progress: Progress | None = None,
+    locked: Mapping[Any, float] | None = None,
 ) -> PathResult:
     """Joint path along ``poses (N, 4, 4)`` (world frame, robot's length unit), keeping to one IK branch.
 
@@ -130,7 +131,8 @@ def follow_path(
     members of self-motion families count). A pose without solution gets a NaN row and the next point is
     compared with the last configuration found. The poses are solved a chunk at a time (:func:`iter_solve`), so
     memory grows with the path's joint rows only; ``progress("path", done, total)`` follows the solves.
-    ``reduction``, ``free_joint``, ``strategy`` and ``limits`` are passed to :func:`iter_solve` (see :func:`solve`).
+    ``reduction``, ``free_joint``, ``strategy``, ``limits`` and ``locked`` are passed to :func:`iter_solve` (see
+    :func:`solve`); with ``locked``, configurations are full length (``q_start`` too).
 
     >>> import numpy as np
     >>> from sweepik import load_robot
@@ -148,7 +150,14 @@ def follow_path(
         raise ShapeError(f"q_start must have shape ({robot.n_joints},), got {ref.shape}")
     report = None if progress is None else (lambda _stage, done, total: progress("path", done, total))
     sols = iter_solve(
-        robot, P, reduction=reduction, free_joint=free_joint, strategy=strategy, limits=limits, progress=report
+        robot,
+        P,
+        reduction=reduction,
+        free_joint=free_joint,
+        strategy=strategy,
+        limits=limits,
+        progress=report,
+        locked=locked,
     )
     weight = orientation_weight(robot.length_unit)
     N, n = P.shape[0], robot.n_joints
