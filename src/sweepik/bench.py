@@ -24,6 +24,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .origin_axis import hold_joints
+from .robot import Robot
 from .robot_file import load_robot
 from .solver import Progress, solve, solve_many
 from .verify import grid_configurations, random_configurations
@@ -239,11 +241,20 @@ def bench_arms(
     robots = [load_robot(n) for n in arms]  # bad names fail before anything is timed
     for k, (name, robot) in enumerate(zip(arms, robots, strict=True)):
         progress("bench: arms", k, len(arms))
-        poses = robot.fk(random_configurations(robot, max(single, batch, 8), np.random.default_rng(1)))
-        plan = analyze(robot)["chosen"]
+        q = random_configurations(robot, max(single, batch, 8), np.random.default_rng(1))
+        locked = _bench_lock(robot)
+        for j, v in (locked or {}).items():
+            q[:, j] = v
+        poses = robot.fk(q)
+        plan = analyze(robot, locked=locked)["chosen"]
+        if plan is None:
+            rows[name] = {"plan": "none", "sweepik": None, "peers": {}}
+            continue
         closed = bool(plan["closed_form"])
         row: dict[str, Any] = {"plan": "closed form" if closed else f"sweep joint {plan['free_joint_number']}"}
-        variants = {"sweepik": {"reduction": "auto"}}
+        if locked:
+            row["plan"] += " (" + ", ".join(f"{robot.joint_names[j]} locked" for j in locked) + ")"
+        variants: dict[str, dict[str, Any]] = {"sweepik": {"reduction": "auto", "locked": locked}}
         if robot.default_reduction:
             variants[f"sweepik {robot.default_reduction}"] = {"reduction": robot.default_reduction}
         for label, kw in variants.items():
@@ -255,19 +266,31 @@ def bench_arms(
             }
         fastest = min((row[v] for v in variants), key=lambda c: c["batched_us"])
         peers = {}
-        for peer, (one, many) in peers_for(robot).items():
+        for peer, (one, many) in peers_for(hold_joints(robot, locked).arm if locked else robot).items():
             peers[peer] = {
                 "single_us": _median_us(one, poses[:single]) if single else None,
                 "batched_us": _batch_us(many, poses[:batch], repeats),
             }
         row["peers"] = peers
-        if memory:
+        if memory and not locked:
             row["peak_rss_mib"] = bench_memory(memory, name)["peak_rss_mib"]
         if single:
             row["misses"] = _flags(name, closed, fastest, peers)
         rows[name] = row
     progress("bench: arms", len(arms), len(arms))
     return {"arms": rows, "single_poses": single, "batch_poses": batch, "memory_poses": memory}
+
+
+def _bench_lock(robot: Robot) -> dict[int, float] | None:
+    """A seven-joint arm is timed with one joint locked: the first whose lock (at a generic value) gives a closed
+    form, else the first that gives a sweep (see ``analysis.lock_options``); None for a six-joint arm."""
+    from .analysis import lock_options
+
+    options = [(lock["joint"], v) for lock in lock_options(robot) for v in lock["values"][-1:] if v["chosen"]]
+    if not options:
+        return None
+    j, v = min(options, key=lambda o: not o[1]["chosen"]["closed_form"])
+    return {j: float(v["value"])}
 
 
 def format_arms(result: dict[str, Any]) -> str:
