@@ -21,8 +21,9 @@ import pytest
 from oracles import ikgeo_solutions, in_limit_configurations, numerical_solutions, recovers, same_solution_set
 
 import sweepik
+from sweepik import LockedJointError
 from sweepik.cli import main
-from sweepik.origin_axis import LockedJointError, hold_joints, joint_origins, origin_axis_form
+from sweepik.origin_axis import hold_joints, joint_origins, origin_axis_form
 from sweepik.robot import Joint, Robot
 from sweepik.robot_file import _parse, robot_to_toml
 

@@ -1,7 +1,9 @@
 """sweepik: every inverse-kinematics solution of 6-DOF serial arms, by a one-joint sweep.
 
-Public API: robots (``load_robot``, ``Robot``, ``Joint``), pose helpers and error metrics, and the solvers
-``solve`` and ``solve_many``. See the README and docs/conventions.md for units and conventions.
+Public API: robots (``load_robot`` for bundled arms, TOML robot files and URDF; ``Robot``, ``Joint``;
+``read_urdf``, ``urdf_text``, ``robot_to_toml``), pose helpers and error metrics, and the solvers ``solve``,
+``solve_many`` and ``iter_solve`` (``locked=`` for arms with more than six joints). See the README and
+docs/conventions.md for units and conventions.
 """
 
 from importlib.metadata import PackageNotFoundError, version
@@ -10,6 +12,7 @@ from .analysis import analyze
 from .batch import SolutionBatch
 from .errors import (
     InvalidPoseError,
+    LockedJointError,
     NonFiniteError,
     NoReductionError,
     PoseFileError,
@@ -19,6 +22,7 @@ from .errors import (
     SweepikError,
     UnknownOptionError,
     UnknownRobotError,
+    UrdfError,
 )
 from .pose import (
     matrix_from_zyz,
@@ -32,9 +36,10 @@ from .pose import (
 )
 from .reductions import REDUCTIONS, CArmD1, CArmTheta2, GeometricReduction, Plan, Reduction, get_reduction
 from .robot import Joint, Robot
-from .robot_file import bundled_robots, load_robot, robot_from_dict
+from .robot_file import bundled_robots, load_robot, robot_from_dict, robot_to_toml
 from .solutions import Family, Solutions
 from .solver import STRATEGIES, iter_solve, solve, solve_many
+from .urdf import read_urdf, urdf_text
 
 try:
     __version__ = version("sweepik")
@@ -48,6 +53,9 @@ __all__ = [
     "load_robot",
     "bundled_robots",
     "robot_from_dict",
+    "robot_to_toml",
+    "read_urdf",
+    "urdf_text",
     "solve",
     "solve_many",
     "iter_solve",
@@ -81,4 +89,6 @@ __all__ = [
     "UnknownOptionError",
     "PoseFileError",
     "NoReductionError",
+    "LockedJointError",
+    "UrdfError",
 ]

@@ -6,6 +6,7 @@ __all__ = [
     "SweepikError",
     "RobotDefinitionError",
     "RobotFileError",
+    "UrdfError",
     "UnknownRobotError",
     "ShapeError",
     "NonFiniteError",
@@ -13,6 +14,7 @@ __all__ = [
     "UnknownOptionError",
     "PoseFileError",
     "NoReductionError",
+    "LockedJointError",
 ]
 
 
@@ -27,6 +29,13 @@ class RobotDefinitionError(SweepikError):
 class RobotFileError(RobotDefinitionError):
     """A robot file is malformed, incomplete, unreadable (a directory, no permission, over 1 MiB, not UTF-8) or
     out of bounds; the message names the file, and the joint and field where there is one."""
+
+
+class UrdfError(RobotFileError):
+    """A URDF file or text is refused: not XML, a DTD or entity declaration (refused outright), over the size or
+    joint bounds of :mod:`sweepik.urdf`, a broken tree (missing link, cycle, two roots, duplicate names), a bad
+    number, or a chain sweepik cannot model (mimic, floating or planar joints on it); the message names the file,
+    and the joint or link where there is one."""
 
 
 class UnknownRobotError(SweepikError, LookupError):
@@ -59,3 +68,8 @@ class PoseFileError(SweepikError):
 class NoReductionError(SweepikError):
     """No decomposition in sweepik's catalogue solves this arm (or not with the joint asked for as theta*); the
     message names the structure found and what a decomposition would need."""
+
+
+class LockedJointError(UnknownOptionError):
+    """A ``locked`` argument (``--lock``) names no joint of the arm, gives a value that is not a finite number or lies
+    outside the joint's limits, or leaves other than six joints to solve for (a 7-joint arm without ``locked``)."""

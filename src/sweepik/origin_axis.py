@@ -27,17 +27,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .chain import rotation_about
-from .errors import RobotDefinitionError, SweepikError
+from .errors import LockedJointError, RobotDefinitionError
 from .robot import Joint, Robot
 
-__all__ = ["origin_axis_form", "joint_origins", "hold_joints", "HeldJoints", "LockedJointError"]
+__all__ = ["origin_axis_form", "joint_origins", "hold_joints", "held_values", "HeldJoints"]
 
 Array = NDArray[np.float64]
-
-
-class LockedJointError(SweepikError):
-    """A ``locked`` argument names no joint of the arm, gives a value that is not a finite number (or lies outside
-    the joint's limits), or leaves other than six joints to solve for."""
 
 
 def _motion(axis: Array, revolute: bool, value: float) -> Array:

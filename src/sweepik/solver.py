@@ -16,7 +16,8 @@ from numpy.typing import ArrayLike, NDArray
 from . import fastcertify, fastsweep
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch
-from .errors import ShapeError, UnknownOptionError
+from .dedupe import finish, wrap_inside
+from .errors import LockedJointError, ShapeError, UnknownOptionError
 from .families import collapse_continua, families_of, off_families, unique_families
 from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
@@ -51,10 +52,6 @@ POLISH_ABOVE_REL = 1e-14
 POLISH_PAPER_ABOVE_REL = 5e-14
 #: Paper strategy: the paper's acceptance threshold J < 1e-5 mm (section 4).
 PAPER_ACCEPT_MM = 1e-5
-#: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
-DEDUPE_ANGLE = 1e-6
-#: ... and every prismatic joint within this times the arm's length scale.
-DEDUPE_LENGTH_REL = 1e-8
 #: Poses per chunk of ``solve_many``: bounds memory at (chunk x samples x branches) residuals.
 CHUNK = 2048
 
@@ -123,63 +120,23 @@ SNAP_ITERATIONS = 4
 def _snap_to_limits(robot: Robot, q: Array, err_geo: Array, err_paper: Array, target: Array, weight: float) -> None:
     """In place: certified configurations ``q (K, n)`` just outside the limits are clamped to them and polished
     with the clamped joints held; where that still certifies, it replaces them (with their errors)."""
-    w = robot.wrap(q)
+    w, inside = wrap_inside(robot, q)
+    out = np.nonzero(~inside)[0]
+    if out.size == 0:
+        return
+    w = w[out]
     reach = np.where(robot.is_revolute, SNAP_REACH, SNAP_REACH * robot.length_scale)
     over = np.maximum(robot.lower - robot.limit_tol - w, w - robot.upper - robot.limit_tol)
-    k = np.nonzero(np.any(over > 0, axis=-1) & np.all(over <= reach, axis=-1))[0]
+    near = np.all(over <= reach, axis=-1)
+    k, w, over = out[near], w[near], over[near]
     if k.size == 0:
         return
-    held = over[k] > 0
-    start = np.clip(w[k], robot.lower, robot.upper)
+    held = over > 0
+    start = np.clip(w, robot.lower, robot.upper)
     moved = polish(robot, start, target[k], weight, SNAP_ITERATIONS, fixed=held)
     eg, ep = _errors(robot, moved, target[k], weight)
     ok = (eg <= ACCEPT_TOL_REL * robot.length_scale) & robot.within_limits(moved)
     q[k[ok]], err_geo[k[ok]], err_paper[k[ok]] = moved[ok], eg[ok], ep[ok]
-
-
-def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:
-    """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one.
-
-    Candidates are sorted by pose and by their joint values rounded to 10x the tolerance; equal ones are
-    then at most ``_DEDUPE_WINDOW`` places apart, so each is compared with its next neighbours only.
-    """
-    K = q.shape[0]
-    keep = np.ones(K, dtype=bool)
-    if K == 0:
-        return keep
-    if K <= _DEDUPE_PAIRWISE:  # small sets (a single pose): all pairs at once, fewer array operations
-        tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
-        d = q[:, None, :] - q[None, :, :]
-        d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
-        same = np.all(d <= tol, axis=-1) & (pose_idx[:, None] == pose_idx[None, :])
-        idx = np.arange(K)
-        better = (err[None, :] < err[:, None]) | ((err[None, :] == err[:, None]) & (idx[None, :] < idx[:, None]))
-        return ~np.any(same & better, axis=1)
-    tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
-    keys = np.round(q / (10.0 * tol))
-    order = np.lexsort((*keys.T[::-1], pose_idx))
-    ps, qs, es = pose_idx[order], q[order], err[order]
-    drop = np.zeros(K, dtype=bool)
-    ks = keys[order, 0]
-    for w in range(1, min(_DEDUPE_WINDOW, K - 1) + 1):
-        # sorted by (pose, rounded first joint, ...): once no pair w apart shares pose and first key
-        # (within one rounding step), no pair further apart does
-        if not np.any((ps[w:] == ps[:-w]) & (ks[w:] - ks[:-w] <= 1)):
-            break
-        d = qs[w:] - qs[:-w]
-        d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
-        same = (ps[w:] == ps[:-w]) & np.all(d <= tol, axis=-1)
-        i = np.nonzero(same)[0]
-        worse_later = es[i + w] >= es[i]
-        drop[np.where(worse_later, i + w, i)] = True
-    keep[order] = ~drop
-    return keep
-
-
-#: Candidates compared by ``_dedupe`` on each side in sorted order (duplicates of one solution are few).
-_DEDUPE_WINDOW = 16
-#: Up to this many candidates, ``_dedupe`` compares all pairs directly.
-_DEDUPE_PAIRWISE = 48
 
 
 def _twin_copies(red: Reduction, cand: Candidates, spans: list[FamilySpan]) -> tuple[Candidates, list[FamilySpan]]:
@@ -336,10 +293,9 @@ def _solve_chunk(
                 err_paper = np.concatenate([err_paper, r_sol.error])
                 err_geo = np.concatenate([err_geo, r_sol.error_geodesic])
                 mult = np.concatenate([mult, r_sol.multiplicity])
-    q, inside = robot.wrapped_within_limits(q)
     # duplicates first (of twins, the one inside the limits is kept), so that limits=True is exactly
     # limits=False filtered by the limits
-    keep = _dedupe(robot, pose_idx, q, np.where(inside, err_geo, err_geo + robot.length_scale))
+    q, inside, keep = finish(robot, pose_idx, q, err_geo)
     if strategy == "precise":  # a numerical continuum of certified solutions is reported once
         keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
     n_reachable = np.bincount(pose_idx[keep], minlength=len(poses))
@@ -535,7 +491,7 @@ def _prepare(
     ``robot`` is the arm solved (with ``held``, the smaller arm; ``free_joint`` names a joint of the full one)."""
     _check_robot(robot)
     if held is None and robot.n_joints != 6:
-        raise UnknownOptionError(
+        raise LockedJointError(
             f"robot {robot.name!r} has {robot.n_joints} joints; sweepik solves six: "
             + (
                 f"hold {robot.n_joints - 6} of them with locked={{joint name: value}} (sweepik.analyze tells which "
