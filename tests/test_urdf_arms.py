@@ -95,3 +95,25 @@ def test_urdf_arm_through_the_cli(capsys: pytest.CaptureFixture[str], tmp_path: 
     assert err.count("\n") == 1 and "nosuchlink" in err
     assert main(["fk", "ur5", "0", "0", "0", "0", "0", "0", "--tip-link", "tool0"]) == 2
     assert "URDF" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        '<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">]>'
+        "<robot name='x'>&b;</robot>",
+        '<?xml version="1.0"?><!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]><robot name="x">&x;</robot>',
+        '<robot name="x"><link name="a"/><joint name="j" type="revolute"><parent link="zz"/><child link="a"/>'
+        '<limit lower="-1" upper="1"/></joint></robot>',
+        "<robot name='x'><link name='a'",
+    ],
+)
+def test_bad_urdf_through_the_cli(text: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from sweepik.cli import main
+
+    path = tmp_path / "bad.urdf"
+    path.write_text(text)
+    for argv in (["analyze", str(path)], ["solve", str(path), "--xyz", "0", "0", "0"], ["fk", str(path), "0"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(path) in err and "Traceback" not in err, err
