@@ -117,9 +117,13 @@ _DEDUPE_PAIRWISE = 48
 if AVAILABLE:
     import math
 
-    from numba import boolean, float64, int64, njit
+    from numba import boolean, float64, int64
 
-    @njit((float64[:, ::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean, boolean[::1]), cache=True)
+    from .reductions.kernels import lazy_njit
+
+    @lazy_njit(
+        (float64[:, ::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean, boolean[::1]), cache=True
+    )
     def _wrap_inside(q, rev, lower, upper, ltol, beyond, inside):  # pragma: no cover
         K, n = q.shape
         two_pi = 2.0 * math.pi
@@ -140,7 +144,7 @@ if AVAILABLE:
                     ok = False
             inside[k] = ok
 
-    @njit((int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True)
+    @lazy_njit((int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True)
     def _dedupe_compiled(pose, q, score, rev, tol, keep):  # pragma: no cover
         K, n = q.shape
         two_pi = 2.0 * math.pi

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
-from .reductions.kernels import first_class
+from .reductions.kernels import first_class, lazy_njit
 from .units import orientation_weight
 
 if TYPE_CHECKING:
@@ -140,14 +140,14 @@ if AVAILABLE:
         float64[::1],
     )
 
-    @njit(_CERTIFY_SIG, cache=True, parallel=True)
+    @lazy_njit(_CERTIFY_SIG, cache=True, parallel=True)
     def _certify_parallel(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper):
         for k in prange(pose.shape[0]):
             err_geo[k], err_paper[k] = _certify_one(
                 cfg, params, world, theta, branch, H, P, rev, R_end, weight, q, pose[k], k
             )
 
-    @njit(_CERTIFY_SIG, cache=True)
+    @lazy_njit(_CERTIFY_SIG, cache=True)
     def _certify_serial(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper):
         for k in range(pose.shape[0]):
             err_geo[k], err_paper[k] = _certify_one(
@@ -185,7 +185,7 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, 
 
 if AVAILABLE:
 
-    @njit((_CFG, float64[:, ::1], int64[::1], float64[::1], int64[::1], float64[:, ::1]), cache=True)
+    @lazy_njit((_CFG, float64[:, ::1], int64[::1], float64[::1], int64[::1], float64[:, ::1]), cache=True)
     def _configurations(cfg, params, pose, theta, branch, q):
         for k in range(pose.shape[0]):
             cfg(params[pose[k]], theta[k], branch[k], q[k])

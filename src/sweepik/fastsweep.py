@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import sweep as _ref
-from .reductions.kernels import first_class
+from .reductions.kernels import first_class, lazy_njit
 from .robot import Robot
 
 try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
@@ -470,12 +470,12 @@ if AVAILABLE:
         int64[::1],
     )
 
-    @njit(_SEARCH_SIG, cache=True, parallel=True)
+    @lazy_njit(_SEARCH_SIG, cache=True, parallel=True)
     def _search_parallel(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in prange(grid.shape[0]):
             _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
 
-    @njit(_SEARCH_SIG, cache=True)
+    @lazy_njit(_SEARCH_SIG, cache=True)
     def _search_serial(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in range(grid.shape[0]):
             _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)

@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
-from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, first_class
+from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, LazyKernel, first_class, lazy_njit
 from .position import angle, motion, place, reduce_chain
 
 Array = NDArray[np.float64]
@@ -333,17 +333,18 @@ def _no_residual(p, x, branch):
     return 0.0
 
 
-pair_residual = njit(RESIDUAL_SIG, cache=True)(_pair_residual)
-pair_configuration = njit(CONFIGURATION_SIG, cache=True)(_pair_configuration)
-pair_margin = njit(RESIDUAL_SIG, cache=True)(_pair_margin)
+pair_residual = LazyKernel(_pair_residual, RESIDUAL_SIG, cache=True)
+pair_configuration = LazyKernel(_pair_configuration, CONFIGURATION_SIG, cache=True)
+pair_margin = LazyKernel(_pair_margin, RESIDUAL_SIG, cache=True)
 
 
+@njit(cache=True)
 def _amplitude(p, x, k):
     """Amplitude of step k (``_step``)."""
     return _step(p, x, k)[1]
 
 
-amplitude = njit(RESIDUAL_SIG, cache=True)(_amplitude)
+amplitude = LazyKernel(_amplitude.py_func, RESIDUAL_SIG, cache=True)  # for the engine; compiled code calls _amplitude
 
 #: Swing hints: up to this many local minima of each step's amplitude per pose, ...
 SWING_MINIMA = 4
@@ -369,18 +370,18 @@ def _swing_pose(params, lo, hi, n, periodic, ks, out, i):
     cnt = 0
     for k in ks:
         found = 0
-        xm, am = lo[i] - h, amplitude(p, lo[i] - h, k)
-        x0, a0 = lo[i], amplitude(p, lo[i], k)
+        xm, am = lo[i] - h, _amplitude(p, lo[i] - h, k)
+        x0, a0 = lo[i], _amplitude(p, lo[i], k)
         for j in range(1, n + 2):
             x1 = lo[i] + j * h
-            a1 = amplitude(p, x1, k)
+            a1 = _amplitude(p, x1, k)
             # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
             # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
             deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
             if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
                 a, b = xm, x1
                 c, d = b - g * (b - a), a + g * (b - a)
-                fc, fd = amplitude(p, c, k), amplitude(p, d, k)
+                fc, fd = _amplitude(p, c, k), _amplitude(p, d, k)
                 for _ in range(SWING_GOLDEN):
                     # located well enough: the bracket is a small part of the window it centres
                     fm = min(fc, fd)
@@ -390,13 +391,13 @@ def _swing_pose(params, lo, hi, n, periodic, ks, out, i):
                     if fc < fd:
                         b, d, fd = d, c, fc
                         c = b - g * (b - a)
-                        fc = amplitude(p, c, k)
+                        fc = _amplitude(p, c, k)
                     else:
                         a, c, fc = c, d, fd
                         d = a + g * (b - a)
-                        fd = amplitude(p, d, k)
+                        fd = _amplitude(p, d, k)
                 xs = 0.5 * (a + b)
-                rs = amplitude(p, xs, k)
+                rs = _amplitude(p, xs, k)
                 slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
                 if slope > 0.0 and rs < slope * h:
                     w = rs / slope
@@ -436,9 +437,9 @@ def swing_hints(params, lo, hi, n, periodic, ks, out):
     run(params, lo, hi, n, periodic, ks, out)
 
 
-wrist_residual = njit(RESIDUAL_SIG, cache=True)(_no_residual)
-wrist_configuration = njit(CONFIGURATION_SIG, cache=True)(_wrist_configuration)
-parallel_configuration = njit(CONFIGURATION_SIG, cache=True)(_parallel_configuration)
+wrist_residual = LazyKernel(_no_residual, RESIDUAL_SIG, cache=True)
+wrist_configuration = LazyKernel(_wrist_configuration, CONFIGURATION_SIG, cache=True)
+parallel_configuration = LazyKernel(_parallel_configuration, CONFIGURATION_SIG, cache=True)
 
 
 # Kernels enter as first-class functions (``kernels.first_class``) through an explicit signature: compiled once
@@ -461,13 +462,13 @@ _CONFIGURE_SIG = (
 )
 
 
-@njit(_EVALUATE_SIG, cache=True)
+@lazy_njit(_EVALUATE_SIG, cache=True)
 def _evaluate(res, params, pose, theta, branch, out):
     for k in range(pose.shape[0]):
         out[k] = res(params[pose[k]], theta[k], branch[k])
 
 
-@njit(_CONFIGURE_SIG, cache=True)
+@lazy_njit(_CONFIGURE_SIG, cache=True)
 def _configure(cfg, params, pose, theta, branch, out):
     for k in range(pose.shape[0]):
         cfg(params[pose[k]], theta[k], branch[k], out[k])

@@ -77,8 +77,42 @@ if _njit is not None:
     _elbow = _njit(cache=True)(_elbow)
     _d1_position = _njit(cache=True)(_d1_position)
     _elbow_residual = _njit(cache=True)(_elbow_residual)
-    carm_d1_residual = _njit(RESIDUAL_SIG, cache=True)(_carm_d1)
-    carm_theta2_residual = _njit(RESIDUAL_SIG, cache=True)(_carm_theta2)
+
+
+class LazyKernel:
+    """A Numba function with one explicit signature, compiled (or loaded from the disk cache) on first use instead
+    of at import: a process loads only the kernels its arms need (each takes 10-100 ms to load from the cache).
+
+    Call it like the compiled function; :func:`first_class` takes it like a dispatcher. Only for functions called
+    from Python (compiled code needs the dispatcher itself).
+    """
+
+    def __init__(self, fn: Any, sig: Any, **options: Any) -> None:
+        self.py_func, self._sig, self._options = fn, sig, options
+        self._dispatcher: Any = None
+
+    @property
+    def dispatcher(self) -> Any:
+        if self._dispatcher is None:
+            self._dispatcher = _njit(self._sig, **self._options)(self.py_func)
+        return self._dispatcher
+
+    def __call__(self, *args: Any) -> Any:
+        return self.dispatcher(*args)
+
+
+def lazy_njit(sig: Any, **options: Any) -> Any:
+    """Decorator: :class:`LazyKernel` of the function, with ``sig`` and Numba's ``options`` (e.g. ``cache=True``)."""
+    return lambda fn: LazyKernel(fn, sig, **options)
+
+
+carm_d1_residual: Any
+carm_theta2_residual: Any
+carm_d1_configuration: Any
+carm_theta2_configuration: Any
+if _njit is not None:
+    carm_d1_residual = LazyKernel(_carm_d1, RESIDUAL_SIG, cache=True)
+    carm_theta2_residual = LazyKernel(_carm_theta2, RESIDUAL_SIG, cache=True)
 else:  # pragma: no cover
     carm_d1_residual, carm_theta2_residual = _carm_d1, _carm_theta2
 
@@ -96,8 +130,9 @@ def first_class(fn: Any) -> Any:
     if wap is None:
         from numba import types
 
-        (sig,) = fn.nopython_signatures
-        cres = fn.overloads[sig.args]
+        disp = fn.dispatcher if isinstance(fn, LazyKernel) else fn
+        (sig,) = disp.nopython_signatures
+        cres = disp.overloads[sig.args]
         address = cres.library.get_pointer_to_function(cres.fndesc.llvm_cfunc_wrapper_name)
 
         class _Kernel:
@@ -164,7 +199,7 @@ def _carm_theta2_configuration(p, x: float, b: int, out) -> None:
 
 if _njit is not None:
     _carm_configuration = _njit(cache=True)(_carm_configuration)
-    carm_d1_configuration = _njit(CONFIGURATION_SIG, cache=True)(_carm_d1_configuration)
-    carm_theta2_configuration = _njit(CONFIGURATION_SIG, cache=True)(_carm_theta2_configuration)
+    carm_d1_configuration = LazyKernel(_carm_d1_configuration, CONFIGURATION_SIG, cache=True)
+    carm_theta2_configuration = LazyKernel(_carm_theta2_configuration, CONFIGURATION_SIG, cache=True)
 else:  # pragma: no cover
     carm_d1_configuration, carm_theta2_configuration = _carm_d1_configuration, _carm_theta2_configuration
