@@ -88,7 +88,7 @@ def _add_robot_options(p: argparse.ArgumentParser, lock: bool = False) -> None:
     p.add_argument(
         "--tip-link",
         metavar="LINK",
-        help="URDF robot: tip link of the chain (default: the child link of the last moving joint)",
+        help="URDF robot: tip link of the chain (default: after the last moving joint, up to where the tree branches)",
     )
     if lock:
         p.add_argument(

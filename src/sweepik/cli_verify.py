@@ -11,15 +11,16 @@ from .cli_common import (
     DEFAULT_ROBOT,
     CliInputError,
     _add_json,
+    _add_robot_options,
     _check_output_path,
     _count,
+    _load_robot,
     _nonnegative_int,
     _print_json,
     _Progress,
     _subparser,
     _SubParsers,
 )
-from .robot_file import load_robot
 
 #: Largest --offgrid: every off-grid pose's solutions are kept for the statistics (~8 kB each).
 MAX_OFFGRID = 1_000_000
@@ -53,6 +54,7 @@ def add_verify_parser(sub: _SubParsers) -> None:
     p.add_argument("--seed", type=_nonnegative_int, default=0, help="seed of the off-grid poses (default 0)")
     p.add_argument("--report", metavar="DIR", help="write a Markdown report with PNG figures into DIR")
     p.add_argument("--json", metavar="FILE", help="write the results as JSON to FILE ('-' for standard output)")
+    _add_robot_options(p)
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
@@ -64,7 +66,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
             raise CliInputError(f"--report {args.report}: the figures need matplotlib: pip install 'sweepik[plot]'")
     if args.json and args.json != "-":
         _check_output_path(args.json)
-    robot = load_robot(args.robot)
+    robot = _load_robot(args.robot, args)
     progress = _Progress()
     try:
         result = run_verify(robot, args.strategy, offgrid=args.offgrid, seed=args.seed, progress=progress)
