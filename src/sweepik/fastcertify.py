@@ -37,74 +37,102 @@ if AVAILABLE:
     _CFG = types.FunctionType(CONFIGURATION_SIG)
 
     @njit(cache=True)
-    def _poe_fk(H, P, rev, R_end, q, T):
-        """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain into ``T (4, 4)``
-        (explicit loops: no BLAS)."""
-        R = np.eye(3)
-        Rn = np.empty((3, 3))
-        p = P[0].copy()
+    def _poe_fk(H, P, rev, R_end, q):
+        """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain as 12 scalars (rotation
+        row by row, then position): scalar locals only, no array allocated (this runs once per candidate)."""
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+        px, py, pz = P[0, 0], P[0, 1], P[0, 2]
         for i in range(H.shape[0]):
+            kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
             if rev[i]:
-                kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
                 c, s = math.cos(q[i]), math.sin(q[i])
                 v = 1.0 - c
                 k00, k01, k02 = c + kx * kx * v, kx * ky * v - kz * s, kx * kz * v + ky * s
                 k10, k11, k12 = ky * kx * v + kz * s, c + ky * ky * v, ky * kz * v - kx * s
                 k20, k21, k22 = kz * kx * v - ky * s, kz * ky * v + kx * s, c + kz * kz * v
-                for r in range(3):
-                    a0, a1, a2 = R[r, 0], R[r, 1], R[r, 2]
-                    Rn[r, 0] = a0 * k00 + a1 * k10 + a2 * k20
-                    Rn[r, 1] = a0 * k01 + a1 * k11 + a2 * k21
-                    Rn[r, 2] = a0 * k02 + a1 * k12 + a2 * k22
-                R[:, :] = Rn
+                r00, r01, r02 = (
+                    r00 * k00 + r01 * k10 + r02 * k20,
+                    r00 * k01 + r01 * k11 + r02 * k21,
+                    r00 * k02 + r01 * k12 + r02 * k22,
+                )
+                r10, r11, r12 = (
+                    r10 * k00 + r11 * k10 + r12 * k20,
+                    r10 * k01 + r11 * k11 + r12 * k21,
+                    r10 * k02 + r11 * k12 + r12 * k22,
+                )
+                r20, r21, r22 = (
+                    r20 * k00 + r21 * k10 + r22 * k20,
+                    r20 * k01 + r21 * k11 + r22 * k21,
+                    r20 * k02 + r21 * k12 + r22 * k22,
+                )
             else:
-                for r in range(3):
-                    p[r] += (R[r, 0] * H[i, 0] + R[r, 1] * H[i, 1] + R[r, 2] * H[i, 2]) * q[i]
-            for r in range(3):
-                p[r] += R[r, 0] * P[i + 1, 0] + R[r, 1] * P[i + 1, 1] + R[r, 2] * P[i + 1, 2]
-        for r in range(3):
-            for c2 in range(3):
-                T[r, c2] = R[r, 0] * R_end[0, c2] + R[r, 1] * R_end[1, c2] + R[r, 2] * R_end[2, c2]
-            T[r, 3] = p[r]
-            T[3, r] = 0.0
-        T[3, 3] = 1.0
+                d = q[i]
+                px += (r00 * kx + r01 * ky + r02 * kz) * d
+                py += (r10 * kx + r11 * ky + r12 * kz) * d
+                pz += (r20 * kx + r21 * ky + r22 * kz) * d
+            ax, ay, az = P[i + 1, 0], P[i + 1, 1], P[i + 1, 2]
+            px += r00 * ax + r01 * ay + r02 * az
+            py += r10 * ax + r11 * ay + r12 * az
+            pz += r20 * ax + r21 * ay + r22 * az
+        e = R_end
+        return (
+            r00 * e[0, 0] + r01 * e[1, 0] + r02 * e[2, 0],
+            r00 * e[0, 1] + r01 * e[1, 1] + r02 * e[2, 1],
+            r00 * e[0, 2] + r01 * e[1, 2] + r02 * e[2, 2],
+            r10 * e[0, 0] + r11 * e[1, 0] + r12 * e[2, 0],
+            r10 * e[0, 1] + r11 * e[1, 1] + r12 * e[2, 1],
+            r10 * e[0, 2] + r11 * e[1, 2] + r12 * e[2, 2],
+            r20 * e[0, 0] + r21 * e[1, 0] + r22 * e[2, 0],
+            r20 * e[0, 1] + r21 * e[1, 1] + r22 * e[2, 1],
+            r20 * e[0, 2] + r21 * e[1, 2] + r22 * e[2, 2],
+            px,
+            py,
+            pz,
+        )
 
     @njit(cache=True)
     def _wrap(x):
         return math.pi - ((math.pi - x) % (2.0 * math.pi))
 
     @njit(cache=True)
-    def _zyz(R):
-        r13, r23, r33, r31, r32 = R[0, 2], R[1, 2], R[2, 2], R[2, 0], R[2, 1]
-        sb = math.hypot(r31, r32)
-        beta = math.atan2(sb, r33)
-        alpha = math.atan2(r23, r13)
+    def _zyz(r00, r01, r02, r10, r11, r12, r20, r21, r22):
+        """Z-Y-Z angles of a rotation given by its entries, as pose.zyz_from_matrix."""
+        sb = math.hypot(r20, r21)
+        beta = math.atan2(sb, r22)
+        alpha = math.atan2(r12, r02)
         if sb <= _EXACT_GIMBAL:  # as pose.zyz_from_matrix: alpha = 0, beta keeps its value
             alpha = 0.0
-            if r33 > 0:
-                gamma = math.atan2(-R[0, 1], R[0, 0])
+            if r22 > 0:
+                gamma = math.atan2(-r01, r00)
             else:
-                gamma = math.atan2(R[0, 1], -R[0, 0])
+                gamma = math.atan2(r01, -r00)
         else:
             ca, sa = math.cos(alpha), math.sin(alpha)
-            gamma = math.atan2(ca * R[1, 0] - sa * R[0, 0], ca * R[1, 1] - sa * R[0, 1])
+            gamma = math.atan2(ca * r10 - sa * r00, ca * r11 - sa * r01)
         return _wrap(alpha), beta, _wrap(gamma)
 
     @njit(cache=True)
     def _errors(T, Td, weight):
-        dp = math.sqrt((T[0, 3] - Td[0, 3]) ** 2 + (T[1, 3] - Td[1, 3]) ** 2 + (T[2, 3] - Td[2, 3]) ** 2)
-        # geodesic: angle of Td^T T
-        M = np.empty((3, 3))
-        for i in range(3):
-            for j in range(3):
-                M[i, j] = Td[0, i] * T[0, j] + Td[1, i] * T[1, j] + Td[2, i] * T[2, j]
-        vx, vy, vz = M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]
-        ang = math.atan2(0.5 * math.sqrt(vx * vx + vy * vy + vz * vz), 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0))
+        """(geodesic error, paper J) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``."""
+        r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
+        dp = math.sqrt((px - Td[0, 3]) ** 2 + (py - Td[1, 3]) ** 2 + (pz - Td[2, 3]) ** 2)
+        # geodesic: angle of M = Td^T R (only its trace and skew part are needed)
+        m00 = Td[0, 0] * r00 + Td[1, 0] * r10 + Td[2, 0] * r20
+        m11 = Td[0, 1] * r01 + Td[1, 1] * r11 + Td[2, 1] * r21
+        m22 = Td[0, 2] * r02 + Td[1, 2] * r12 + Td[2, 2] * r22
+        m21 = Td[0, 2] * r01 + Td[1, 2] * r11 + Td[2, 2] * r21
+        m12 = Td[0, 1] * r02 + Td[1, 1] * r12 + Td[2, 1] * r22
+        m02 = Td[0, 0] * r02 + Td[1, 0] * r12 + Td[2, 0] * r22
+        m20 = Td[0, 2] * r00 + Td[1, 2] * r10 + Td[2, 2] * r20
+        m10 = Td[0, 1] * r00 + Td[1, 1] * r10 + Td[2, 1] * r20
+        m01 = Td[0, 0] * r01 + Td[1, 0] * r11 + Td[2, 0] * r21
+        vx, vy, vz = m21 - m12, m02 - m20, m10 - m01
+        ang = math.atan2(0.5 * math.sqrt(vx * vx + vy * vy + vz * vz), 0.5 * (m00 + m11 + m22 - 1.0))
         geo = dp + weight * ang
         if geo > J_CUTOFF_FACTOR * weight:  # far from a solution: the paper's J is not needed
             return geo, np.inf
-        a, b, g = _zyz(T)
-        ad, bd, gd = _zyz(Td)
+        a, b, g = _zyz(r00, r01, r02, r10, r11, r12, r20, r21, r22)
+        ad, bd, gd = _zyz(Td[0, 0], Td[0, 1], Td[0, 2], Td[1, 0], Td[1, 1], Td[1, 2], Td[2, 0], Td[2, 1], Td[2, 2])
         da, db, dg = _wrap(a - ad), b - bd, _wrap(g - gd)
         if b < GIMBAL_TOL or bd < GIMBAL_TOL:
             da, dg = 0.0, _wrap((a + g) - (ad + gd))
@@ -117,11 +145,10 @@ if AVAILABLE:
     def _certify_one(cfg, params, world, theta, branch, H, P, rev, R_end, weight, q, i, k):
         """Configuration of candidate k (pose i) into q[k]; returns (geodesic error, paper J)."""
         cfg(params[i], theta[k], branch[k], q[k])
-        if not np.all(np.isfinite(q[k])):
-            return np.inf, np.inf
-        T = np.empty((4, 4))
-        _poe_fk(H, P, rev, R_end, q[k], T)
-        return _errors(T, world[i], weight)
+        for j in range(q.shape[1]):
+            if not math.isfinite(q[k, j]):
+                return np.inf, np.inf
+        return _errors(_poe_fk(H, P, rev, R_end, q[k]), world[i], weight)
 
     _CERTIFY_SIG = (
         _CFG,
