@@ -113,6 +113,7 @@ def test_bench_runs_small(capsys: pytest.CaptureFixture[str], monkeypatch: pytes
     out = json.loads(capsys.readouterr().out)
     assert out["grid_precise"]["poses"] == 100 and out["single_pose"]["poses"] == 20
     assert out["grid_precise"]["us_per_pose"] > 0
+    assert out["startup"]["import_s"] > 0 and out["startup"]["first_solve_s"] > 0
     # then every bundled arm, each with its plan, times and the targets it misses
     assert set(out["arms"]) == set(sweepik.bundled_robots())
     for row in out["arms"].values():
