@@ -263,3 +263,44 @@ def test_cli_lock_and_convert(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert six.n_joints == 6 and np.abs(six.fk(np.delete(q, 6)) - panda.fk(q)).max() < 1e-12
     run = _cli("convert", "franka_panda", "-o", str(tmp_path / "x.txt"))
     assert run.returncode == 2 and "toml or .urdf" in run.stderr
+
+
+def test_locked_value_on_a_joint_turning_more_than_once_is_kept() -> None:
+    """A joint with limits beyond +-pi: 4 rad and 4 - 2 pi are two configurations; the one asked for is held."""
+    base = origin_axis_form(sweepik.load_robot("puma560"))
+    extra = Joint("revolute", lower=-2 * np.pi, upper=2 * np.pi, name="extra", origin=tuple(map(tuple, np.eye(4))))
+    robot = Robot("p7", (*base.joints, extra), dh_convention="none", T_flange_tool=base.T_flange_tool)
+    q = np.array([0.3, -0.5, 0.4, 0.2, 0.6, -0.3, 4.0])
+    sols = sweepik.solve(robot, robot.fk(q), locked={"extra": 4.0})
+    assert len(sols) and np.all(sols.q[:, 6] == 4.0)
+    assert recovers(robot, sols, q)
+    # outside the limits, an angle is taken modulo 2 pi into them; beyond the configuration bound it is refused
+    v = hold_joints(robot, {6: 4.0 + 2 * np.pi}).held[0][1]
+    assert abs(v) <= 2 * np.pi and np.cos(v - 4.0) == pytest.approx(1.0)
+    with pytest.raises(LockedJointError, match="magnitude"):
+        hold_joints(robot, {6: 1e300})
+
+
+def test_lock_option_names_with_equals_sign(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    base = origin_axis_form(sweepik.load_robot("puma560"))
+    extra = Joint("revolute", lower=-2.0, upper=2.0, name="a=b", origin=tuple(map(tuple, np.eye(4))))
+    robot = Robot("p7", (*base.joints, extra), dh_convention="none", T_flange_tool=base.T_flange_tool)
+    path = tmp_path / "p7.toml"
+    path.write_text(robot_to_toml(robot))
+    q = np.array([0.3, -0.5, 0.4, 0.2, 0.6, -0.3, 0.5])
+    matrix = [repr(float(v)) for v in robot.fk(q).ravel()]
+    assert main(["solve", str(path), "--matrix", *matrix, "--lock", "a=b=0.5", "--rad", "--json"]) == 0
+    found = np.array(json.loads(capsys.readouterr().out)["poses"][0]["q"])
+    assert np.min(np.abs(found - q).max(axis=1)) < 1e-9
+
+
+def test_writers_escape_names(tmp_path: Path) -> None:
+    base = origin_axis_form(sweepik.load_robot("ur5"))
+    names = ["new\nline", "cr\rx", "del\x7f", 'q"uote', "back\\slash", "tab\t", "ü€"]
+    joints = tuple(
+        Joint(j.type, lower=j.lower, upper=j.upper, name=n, origin=j.origin, axis=j.axis)
+        for j, n in zip(base.joints, names, strict=False)
+    )
+    robot = Robot("weird\nname", joints, dh_convention="none", T_flange_tool=base.T_flange_tool, description="a\nb")
+    back = _parse(robot_to_toml(robot), "weird.toml")
+    assert back.joint_names == robot.joint_names and back.name == robot.name and back.description == "a\nb"

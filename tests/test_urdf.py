@@ -401,6 +401,19 @@ def test_off_chain_joints_are_ignored() -> None:
     assert r.joint_names == ["j1"]
 
 
+def test_unknown_or_multibyte_encoding_declaration_refused() -> None:
+    for enc in ("x-bogus", "utf-32"):
+        doc = f'<?xml version="1.0" encoding="{enc}"?>' + _two_joints()
+        _refused(lambda doc=doc: robot_from_urdf(doc.encode("latin-1"), SOURCE), "encoding")
+
+
+def test_attribute_flood_refused_fast() -> None:
+    """One element with 300,000 attributes (3.5 MiB, few '<'): refused before the parser hands them to Python."""
+    attrs = " ".join(f"a{i:x}='1'" for i in range(300_000))
+    doc = f'<robot name="t"><link name="a" {attrs}/></robot>'
+    _refused(lambda: robot_from_urdf(doc, SOURCE), "'='")
+
+
 def test_text_encoding_and_declarations() -> None:
     text = _two_joints().replace('name="t"', 'name="bräu"')
     declared = '<?xml version="1.0" encoding="ISO-8859-1"?>\n' + text

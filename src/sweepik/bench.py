@@ -163,10 +163,11 @@ def run_bench(
     arms: bool = True,
     batch: int = 2000,
 ) -> dict[str, Any]:
-    """The C-Arm's four benchmarks and the start-up of a new process (:func:`bench_startup`), then (``arms``) :func:`bench_arms` on every bundled arm with ``batch`` poses
-    per batched run, ``min(single, 300)`` single poses and ``min(memory, 10,000)`` poses for peak memory. Sizes
-    can be reduced for a quick look (0 skips a benchmark). ``progress(stage, done, total)`` is called as they
-    advance (a memory benchmark, one child process, reports only its start and end).
+    """The C-Arm's four benchmarks and the start-up of a new process (:func:`bench_startup`), then (``arms``)
+    :func:`bench_arms` on every bundled arm with ``batch`` poses per batched run, ``min(single, 300)`` single poses
+    and ``min(memory, 10,000)`` poses for peak memory. Sizes can be reduced for a quick look (0 skips a benchmark).
+    ``progress(stage, done, total)`` is called as they advance (a memory benchmark, one child process, reports only
+    its start and end).
     """
     report = progress or _no_progress
     result: dict[str, Any] = {"grid_precise": bench_grid(repeats, report)}

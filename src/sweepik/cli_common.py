@@ -97,8 +97,8 @@ def _add_robot_options(p: argparse.ArgumentParser, lock: bool = False) -> None:
             metavar="NAME=VALUE",
             help=(
                 "hold a joint at a value (degrees for revolute joints, radians with --rad; length unit for "
-                "prismatic ones), the joint by name or number from 1; repeatable. A 7-joint arm is solved with "
-                "one joint locked ('sweepik analyze' tells which lock gives a closed form or a sweep)"
+                "prismatic ones), the joint by name (first) or number from 1; repeatable. A 7-joint arm is solved "
+                "with one joint locked ('sweepik analyze' tells which lock gives a closed form or a sweep)"
             ),
         )
 
@@ -116,15 +116,16 @@ def _locked_from_args(robot: Robot, args: argparse.Namespace) -> dict[int, float
     rad = bool(getattr(args, "rad", False))
     out: dict[int, float] = {}
     for item in items:
-        name, sep, text = item.partition("=")
-        name = name.strip()
-        if not sep or not name:
+        name, sep, text = item.rpartition("=")  # the value holds no '=', a joint name may
+        if not sep or not name.strip():
             raise CliInputError(
                 f"--lock takes NAME=VALUE (a joint name or number from 1, then its value), got {item!r}"
             )
-        if name in robot.joint_names:
+        if name not in robot.joint_names:
+            name = name.strip()
+        if name in robot.joint_names:  # a joint's name before a joint number
             k = robot.joint_names.index(name)
-        elif name.isdecimal() and 1 <= int(name) <= robot.n_joints:
+        elif name.isascii() and name.isdecimal() and 1 <= int(name) <= robot.n_joints:
             k = int(name) - 1
         else:
             raise CliInputError(

@@ -71,47 +71,55 @@ def finish(
 
 
 def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:
-    """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one (the reference).
+    """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one, ties going to
+    the earlier candidate (the reference of the compiled ``_dedupe_compiled``: every pair of a pose compared).
 
-    Candidates are sorted by pose and by their joint values rounded to 10x the tolerance; equal ones are
-    then at most ``_DEDUPE_WINDOW`` places apart, so each is compared with its next neighbours only.
+    Poses with at most ``_SMALL_GROUP`` candidates (almost all) are compared together, padded to that size; a pose
+    with more (a numerical continuum) on its own, a block of rows at a time so that memory stays bounded.
     """
-    K = q.shape[0]
+    K, n = q.shape
     keep = np.ones(K, dtype=bool)
     if K == 0:
         return keep
     tol = _tolerance(robot)
-    if K <= _DEDUPE_PAIRWISE:  # small sets (a single pose): all pairs at once, fewer array operations
-        d = q[:, None, :] - q[None, :, :]
-        d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
-        same = np.all(d <= tol, axis=-1) & (pose_idx[:, None] == pose_idx[None, :])
-        idx = np.arange(K)
-        better = (err[None, :] < err[:, None]) | ((err[None, :] == err[:, None]) & (idx[None, :] < idx[:, None]))
-        return ~np.any(same & better, axis=1)
-    keys = np.round(q / (10.0 * tol))
-    order = np.lexsort((*keys.T[::-1], pose_idx))
-    ps, qs, es = pose_idx[order], q[order], err[order]
-    drop = np.zeros(K, dtype=bool)
-    ks = keys[order, 0]
-    for w in range(1, min(_DEDUPE_WINDOW, K - 1) + 1):
-        # sorted by (pose, rounded first joint, ...): once no pair w apart shares pose and first key
-        # (within one rounding step), no pair further apart does
-        if not np.any((ps[w:] == ps[:-w]) & (ks[w:] - ks[:-w] <= 1)):
-            break
-        d = qs[w:] - qs[:-w]
-        d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
-        same = (ps[w:] == ps[:-w]) & np.all(d <= tol, axis=-1)
-        i = np.nonzero(same)[0]
-        worse_later = es[i + w] >= es[i]
-        drop[np.where(worse_later, i + w, i)] = True
-    keep[order] = ~drop
+    order = np.argsort(pose_idx, kind="stable")
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(pose_idx[order])) + 1])
+    sizes = np.diff(np.concatenate([starts, [K]]))
+    small = np.nonzero((sizes > 1) & (sizes <= _SMALL_GROUP))[0]
+    if small.size:
+        # (G, m) candidate indices, padded with -1
+        col = np.arange(_SMALL_GROUP)
+        idx = np.where(col < sizes[small, None], order[np.minimum(starts[small, None] + col, K - 1)], -1)
+        keep[idx[idx >= 0]] = _keep_pairwise(robot, q, err, idx, idx, tol)[idx >= 0]
+    for g in np.nonzero(sizes > _SMALL_GROUP)[0]:
+        members = order[starts[g] : starts[g] + sizes[g]]
+        rows = max(1, _BLOCK_ELEMENTS // (members.size * n))
+        for b in range(0, members.size, rows):
+            keep[members[b : b + rows]] = _keep_pairwise(
+                robot, q, err, members[None, b : b + rows], members[None], tol
+            )[0]
     return keep
 
 
-#: Candidates compared by ``_dedupe`` on each side in sorted order (duplicates of one solution are few).
-_DEDUPE_WINDOW = 16
-#: Up to this many candidates, ``_dedupe`` compares all pairs directly.
-_DEDUPE_PAIRWISE = 48
+def _keep_pairwise(robot: Robot, q: Array, err: Array, rows: NDArray[np.intp], cols: NDArray[np.intp], tol: Array):
+    """``(G, r)``: candidate ``rows[g, i]`` has no better equal among ``cols[g]`` (index -1: padding, never equal)."""
+    d = q[rows][:, :, None, :] - q[cols][:, None, :, :]
+    d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
+    same = (
+        np.all(d <= tol, axis=-1)
+        & (rows[:, :, None] >= 0)
+        & (cols[:, None, :] >= 0)
+        & (rows[:, :, None] != cols[:, None, :])
+    )
+    er, ec = err[rows][:, :, None], err[cols][:, None, :]
+    better = (ec < er) | ((ec == er) & (cols[:, None, :] < rows[:, :, None]))
+    return ~np.any(same & better, axis=-1)
+
+
+#: Poses with at most this many candidates are compared together in ``_dedupe`` (padded arrays).
+_SMALL_GROUP = 32
+#: Elements (rows x candidates x joints) of one block of a large pose's comparison in ``_dedupe``.
+_BLOCK_ELEMENTS = 1 << 22
 
 
 if AVAILABLE:

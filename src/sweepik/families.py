@@ -309,6 +309,8 @@ MAX_ISOLATED_SOLUTIONS = 16
 #: paper's 100 mm per radian, see ``trajectory.weighted_joint_distance``) are linked; each linked group is
 #: reported once, by its medoid: the pose pins these solutions down no better than the group's extent.
 CONTINUUM_LINK = 0.05
+#: A pose with more solutions than this is thinned to one per grid cell before they are linked (bounded memory).
+CONTINUUM_THIN = 1024
 
 
 def collapse_continua(robot: Robot, pose: NDArray[np.intp], q: Array) -> NDArray[np.bool_]:
@@ -321,6 +323,13 @@ def collapse_continua(robot: Robot, pose: NDArray[np.intp], q: Array) -> NDArray
     scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
     for i in np.nonzero(counts > MAX_ISOLATED_SOLUTIONS)[0]:
         idx = np.nonzero(pose == i)[0]
+        if idx.size > CONTINUUM_THIN:
+            # thousands of points along a continuum: one per cell of a grid fine enough that the points of a cell
+            # are linked anyway (memory of the comparison below grows with the square of the count)
+            cell = CONTINUUM_LINK / (2.0 * np.sqrt(q.shape[1]))
+            _, first = np.unique(np.floor(q[idx] * scale / cell), axis=0, return_index=True)
+            keep[idx] = False
+            idx = idx[np.sort(first)]
         d = q[idx][:, None, :] - q[idx][None, :, :]
         d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
         dist = np.linalg.norm(d * scale, axis=-1)

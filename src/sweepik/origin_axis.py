@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._validate import MAX_JOINT_VALUE
 from .chain import rotation_about
 from .errors import LockedJointError, RobotDefinitionError
 from .robot import Joint, Robot
@@ -143,7 +144,9 @@ def held_values(robot: Robot, locked: Mapping[Any, Any]) -> tuple[tuple[int, flo
     """``locked`` (joint name or index -> value) checked against ``robot``: ``((index, value), ...)`` sorted.
 
     A value must be a finite number inside the joint's limits (with the solver's limit tolerance): a solution
-    holding a joint outside its range would not be a solution the arm can reach.
+    holding a joint outside its range would not be a solution the arm can reach. A value inside the limits is kept
+    as given (a joint turning more than once: 4 rad is not -2.28 rad); a revolute value outside them is taken
+    modulo 2 pi into them when it can be.
     """
     if not isinstance(locked, Mapping):
         raise LockedJointError(
@@ -157,10 +160,14 @@ def held_values(robot: Robot, locked: Mapping[Any, Any]) -> tuple[tuple[int, flo
         if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
             raise LockedJointError(f"locked: joint {robot.joint_names[k]!r} needs a number, got {value!r}")
         v = float(value)
-        if not math.isfinite(v):
-            raise LockedJointError(f"locked: joint {robot.joint_names[k]!r} needs a finite value, got {v!r}")
+        if not (math.isfinite(v) and abs(v) <= MAX_JOINT_VALUE):
+            raise LockedJointError(
+                f"locked: joint {robot.joint_names[k]!r} needs a finite value of magnitude at most "
+                f"{MAX_JOINT_VALUE:g}, got {v!r}"
+            )
         tol = float(robot.limit_tol[k])
-        if robot.is_revolute[k]:
+        inside = robot.lower[k] - tol <= v <= robot.upper[k] + tol
+        if robot.is_revolute[k] and not inside:  # an angle given modulo 2 pi: its turn inside the limits
             v = float(robot.wrap(np.where(np.arange(robot.n_joints) == k, v, 0.0))[k])
         if not robot.lower[k] - tol <= v <= robot.upper[k] + tol:
             unit = "rad" if robot.is_revolute[k] else robot.length_unit
@@ -216,7 +223,8 @@ def _hold(robot: Robot, held: tuple[tuple[int, float], ...]) -> HeldJoints:
                 axis=tuple(axes[k]),
             )
         )
-    label = ", ".join(f"{robot.joint_names[k]}={v:.6g}" for k, v in held)
+    units = ["rad" if r else robot.length_unit for r in robot.is_revolute]
+    label = ", ".join(f"{robot.joint_names[k]}={v:.6g} {units[k]}" for k, v in held)
     try:
         arm = Robot(
             name=f"{robot.name} ({label} locked)",

@@ -542,7 +542,9 @@ def _held_free_joint(held: HeldJoints, free_joint: object) -> int | str:
     """A free joint of the full arm (index or name) as a joint of the held arm."""
     full = held.robot
     if isinstance(free_joint, str):
-        return free_joint  # names are kept by the held arm; an unknown or held one is refused there
+        if free_joint in full.joint_names and full.joint_names.index(free_joint) not in held.free:
+            raise UnknownOptionError(f"free_joint {free_joint!r} is locked; sweep one of the others")
+        return free_joint  # names are kept by the held arm; an unknown one is refused there
     k = check_int(free_joint, "free_joint", 0, full.n_joints - 1)
     if k not in held.free:
         raise UnknownOptionError(f"free_joint {full.joint_names[k]!r} is locked; sweep one of the others")

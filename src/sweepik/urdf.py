@@ -47,6 +47,7 @@ __all__ = [
     "urdf_text",
     "MAX_URDF_BYTES",
     "MAX_URDF_TAGS",
+    "MAX_URDF_ATTRIBUTES",
     "MAX_URDF_JOINTS",
     "MAX_URDF_DEPTH",
 ]
@@ -61,6 +62,10 @@ MAX_URDF_BYTES = 4 << 20
 #: counted in C before parsing) are refused: defusedxml parses with Python callbacks, 1.5-3 us a tag, so 4 MiB
 #: of empty tags would take 1.5 s; 100,000 tags take at most about 0.3 s and are 28 times PR2's 3,600.
 MAX_URDF_TAGS = 100_000
+#: ... and at most this many '=' (attributes; also counted in C before parsing): the parser hands every
+#: attribute of an element to Python, and 4 MiB of attributes on one element took 2-4 s to refuse. A URDF element
+#: has a handful (a 7-axis arm's file: ~1,500 in all).
+MAX_URDF_ATTRIBUTES = 100_000
 #: More ``<joint>`` elements than this are refused as soon as the parser meets the next one: a humanoid has about
 #: 50 joints, a full mobile manipulator with hands about 100; a serial arm 6-7.
 MAX_URDF_JOINTS = 1000
@@ -194,6 +199,8 @@ def _collect(blob: bytes, source: str, from_text: bool) -> _Collector:
         ) from None
     except ParseError as exc:
         raise UrdfError(f"{source}: not well-formed XML: {exc}") from None
+    except (LookupError, ValueError) as exc:  # an XML declaration naming an unknown or multi-byte encoding
+        raise UrdfError(f"{source}: unsupported text encoding: {exc}") from None
     return target
 
 
@@ -387,6 +394,11 @@ def robot_from_urdf(
     tags = blob.count(b"<")
     if tags > MAX_URDF_TAGS:
         raise UrdfError(f"{source}: {tags} markup characters '<', more than the {MAX_URDF_TAGS} a URDF may have")
+    attributes = blob.count(b"=")
+    if attributes > MAX_URDF_ATTRIBUTES:
+        raise UrdfError(
+            f"{source}: {attributes} characters '=', more than the {MAX_URDF_ATTRIBUTES} a URDF's attributes may have"
+        )
     found = _collect(blob, source, isinstance(text, str))
     joints = [_checked(raw, found.links, source) for raw in found.joints]
     parent_of, root = _tree(joints, found.links, source)

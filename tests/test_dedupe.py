@@ -1,0 +1,68 @@
+"""The compiled wrap/limits/dedupe pass (``sweepik.dedupe.finish``) equals its NumPy reference, and both keep one
+of each set of equal candidates: the best, ties to the earliest, across the +-pi seam and beyond-pi limits."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import sweepik
+from sweepik import dedupe, fastsweep
+
+pytestmark = pytest.mark.skipif(not fastsweep.AVAILABLE, reason="compares the compiled pass with the reference")
+
+
+def _candidates(robot: sweepik.Robot, rng: np.random.Generator, n_poses: int, per_pose: int):
+    """Distinct base configurations per pose, each repeated with tiny offsets, copies shifted by 2 pi (the seam)
+    and tied errors, in shuffled order."""
+    lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
+    hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
+    rows, poses, errs = [], [], []
+    for p in range(n_poses):
+        base = rng.uniform(lo, hi, size=(per_pose, robot.n_joints))
+        base[0, robot.is_revolute] = np.pi - 1e-9  # on the seam
+        for b in base:
+            for _ in range(int(rng.integers(1, 4))):
+                c = b + rng.normal(scale=1e-8, size=b.shape) * rng.integers(0, 2)
+                c = np.where(robot.is_revolute & (rng.random(b.shape) < 0.3), c - 2 * np.pi * np.sign(c), c)
+                rows.append(c)
+                poses.append(p)
+                errs.append(float(rng.choice([1e-12, 2e-12, 3e-12])))  # many ties
+    order = rng.permutation(len(rows))
+    return np.array(poses)[order], np.array(rows)[order], np.array(errs)[order]
+
+
+@pytest.mark.parametrize("name", ["yaskawa_hc10", "carm", "ur5", "kinova_jaco2"])
+@pytest.mark.parametrize("per_pose", [3, 20, 60])
+def test_compiled_finish_equals_reference(name: str, per_pose: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    robot = sweepik.load_robot(name)
+    rng = np.random.default_rng(per_pose)
+    pose, q, err = _candidates(robot, rng, 7, per_pose)
+    w_c, in_c, keep_c = dedupe.finish(robot, pose, q, err)
+    monkeypatch.setattr(dedupe, "AVAILABLE", False)
+    w_r, in_r, keep_r = dedupe.finish(robot, pose, q, err)
+    np.testing.assert_array_equal(w_c, w_r)
+    np.testing.assert_array_equal(in_c, in_r)
+    np.testing.assert_array_equal(keep_c, keep_r)
+    # one kept per distinct base configuration (the copies are within the tolerance of each other), none equal
+    kept = w_c[keep_c]
+    for p in np.unique(pose):
+        k = kept[pose[keep_c] == p]
+        d = np.abs(k[:, None, :] - k[None, :, :])
+        d = np.where(robot.is_revolute, np.minimum(d, 2 * np.pi - d), d)
+        same = np.all(d <= 1e-6 * np.where(robot.is_revolute, 1.0, robot.length_scale * 1e-2), axis=-1)
+        assert same.sum() == len(k), "two kept candidates are equal"
+
+
+def test_a_continuum_of_tens_of_thousands_of_points_collapses_in_bounded_memory() -> None:
+    """40,000 certified points along one arc of a pose (a numerical continuum) and 5 isolated ones: the arc is
+    reported by one medoid (before, the all-pairs comparison asked for (K, K, 6) floats: 77 GB)."""
+    from sweepik.families import collapse_continua
+
+    robot = sweepik.load_robot("ur5")
+    t = np.linspace(-1.0, 1.0, 40_000)
+    q = np.zeros((t.size, 6))
+    q[:, 0], q[:, 3] = t, -t
+    q[-5:] = np.random.default_rng(0).uniform(-3, 3, (5, 6))
+    keep = collapse_continua(robot, np.zeros(t.size, dtype=np.intp), q)
+    assert keep.sum() == 6 and np.all(keep[-5:])
