@@ -208,7 +208,8 @@ class GeometricReduction(Reduction):
 
     def search_range(self, poses: Array) -> Array | None:
         """A prismatic theta*: the travel that can hold a solution, joint limits aside, ``(N, 2)``: the wrist centre
-        W lies within R (the lengths of the segments from the slide to W, summed) of the point the slide moves,
+        W lies within R (the lengths of the segments from the slide to W, summed, plus the travel of any other slide
+        among them, as far as its limits reach) of the point the slide moves,
         so along a first joint's fixed direction h: ``h . (t - P0) +- R``; deeper in the chain (its direction
         turns with the joints before it) ``|x| <= |t - P0| + R``. The solver sweeps this interval with and without
         limits, so that ``limits=False`` keeps (and flags) solutions beyond the limits."""
@@ -217,6 +218,12 @@ class GeometricReduction(Reduction):
         chain, f = self._chain, self.plan.free
         o3 = chain.P[:4].sum(axis=0)
         R = float(np.linalg.norm(chain.P[1:4], axis=1).sum() + np.linalg.norm(np.asarray(self.plan.W) - o3))
+        # the other slides among the first four joints lengthen the chain by up to their travel (Stanford's d3)
+        n = self.robot.n_joints
+        for j in range(4):
+            k = n - 1 - j if self.plan.reversed else j
+            if j != f and not chain.revolute[j]:
+                R += max(abs(float(self.robot.lower[k])), abs(float(self.robot.upper[k])))
         L = geometric.LAYOUT
         t = self.kernel_params(poses)[:, L["t"] : L["t"] + 3] - chain.P[0]
         if f == 0:
