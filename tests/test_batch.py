@@ -77,3 +77,18 @@ def test_empty_batch():
     batch = sweepik.solve_many(robot, np.zeros((0, 4, 4)))
     assert batch == [] and len(batch) == 0 and list(batch) == []
     assert batch.q.shape == (0, 6) and batch.offsets.tolist() == [0] and batch.families == {}
+
+
+@pytest.mark.parametrize("name", ["ur5", "carm", "fanuc_crx10ia"])
+def test_read_only_poses(name: str, tmp_path) -> None:
+    """Poses in a read-only array (a memory-mapped .npy file) solve like writable ones."""
+    robot = sweepik.load_robot(name)
+    from sweepik.verify import random_configurations
+
+    poses = robot.fk(random_configurations(robot, 12, np.random.default_rng(4)))
+    np.save(tmp_path / "p.npy", poses)
+    mapped = np.load(tmp_path / "p.npy", mmap_mode="r")
+    assert not mapped.flags.writeable
+    a, b = sweepik.solve_many(robot, mapped), sweepik.solve_many(robot, poses)
+    np.testing.assert_array_equal(a.q, b.q)
+    np.testing.assert_array_equal(sweepik.solve(robot, mapped[0]).q, b[0].q)

@@ -194,7 +194,7 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, 
     run(
         first_class(red.kernel[1]),
         np.ascontiguousarray(red.kernel_params(chain) if params is None else params, dtype=np.float64),
-        np.ascontiguousarray(world, dtype=np.float64),
+        np.array(world, dtype=np.float64, order="C", copy=not world.flags.writeable or None),  # compiled: writable
         pose.astype(np.int64),
         theta.astype(np.float64),
         branch.astype(np.int64),
