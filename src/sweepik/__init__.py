@@ -2,7 +2,8 @@
 
 Public API: robots (``load_robot`` for bundled arms, TOML robot files and URDF; ``Robot``, ``Joint``;
 ``read_urdf``, ``urdf_text``, ``robot_to_toml``), pose helpers and error metrics, and the solvers ``solve``,
-``solve_many`` and ``iter_solve`` (``locked=`` for arms with more than six joints). See the README and
+``solve_many`` and ``iter_solve`` (``locked=`` for arms with more than six joints), ``solve_dask`` (on a Dask
+cluster, optionally into an on-disk store) and ``load_solutions``. See the README and
 docs/conventions.md for units and conventions.
 """
 
@@ -10,6 +11,7 @@ from importlib.metadata import PackageNotFoundError, version
 
 from .analysis import analyze
 from .batch import SolutionBatch
+from .distributed import solve_dask
 from .errors import (
     InvalidPoseError,
     LockedJointError,
@@ -39,6 +41,7 @@ from .robot import Joint, Robot
 from .robot_file import bundled_robots, load_robot, robot_from_dict, robot_to_toml
 from .solutions import Family, Solutions
 from .solver import STRATEGIES, iter_solve, solve, solve_many
+from .store import StoreError, load_solutions
 from .urdf import read_urdf, urdf_text
 
 try:
@@ -59,6 +62,8 @@ __all__ = [
     "solve",
     "solve_many",
     "iter_solve",
+    "solve_dask",
+    "load_solutions",
     "Solutions",
     "SolutionBatch",
     "Family",
@@ -91,4 +96,5 @@ __all__ = [
     "NoReductionError",
     "LockedJointError",
     "UrdfError",
+    "StoreError",
 ]

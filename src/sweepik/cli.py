@@ -42,6 +42,7 @@ from .robot_file import bundled_robots
 __all__ = ["main", "build_parser"]
 
 from .cli_analyze import add_analyze_parser, cmd_analyze, plan_line
+from .cli_batch import add_sample_parser, cmd_sample
 from .cli_common import (
     DEFAULT_ROBOT,
     EXIT_IO,
@@ -247,6 +248,7 @@ _COMMANDS: dict[str, tuple[_AddParser, _Run]] = {
     "verify": (add_verify_parser, cmd_verify),
     "bench": (add_bench_parser, cmd_bench),
     "convert": (add_convert_parser, cmd_convert),
+    "sample": (add_sample_parser, cmd_sample),
 }
 
 

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .cli_batch import add_store_options, cmd_solve_store, wants_store
 from .cli_common import (
     DEFAULT_ROBOT,
     CliInputError,
@@ -100,6 +101,7 @@ def add_solve_parser(sub: _SubParsers) -> None:
     _add_ik_options(p)
     _add_json(p, ": per pose, solutions q (radians / length unit), errors, families")
     _add_precision(p)
+    add_store_options(p)  # --out STORE [--workers N | --scheduler ADDRESS] [--resume]: cli_batch
 
 
 def _poses_from_args(args: argparse.Namespace) -> Array:
@@ -203,6 +205,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
             "--matrix 16 numbers"
         )
     robot = _load_robot(args.robot, args)
+    if wants_store(args):  # many poses on Dask into a store: cli_batch
+        return cmd_solve_store(args, robot, _ik_kwargs(args, robot))
     nearest = None if args.nearest is None else _config_from_cli(robot, args.nearest, args.rad)
     poses = _poses_from_args(args)
     # the output streaming to the terminal shows the progress by itself: no progress line mixed into it

@@ -1,0 +1,465 @@
+"""``solve_dask``: ``solve_many`` on a Dask cluster, chunk by chunk, optionally into an on-disk store.
+
+The poses are cut into chunks of ``chunk_size`` poses (``chunk k`` = poses ``[k * chunk_size, (k + 1) *
+chunk_size)``); each chunk is one Dask task running the solver's own chunk loop (:func:`_solve_task`: the same
+steps as ``solve_many``, in sub-chunks of the solver's ``CHUNK`` poses), so the results are ``solve_many``'s, in
+the same order. The robot travels by value (pickled with each task, ~1.5 kB); each worker process builds its
+reductions and loads its compiled kernels once (they are cached per robot content).
+
+The client collects the chunks as they finish and (with ``out``) writes each one to the store
+(:mod:`sweepik.store`): one writer, so the store needs no locking and may live where only the client can write;
+the workers need no shared file system. At most ``IN_FLIGHT_PER_THREAD`` chunks per worker thread are submitted at
+once, so the client, the scheduler and the workers hold a bounded number of chunks whatever the number of poses.
+
+Nothing is lost: Dask reruns the tasks of a worker that dies (a local cluster's nanny restarts the process; the
+scheduler gives up on a task only after it has killed ``distributed.scheduler.allowed-failures`` workers, 3 by
+default); the store is written chunk by chunk and marked complete last, and ``resume=True`` skips the chunks an
+interrupted run stored (after checking that they hold the same poses, robot and options).
+
+Dask is an optional dependency (``pip install 'sweepik[dask]'``), imported when ``solve_dask`` runs.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import math
+import os
+import time
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._validate import as_float_array, check_int, check_poses, short_repr
+from .batch import Block, SolutionBatch
+from .errors import ShapeError, SweepikError, UnknownOptionError
+from .reductions import Reduction
+from .robot import Robot
+from .store import StoreError, StoreWriter, chunk_stats, load_solutions, merge_blocks, poses_digest, store_info
+from .sweep import N_SAMPLES
+
+__all__ = ["solve_dask"]
+
+#: A progress callback: ``progress(stage, done, total)`` (``stage`` is ``"solve"``, counts are poses).
+Progress = Callable[[str, int, int], None]
+Array = NDArray[np.float64]
+
+#: Chunks submitted per worker thread at a time: one running, one queued (the worker never waits for the client).
+IN_FLIGHT_PER_THREAD = 2
+#: Automatic chunk size: about this many chunks per worker thread (tasks even out at the end of the run) ...
+CHUNKS_PER_THREAD = 8
+#: ... at least this many poses (smaller chunks cost more in scheduling than they solve) ...
+MIN_AUTO_CHUNK = 64
+#: ... at most this many (16,384 C-Arm poses: ~3 s on one core, ~10 MB of results), and above the solver's
+#: CHUNK a multiple of it, so that the solver's sub-chunks fall where ``solve_many``'s do.
+MAX_AUTO_CHUNK = 8 * 2048
+#: Seconds to wait for a scheduler given by address.
+CONNECT_TIMEOUT_S = 30
+
+
+def _dask() -> Any:
+    try:
+        import distributed
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise SweepikError("solve_dask needs Dask: pip install 'sweepik[dask]'") from exc
+    return distributed
+
+
+# --------------------------------------------------------------------------------------------------
+# The task run by a worker
+# --------------------------------------------------------------------------------------------------
+
+
+def _solve_task(robot: Robot, poses: ArrayLike, options: Mapping[str, Any], start: int) -> Block:
+    """The solutions of one chunk of poses ``(n, 4, 4)`` (poses ``start:start + n`` of the run), as one Block:
+    ``solve_many``'s steps (checks, reduction, sub-chunks of the solver's chunk size, locked joints)."""
+    from .solver import CHUNK, _expanded, _held, _prepare, _solve_chunk
+
+    arr = as_float_array(poses, "poses")
+    what = f"poses[{start}:{start + arr.shape[0]}]" if arr.ndim == 3 else "poses"
+    P = check_poses(arr, what)
+    if not P.flags.writeable:  # a chunk unpickled from a message is read-only; the compiled kernels want writable
+        P = P.copy()
+    if P.ndim != 3:
+        raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
+    o = options
+    held = _held(robot, o["locked"])
+    arm = robot if held is None else held.arm
+    red, strat, lim, ns, cs = _prepare(
+        arm, P, o["reduction"], o["strategy"], o["limits"], o["n_samples"], CHUNK, o["free_joint"], held
+    )
+    return merge_blocks(
+        [_expanded(_solve_chunk(arm, red, P[s : s + cs], strat, lim, ns), held) for s in range(0, len(P), cs)]
+    )
+
+
+def _checked_options(
+    robot: Robot,
+    reduction: str | Reduction | None,
+    free_joint: int | str | None,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    locked: Mapping[Any, float] | None,
+    stored: bool,
+) -> dict[str, Any]:
+    """The solver options, checked as ``solve_many`` checks them (before any cluster starts), normalised to plain
+    Python values (the store keeps them as JSON)."""
+    from .solver import _held, _prepare
+
+    held = _held(robot, locked)
+    arm = robot if held is None else held.arm
+    _, strategy, limits, n_samples, _ = _prepare(
+        arm, np.zeros((0, 4, 4)), reduction, strategy, limits, n_samples, 1, free_joint, held
+    )
+    if stored and isinstance(reduction, Reduction):
+        raise UnknownOptionError(
+            f"with out=, reduction must be a name or None, not a {type(reduction).__name__} instance: a store "
+            "rebuilds its families' reduction by name"
+        )
+    if isinstance(free_joint, int | np.integer) and not isinstance(free_joint, bool):
+        free_joint = int(free_joint)
+    return {
+        "reduction": reduction,
+        "free_joint": free_joint,
+        "strategy": strategy,
+        "limits": limits,
+        "n_samples": n_samples,
+        "locked": None
+        if not locked
+        else {(int(k) if isinstance(k, int | np.integer) else k): float(v) for k, v in locked.items()},
+    }
+
+
+# --------------------------------------------------------------------------------------------------
+# Pose sources: in-memory or memory-mapped arrays, .npy paths, Dask arrays
+# --------------------------------------------------------------------------------------------------
+
+
+@dataclass
+class _Source:
+    """The poses of a run: ``array`` (NumPy, possibly a memmap; sliced by the client) or ``dask`` (a Dask array,
+    computed by the workers)."""
+
+    n: int
+    array: Any = None
+    dask: Any = None
+
+    def chunk(self, s: int, e: int) -> Array:
+        return np.ascontiguousarray(self.array[s:e])
+
+
+def _is_dask_array(x: object) -> bool:
+    return type(x).__module__.startswith("dask.array") and hasattr(x, "to_delayed")
+
+
+def _source(poses: Any) -> _Source:
+    if _is_dask_array(poses):
+        shape = tuple(poses.shape)
+        if len(shape) != 3 or shape[1:] != (4, 4) or any(isinstance(s, float) and math.isnan(s) for s in shape):
+            raise ShapeError(f"poses must have shape (N, 4, 4), got {shape}")
+        return _Source(int(shape[0]), dask=poses)
+    if isinstance(poses, str | os.PathLike):
+        poses = _open_npy(Path(poses))
+    arr = poses if isinstance(poses, np.ndarray) else as_float_array(poses, "poses")
+    if arr.size == 0:
+        return _Source(0, array=np.zeros((0, 4, 4)))
+    if arr.ndim != 3 or arr.shape[1:] != (4, 4):
+        raise ShapeError(f"poses must have shape (N, 4, 4), got {arr.shape}")
+    if arr.dtype.kind not in "fiu":
+        raise ShapeError(f"poses must hold real numbers, got dtype {arr.dtype}")
+    return _Source(int(arr.shape[0]), array=arr)
+
+
+def _open_npy(path: Path) -> NDArray[Any]:
+    """A ``.npy`` file of poses, memory-mapped (read a chunk at a time; never all in memory)."""
+    from .errors import PoseFileError
+
+    if path.suffix.lower() != ".npy":
+        raise PoseFileError(f"{path}: poses by path must be a .npy file (load other formats with load_poses)")
+    if not path.is_file():
+        raise PoseFileError(f"{path}: no such file" if not path.exists() else f"{path}: not a file")
+    try:
+        arr = np.load(path, mmap_mode="r", allow_pickle=False)
+    except (ValueError, OSError) as exc:
+        raise PoseFileError(f"{path}: not a readable .npy array ({exc})") from None
+    if arr.dtype.kind not in "fiu":
+        raise PoseFileError(f"{path}: poses must be real numbers, got dtype {arr.dtype}")
+    if arr.ndim == 2 and arr.shape == (4, 4):
+        arr = arr.reshape(1, 4, 4)
+    if arr.ndim != 3 or arr.shape[1:] != (4, 4):
+        raise PoseFileError(f"{path}: poses must have shape (N, 4, 4), got {arr.shape}")
+    return arr
+
+
+# --------------------------------------------------------------------------------------------------
+# Cluster
+# --------------------------------------------------------------------------------------------------
+
+
+@contextlib.contextmanager
+def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
+    """The client to use: ``client`` itself; a new one for a scheduler address; a local cluster (processes,
+    one thread each) when None. Clients and clusters made here are closed on exit."""
+    distributed = _dask()
+    if client is not None and n_workers is not None:
+        raise UnknownOptionError("n_workers sizes the local cluster started when client is None; give one of them")
+    if client is None:
+        n = (os.cpu_count() or 1) if n_workers is None else check_int(n_workers, "n_workers", 1, 4096)
+        cluster = distributed.LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+        )
+        try:
+            with distributed.Client(cluster) as c:
+                yield c
+        finally:
+            cluster.close()
+    elif isinstance(client, str):
+        try:
+            c = distributed.Client(client, timeout=CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError) as exc:
+            raise SweepikError(f"cannot reach the Dask scheduler at {client!r}: {exc}") from None
+        with c:
+            yield c
+    elif isinstance(client, distributed.Client):
+        yield client
+    else:
+        raise UnknownOptionError(
+            f"client must be a dask.distributed Client, a scheduler address or None, got {short_repr(client, 40)}"
+        )
+
+
+def auto_chunk_size(n_poses: int, threads: int) -> int:
+    """Poses per chunk when ``chunk_size`` is not given: ``CHUNKS_PER_THREAD`` chunks per worker thread, between
+    ``MIN_AUTO_CHUNK`` and ``MAX_AUTO_CHUNK`` poses, a multiple of the solver's chunk above it."""
+    from .solver import CHUNK
+
+    target = max(MIN_AUTO_CHUNK, -(-n_poses // (CHUNKS_PER_THREAD * max(threads, 1))))
+    if target > CHUNK:
+        target = -(-target // CHUNK) * CHUNK
+    return int(min(target, MAX_AUTO_CHUNK))
+
+
+# --------------------------------------------------------------------------------------------------
+# The run
+# --------------------------------------------------------------------------------------------------
+
+
+@dataclass
+class RunSummary:
+    """What a run did: ``totals`` (poses, solutions, unreachable, out_of_limits, families: over all chunks,
+    resumed ones included), chunk counts, poses resumed from the store, wall time, worker threads."""
+
+    totals: dict[str, int]
+    n_chunks: int
+    chunk_size: int
+    resumed_chunks: int
+    resumed_poses: int
+    seconds: float
+    threads: int
+
+
+def run(
+    robot: Robot,
+    poses: object,
+    *,
+    client: Any = None,
+    n_workers: int | None = None,
+    out: str | os.PathLike[str] | None = None,
+    chunk_size: int | None = None,
+    resume: bool = False,
+    progress: Progress | None = None,
+    keep: bool = True,
+    options: Mapping[str, Any],
+) -> tuple[RunSummary, dict[int, Block]]:
+    """The engine of :func:`solve_dask` and ``sweepik solve --out``: solves every chunk not yet stored, writes
+    each to ``out`` as it comes, returns the summary and (``keep``) the blocks computed, by chunk index."""
+    t0 = time.perf_counter()
+    src = _source(poses)
+    if chunk_size is not None:
+        chunk_size = check_int(chunk_size, "chunk_size", 1, 2**31)
+    if resume and out is None:
+        raise UnknownOptionError("resume=True continues a store: give out=PATH too")
+    stored_chunk = None
+    if out is not None:
+        path = Path(out)
+        if path.exists() or path.is_symlink():
+            if not resume:
+                raise StoreError(f"{path}: already exists; resume it (resume=True, --resume) or give a new path")
+            stored_chunk = int(store_info(path)["chunk_size"])
+            if chunk_size is not None and chunk_size != stored_chunk:
+                raise StoreError(
+                    f"{path}: cannot resume with chunk_size {chunk_size}: the store has chunks of {stored_chunk}"
+                )
+        elif not path.parent.is_dir():
+            raise StoreError(f"{path}: cannot create the store: directory {str(path.parent)!r} is missing")
+    with _connected(client, n_workers) as c:
+        threads = max(1, sum(c.nthreads().values()))
+        cs = stored_chunk or chunk_size or auto_chunk_size(src.n, threads)
+        n_chunks = -(-src.n // cs)
+        writer = None if out is None else StoreWriter(out, robot, options, src.n, cs, resume=resume)
+        done: dict[int, dict[str, Any]] = {} if writer is None else writer.done()
+        if writer is not None and done:
+            _check_resumed(c, src, writer, done, cs)
+        stats = [done[k]["stats"] for k in sorted(done)]
+        resumed_poses = sum(int(s["poses"]) for s in stats)
+        todo = [k for k in range(n_chunks) if k not in done]
+        blocks: dict[int, Block] = {}
+        solved = resumed_poses
+        if progress is not None:
+            progress("solve", solved, src.n)
+        for k, block in _results(c, robot, src, options, cs, todo, threads):
+            if writer is not None:
+                stats.append(writer.write(k, block))
+            else:
+                stats.append(chunk_stats(block))
+            if keep:
+                blocks[k] = block
+            solved += block.n
+            if progress is not None:
+                progress("solve", solved, src.n)
+        totals = writer.finish() if writer is not None else _totals(stats)
+    summary = RunSummary(totals, n_chunks, cs, len(done), resumed_poses, time.perf_counter() - t0, threads)
+    return summary, blocks
+
+
+def _totals(stats: list[dict[str, int]]) -> dict[str, int]:
+    keys = ("poses", "solutions", "unreachable", "out_of_limits", "families")
+    return {key: int(sum(int(s[key]) for s in stats)) for key in keys}
+
+
+def _task(c: Any, robot: Robot, src: _Source, options: Mapping[str, Any], cs: int, k: int) -> Any:
+    s, e = k * cs, min((k + 1) * cs, src.n)
+    if src.dask is None:
+        return c.submit(_solve_task, robot, src.chunk(s, e), options, s, pure=False)
+    import dask
+
+    piece = src.dask[s:e]
+    return c.compute(dask.delayed(_solve_task, pure=False)(robot, piece, options, s))
+
+
+def _results(
+    c: Any, robot: Robot, src: _Source, options: Mapping[str, Any], cs: int, todo: list[int], threads: int
+) -> Iterator[tuple[int, Block]]:
+    """(chunk index, block) of every chunk in ``todo``, as they finish; at most ``IN_FLIGHT_PER_THREAD`` chunks per
+    worker thread submitted at once. A task's error is raised here; the futures left are cancelled on exit."""
+    distributed = _dask()
+    pending = iter(todo)
+    live: dict[Any, tuple[int, Any]] = {}  # future key -> (chunk index, future)
+    queue = distributed.as_completed()
+
+    def submit() -> None:
+        k = next(pending, None)
+        if k is not None:
+            fut = _task(c, robot, src, options, cs, k)
+            live[fut.key] = (k, fut)
+            queue.add(fut)
+
+    try:
+        for _ in range(IN_FLIGHT_PER_THREAD * threads):
+            submit()
+        for fut in queue:
+            block = fut.result()
+            k, _ = live.pop(fut.key)
+            fut.release()
+            submit()
+            yield k, block
+    finally:
+        if live:
+            c.cancel([f for _, f in live.values()])
+
+
+def _check_resumed(c: Any, src: _Source, writer: StoreWriter, done: Mapping[int, Mapping[str, Any]], cs: int) -> None:
+    """StoreError unless every stored chunk holds the poses given now (SHA-256 of the chunk's float64 poses)."""
+    if src.dask is None:
+        for k, attrs in done.items():
+            s, e = writer.span(k)
+            writer.check_poses(k, attrs, poses_digest(as_float_array(src.chunk(s, e), "poses")))
+        return
+    import dask
+
+    keys = sorted(done)
+    digests = c.gather([c.compute(dask.delayed(_digest)(src.dask[k * cs : min((k + 1) * cs, src.n)])) for k in keys])
+    for k, digest in zip(keys, digests, strict=True):
+        writer.check_poses(k, done[k], digest)
+
+
+def _digest(poses: ArrayLike) -> str:
+    return poses_digest(as_float_array(poses, "poses"))
+
+
+# --------------------------------------------------------------------------------------------------
+# Public entry point
+# --------------------------------------------------------------------------------------------------
+
+
+def solve_dask(
+    robot: Robot,
+    poses: ArrayLike | str | os.PathLike[str],
+    client: Any = None,
+    out: str | os.PathLike[str] | None = None,
+    *,
+    chunk_size: int | None = None,
+    resume: bool = False,
+    progress: Progress | None = None,
+    n_workers: int | None = None,
+    reduction: str | Reduction | None = None,
+    free_joint: int | str | None = None,
+    strategy: str = "precise",
+    limits: bool = True,
+    n_samples: int = N_SAMPLES,
+    locked: Mapping[Any, float] | None = None,
+) -> SolutionBatch:
+    """All IK solutions of each pose in ``poses (N, 4, 4)``, solved on a Dask cluster: the same
+    :class:`~sweepik.batch.SolutionBatch` as ``solve_many(robot, poses, ...)`` (same solutions, same order).
+
+    Args:
+        robot: the arm (travels to the workers by value).
+        poses: a NumPy array (or ``np.memmap``), the path of a ``.npy`` file (memory-mapped: the client reads one
+            chunk at a time), or a Dask array ``(N, 4, 4)`` (each worker computes the chunks it solves).
+        client: None: a local cluster on this machine (``n_workers`` processes, default one per core, one thread
+            each), closed at the end; a ``dask.distributed.Client``; or a scheduler address
+            (``"tcp://host:8786"``). The workers need sweepik (and its version) installed.
+        out: a directory to write the store to (Zarr, see :mod:`sweepik.store`), chunk by chunk as chunks finish,
+            marked complete at the end; :func:`~sweepik.store.load_solutions` reads it back. It must not exist,
+            unless ``resume``.
+        chunk_size: poses per task (and per chunk of the store); default: about 8 chunks per worker thread, between
+            64 and 16,384 poses. With ``resume``, the store's.
+        resume: continue the store at ``out``: only the chunks it lacks are solved (StoreError if it was written
+            for other poses, another robot or other options).
+        progress: ``progress("solve", done, total)`` (poses) after each chunk.
+        n_workers: processes of the local cluster (only when ``client`` is None).
+        reduction, free_joint, strategy, limits, n_samples, locked: as :func:`~sweepik.solve_many` (with ``out``,
+            ``reduction`` must be a name or None).
+
+    Returns the batch of every pose; with ``out``, read back from the store (its content is what was written).
+
+    Raises:
+        SweepikError subclasses, as ``solve_many`` (options checked before any cluster starts; a pose that is not a
+        rigid transform when its chunk is solved); StoreError for a store that exists (without ``resume``) or
+        does not match (with it). Other exceptions of Dask (e.g. ``KilledWorker``, when a task killed
+        ``allowed-failures`` workers) pass through. On any error or interruption the store stays incomplete.
+    """
+    opts = _checked_options(robot, reduction, free_joint, strategy, limits, n_samples, locked, stored=out is not None)
+    if progress is not None and not callable(progress):
+        raise UnknownOptionError(f"progress must be callable or None, got {type(progress).__name__}")
+    resume = bool(resume)
+    _, blocks = run(
+        robot,
+        poses,
+        client=client,
+        n_workers=n_workers,
+        out=out,
+        chunk_size=chunk_size,
+        resume=resume,
+        progress=progress,
+        keep=out is None,
+        options=opts,
+    )
+    if out is not None:
+        return load_solutions(out)
+    return SolutionBatch(robot, [blocks[k] for k in sorted(blocks)])
