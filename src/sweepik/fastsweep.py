@@ -259,10 +259,11 @@ if AVAILABLE:
 
     @njit(cache=True)
     def _scan(
-        res, p, b, th, f, level, el, er, ctx, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top
+        res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top
     ):
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
-        hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, as in sweep._Search.scan."""
+        hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
+        coordinate judges curvature (NaN: theta), as in sweep._Search.scan."""
         M = th.shape[0]
         valid = np.empty(M, dtype=np.bool_)
         for j in range(M):
@@ -293,13 +294,16 @@ if AVAILABLE:
             nl = abs(f[j - 1]) if (j > 0 and valid[j - 1]) else np.inf
             if (lo_open and abs(f[j]) <= nr) or (hi_open and abs(f[j]) <= nl):
                 _push(out_t, out_b, cnt, th[j], b)
-        # second divided differences
+        # second divided differences, in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate)
+        x = np.empty(M)
+        for j in range(M):
+            x[j] = th[j] if math.isnan(xe) else math.sqrt(abs(th[j] - xe))
         dd = np.full(M, np.nan)
         for j in range(1, M - 1):
             if valid[j - 1] and valid[j] and valid[j + 1]:
-                hl = th[j] - th[j - 1]
-                hr = th[j + 1] - th[j]
-                if hl > 0 and hr > 0:
+                hl = x[j] - x[j - 1]
+                hr = x[j + 1] - x[j]
+                if hl != 0.0 and hr != 0.0:  # (decreasing where the edge is on the right: same dd)
                     dd[j] = 2.0 * ((f[j + 1] - f[j]) / hr - (f[j] - f[j - 1]) / hl) / (hl + hr)
         for j in range(M - 1):
             if not (valid[j] and valid[j + 1] and th[j + 1] > th[j]):
@@ -316,10 +320,11 @@ if AVAILABLE:
                     curv = abs(c1)
                 if not math.isnan(c2) and (math.isnan(curv) or abs(c2) > curv):
                     curv = abs(c2)
-                h = th[j + 1] - th[j]
+                h = x[j + 1] - x[j]
                 lowest = min(abs(f[j]), abs(f[j + 1]))
                 bend = (not math.isnan(curv)) and lowest <= BEND * curv * h * h
-                refine = bend or near_edge
+                own_edge = (open_l and th[j] == xe and not open_r) or (open_r and th[j + 1] == xe and not open_l)
+                refine = bend or (near_edge and not own_edge)
             if refine:
                 if top[0] >= stk_t.shape[0]:
                     cnt[0] += out_t.shape[0] + 1  # overflow: the caller redoes this pose with NumPy
@@ -343,6 +348,12 @@ if AVAILABLE:
                     stk_c[k0, 2], stk_c[k0, 3] = th[j + 2], f[j + 2]
                 else:
                     stk_c[k0, 2], stk_c[k0, 3] = ctx[2], ctx[3]
+                if open_l and not open_r:
+                    stk_c[k0, 4] = th[j]
+                elif open_r and not open_l:
+                    stk_c[k0, 4] = th[j + 1]
+                else:
+                    stk_c[k0, 4] = np.nan if open_l else xe
                 top[0] += 1
             elif prod < 0:
                 _push(out_t, out_b, cnt, _root(res, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
@@ -361,7 +372,7 @@ if AVAILABLE:
             stk_t = np.empty((STACK, SUB + 2))
             stk_f = np.empty((STACK, SUB + 2))
             stk_i = np.empty((STACK, 3), dtype=np.int64)
-            stk_c = np.empty((STACK, 4))
+            stk_c = np.empty((STACK, 5))
             no_ctx = np.full(4, np.nan)
             for bi in range(branches.shape[0]):
                 b = branches[bi]
@@ -394,15 +405,15 @@ if AVAILABLE:
                         j += 1
                 top = np.zeros(1, dtype=np.int64)
                 # the sequence itself, then the resampled intervals it (and they) push on the stack
-                seq_t, seq_f, level, el, er, ctx = th, f, 0, False, False, no_ctx
+                seq_t, seq_f, level, el, er, ctx, xe = th, f, 0, False, False, no_ctx, np.nan
                 while True:
-                    _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, span[i], noise, xtol, out_t[i], out_b[i], c,
-                          stk_t, stk_f, stk_i, stk_c, top)  # fmt: skip
+                    _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
+                          c, stk_t, stk_f, stk_i, stk_c, top)  # fmt: skip
                     if top[0] == 0:
                         break
                     top[0] -= 1
                     k0 = top[0]
-                    seq_t, seq_f, ctx = stk_t[k0].copy(), stk_f[k0].copy(), stk_c[k0].copy()
+                    seq_t, seq_f, ctx, xe = stk_t[k0].copy(), stk_f[k0].copy(), stk_c[k0, :4].copy(), stk_c[k0, 4]
                     level, el, er = stk_i[k0, 0], stk_i[k0, 1] == 1, stk_i[k0, 2] == 1
             cnt[i] = c[0]
             n0 = min(c[0], out_t.shape[1])

@@ -45,7 +45,9 @@ SUB_SAMPLES = 8
 MAX_LEVELS = 4
 #: An interval is resampled when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola dips h^2 |f''| / 8
 #: below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step), and always next to
-#: a domain edge or range end (no curvature estimate there; square-root behaviour at a domain edge).
+#: a domain edge at the first level (square-root behaviour there: no curvature estimate in theta). Below that,
+#: curvature is judged in the coordinate sqrt(|theta - edge|), in which the residual is smooth
+#: (``_edge_coordinate``): the intervals next to the edge are resampled only where that test says so.
 BEND = 1.0
 #: An interior extremum of |residual| is examined only if its sample is within EXTREMUM_REACH |f''| h^2 of
 #: zero: 8 times the deepest dip a parabola through the three samples can have (|f''| h^2 / 2).
@@ -157,6 +159,15 @@ def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samp
     return grid
 
 
+def _edge_coordinate(theta: Array, edge: Array) -> Array:
+    """The coordinate in which an interval's curvature is judged: theta, or ``sqrt(|theta - edge|)`` where
+    ``edge`` (broadcast against ``theta``) is finite. At a branch-domain edge the residual behaves like
+    ``a + b sqrt(|theta - edge|) + ...`` (the square root of the branch's discriminant): analytic in that
+    coordinate, unbounded in curvature in theta. Judged in theta, the intervals next to an edge always look bent
+    and are resampled down to the last level; judged in the square root, only where a root can hide."""
+    return np.where(np.isfinite(edge), np.sqrt(np.abs(theta - edge)), theta)
+
+
 class _Search:
     """Candidate search over residual sequences ``theta, f (S, M)`` with pose/branch per sequence."""
 
@@ -192,6 +203,7 @@ class _Search:
         edge_left: NDArray[np.bool_] | None = None,
         edge_right: NDArray[np.bool_] | None = None,
         ctx: tuple[Array, Array, Array, Array] | None = None,
+        edge_x: Array | None = None,
     ) -> None:
         """Find candidates on sequences ``th, f (S, M)`` (``valid``: usable samples); recurse into bends.
 
@@ -199,10 +211,14 @@ class _Search:
         ``ctx``: (theta, f) of the samples just left and right of a resampled interval (its parent's neighbours,
         NaN where there is none), so that its end samples get the extremum test with their nearest neighbours:
         a double root just beside a parent sample lies in the first or last sub-interval at every level.
+        ``edge_x (S,)``: the domain edge whose neighbouring interval this sequence resamples (NaN if none): there
+        curvature is judged in the coordinate sqrt(|theta - edge|) (see ``_edge_coordinate``).
         """
         S, M = f.shape
         if edge_left is None or edge_right is None:
             edge_left = edge_right = np.zeros(S, dtype=bool)
+        if edge_x is None:
+            edge_x = np.full(S, np.nan)
         absf = np.abs(f)
         fin = np.where(valid, f, np.nan)
         t0, t1 = th[:, :-1], th[:, 1:]
@@ -262,25 +278,33 @@ class _Search:
         self._root(p[d_i], b[d_i], th[d_i, d_j])
         # 5) intervals that may hide a pair of roots (besides a sign change they may have) are resampled;
         #    sign changes of the other intervals are bracketed
-        h = t1 - t0
         prod = fin[:, :-1] * fin[:, 1:]
         if level < MAX_LEVELS:
             with np.errstate(invalid="ignore", divide="ignore"):
+                # curvature in theta, or in sqrt(|theta - edge|) below an edge's interval
+                x = _edge_coordinate(th, edge_x[:, None])
                 dd = np.full((S, M), np.nan)  # second divided difference at interior samples
                 if M >= 3:
-                    hl, hr = th[:, 1:-1] - th[:, :-2], th[:, 2:] - th[:, 1:-1]
+                    hl, hr = x[:, 1:-1] - x[:, :-2], x[:, 2:] - x[:, 1:-1]
                     dd[:, 1:-1] = (
                         2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
                     )
                 curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
                 lowest = np.minimum(absf[:, :-1], absf[:, 1:])
-                bend = lowest <= BEND * curv * h * h
+                hx = x[:, 1:] - x[:, :-1]
+                bend = lowest <= BEND * curv * hx * hx
                 # sample j borders a domain edge on its left / right
                 open_l = np.concatenate([edge_left[:, None], ~valid[:, :-1]], axis=1)
                 open_r = np.concatenate([~valid[:, 1:], edge_right[:, None]], axis=1)
                 near_edge = open_l[:, :-1] | open_r[:, 1:]
+                # an interval next to an edge is resampled unconditionally, except next to the edge whose
+                # coordinate judges the curvature (there the bend test in that coordinate decides)
+                ex = edge_x[:, None]
+                own_edge = (open_l[:, :-1] & (t0 == ex) & ~open_r[:, 1:]) | (
+                    open_r[:, 1:] & (t1 == ex) & ~open_l[:, :-1]
+                )
             nonzero = np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0
-            refine = both & nonzero & (bend | near_edge)
+            refine = both & nonzero & (bend | (near_edge & ~own_edge))
         else:
             refine = np.zeros_like(both)
         s_i, s_j = np.nonzero(both & ~refine & (prod < 0))
@@ -306,7 +330,11 @@ class _Search:
         cl_f = np.where(left, fin[r_i, jl], nan if ctx is None else ctx[1][r_i])
         cr_t = np.where(right, th[r_i, jr], nan if ctx is None else ctx[2][r_i])
         cr_f = np.where(right, fin[r_i, jr], nan if ctx is None else ctx[3][r_i])
-        self.scan(pp, bb, sub, fs, vs, level + 1, open_l[r_i, r_j], open_r[r_i, r_j + 1], (cl_t, cl_f, cr_t, cr_f))
+        # an interval next to one edge: its sub-sequences judge curvature in that edge's coordinate; next to two
+        # edges: in theta; next to none: as their parent
+        el, er = open_l[r_i, r_j], open_r[r_i, r_j + 1]
+        ex = np.where(el & ~er, th[r_i, r_j], np.where(er & ~el, th[r_i, r_j + 1], np.where(el, np.nan, edge_x[r_i])))
+        self.scan(pp, bb, sub, fs, vs, level + 1, el, er, (cl_t, cl_f, cr_t, cr_f), ex)
 
     def _extrema(
         self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array, fa: Array, fb: Array
