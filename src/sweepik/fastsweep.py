@@ -362,7 +362,9 @@ if AVAILABLE:
     _U_EDGE_ARR = _U_EDGE.copy()
 
     @njit(cache=True)
-    def _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
+    def _search_pose(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
+        """Pose ``i``. ``res_all``: every branch's residual at once (``Reduction.kernel_residuals``), used for the
+        uniform samples when ``n_all`` (the number of branches it fills) is not 0."""
         M = grid.shape[1]
         if True:
             p = params[i]
@@ -374,11 +376,19 @@ if AVAILABLE:
             stk_i = np.empty((STACK, 3), dtype=np.int64)
             stk_c = np.empty((STACK, 5))
             no_ctx = np.full(4, np.nan)
+            f_all = np.empty((M, max(n_all, 1)))
+            if n_all > 0:
+                for j in range(M):
+                    res_all(p, th[j], f_all[j])
             for bi in range(branches.shape[0]):
                 b = branches[bi]
                 f = np.empty(M)
-                for j in range(M):
-                    f[j] = res(p, th[j], b)
+                if n_all > 0:
+                    for j in range(M):
+                        f[j] = f_all[j, b]
+                else:
+                    for j in range(M):
+                        f[j] = res(p, th[j], b)
                 # families: runs of vanishing samples
                 j = 0
                 while j < M:
@@ -462,12 +472,14 @@ if AVAILABLE:
 
     from numba import float64, int64, types
 
-    from .reductions.kernels import RESIDUAL_SIG
+    from .reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG
 
     #: The engine's entry signature: the residual is a first-class function, so the engine is compiled once
     #: (and cached) for every reduction.
     _SEARCH_SIG = (
         types.FunctionType(RESIDUAL_SIG),
+        types.FunctionType(RESIDUALS_SIG),
+        int64,
         float64[:, ::1],
         float64[:, ::1],
         int64[::1],
@@ -482,14 +494,31 @@ if AVAILABLE:
     )
 
     @njit(_SEARCH_SIG, cache=True, parallel=True)
-    def _search_parallel(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
+    def _search_parallel(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in prange(grid.shape[0]):
-            _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
+            _search_pose(
+                res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i
+            )
 
     @njit(_SEARCH_SIG, cache=True)
-    def _search_serial(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
+    def _search_serial(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in range(grid.shape[0]):
-            _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
+            _search_pose(
+                res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i
+            )
+
+    @njit(RESIDUALS_SIG, cache=True)
+    def _no_residuals(params, theta, out):  # pragma: no cover - never called (n_all = 0)
+        pass
+
+
+def _kernel_residuals(reduction):
+    """``reduction.kernel_residuals`` if the class that sets ``kernel`` sets it too (else None: a subclass with
+    its own ``kernel`` must not get its parent's all-branch kernel)."""
+    mro = type(reduction).__mro__
+    owner = next((c for c in mro if "kernel" in vars(c)), None)
+    # read from the class: a compiled function stored as a class attribute would bind to the instance
+    return None if owner is None else vars(owner).get("kernel_residuals")
 
 
 def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
@@ -507,8 +536,11 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
     span = (hi - lo).astype(np.float64)
     # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
     run = _search_parallel if N >= PARALLEL_MIN else _search_serial
+    res_all = _kernel_residuals(reduction)
     run(
         first_class(reduction.kernel[0]),
+        first_class(_no_residuals if res_all is None else res_all),
+        0 if res_all is None else reduction.n_branches,
         params,
         np.ascontiguousarray(theta),
         np.asarray(reduction.search_branches, dtype=np.int64),
