@@ -56,6 +56,7 @@ FLAT_BISECT = _ref.FLAT_BISECT
 JUMP_NOISE = _ref.JUMP_NOISE
 MULT_LEVEL = _ref.MULT_LEVEL
 MULT_MAX = _ref.MULT_MAX
+FAR_NOISE = _ref.FAR_NOISE
 #: Candidates and family spans kept per pose (the C-Arm has at most 8 rail positions; edges and near misses add
 #: candidates). Overflow is reported and the pose is redone by the NumPy engine.
 MAX_CAND = 256
@@ -213,6 +214,8 @@ if AVAILABLE:
                 break
             # root of the central difference g(x) = f(x + h) - f(x - h)
             xe = _root_diff(res, p, b, a, c, ga, gc, h)
+            if level == 0 and (1.0 if fc > 0 else -1.0) * res(p, xe, b) > FAR_NOISE * noise:
+                return  # located far from zero on fc's side: neither root nor touching (sweep.FAR_NOISE)
         fx = res(p, xe, b)
         if math.isnan(fx):
             return
@@ -220,7 +223,7 @@ if AVAILABLE:
         if s * fx < -noise:
             _push(out_t, out_b, cnt, _root(res, p, b, ta, xe, fa, fx, xtol), b)
             _push(out_t, out_b, cnt, _root(res, p, b, xe, tb, fx, fb, xtol), b)
-        else:
+        elif abs(fx) <= FAR_NOISE * noise:
             _push(out_t, out_b, cnt, xe, b)
 
     @njit(cache=True)

@@ -85,6 +85,13 @@ JUMP_NOISE = 1e3
 MULT_LEVEL = 1e4
 #: Largest multiplicity reported (rounding decides nothing finer).
 MULT_MAX = 8
+#: A located extremum of |residual| whose |residual| exceeds FAR_NOISE x the residual's noise (on the side of its
+#: samples) is not a candidate: 1e-2 for residuals of O(1) sines and cosines (noise 1e-14; C-Arm: the sine of the
+#: wrist's misalignment), 1e-2 of the arm's size for the pose-error residual; far above what certification
+#: (2e-13 of the arm's size) or the Newton polish (candidates within 1e-6 of it) accept. Extrema found that far
+#: after their first location are not located further. (Samples next to a NaN stay candidates whatever their
+#: residual: next to a family's samples, masked as NaN, their flat-stretch probe can join two pieces of it.)
+FAR_NOISE = 1e12
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
 XTOL_REL = 1e-16
 #: Half-step of the central difference used to locate extrema, relative to the theta* range.
@@ -180,6 +187,8 @@ class _Search:
         self.roots_t: list[Array] = []
         self.br: list[tuple[IntArray, IntArray, Array, Array, Array, Array]] = []
         self.spans: list[FamilySpan] = []
+        #: |residual| above which a sample or extremum is no candidate (see ``FAR_NOISE``)
+        self.far = FAR_NOISE * reduction.residual_noise
 
     def residual(self, pose: IntArray, branch: IntArray, theta: Array) -> Array:
         """Residual ``(K, M)`` of one branch per row."""
@@ -348,6 +357,8 @@ class _Search:
 
         xe = tc.copy()
         a, c = ta, tb
+        far = np.zeros(p.size, dtype=bool)
+        idx_ok = ~far
         # root of the central difference g(x) = f(x + h) - f(x - h), then again with h / DIFF_SHRINK around it:
         # the first step's truncation error (next to a domain edge f''' is large) shrinks by DIFF_SHRINK^2
         for level in range(DIFF_LEVELS):
@@ -358,7 +369,7 @@ class _Search:
             lo_, hi_ = a + h, c - h
             ga = fe(lo_ + h, idx) - fe(lo_ - h, idx)
             gc = fe(hi_ + h, idx) - fe(hi_ - h, idx)
-            ok = (ga * gc < 0) & (lo_ < hi_)
+            ok = (ga * gc < 0) & (lo_ < hi_) & idx_ok
             if not ok.any():
                 break
             k = np.nonzero(ok)[0]
@@ -368,6 +379,10 @@ class _Search:
                 return fe(x + hk[s], k[s]) - fe(x - hk[s], k[s])
 
             xe[k] = find_roots(g, lo_[k], hi_[k], ga[k], gc[k], 1e-3 * float(hk.min()))
+            if level == 0:  # an extremum located this far from zero (on fc's side) is neither root nor touching
+                f0 = fe(xe, idx)
+                far |= np.sign(fc) * f0 > self.far
+                idx_ok = ~far
         fx = fe(xe, idx)
         # a dip below zero within the residual's rounding noise is a double root, not two roots: bracketing
         # it would return arbitrary points of the flat bottom (where |f| < noise) instead of the extremum
@@ -376,7 +391,7 @@ class _Search:
         if k.size:
             self.br.append((p[k], b[k], ta[k], xe[k], fa[k], fx[k]))
             self.br.append((p[k], b[k], xe[k], tb[k], fx[k], fb[k]))
-        k = np.nonzero(~cross & np.isfinite(fx))[0]
+        k = np.nonzero(~cross & np.isfinite(fx) & ~far & (np.abs(fx) <= self.far))[0]
         self._root(p[k], b[k], xe[k])
 
     def finish(self) -> Candidates:
