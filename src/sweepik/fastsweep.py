@@ -142,7 +142,7 @@ if AVAILABLE:
                     if not _small(res, p, x + sgn * outer, b, noise):
                         break
             at_limit = inner >= limit
-            for _ in range(FLAT_BISECT):
+            for _ in range(FLAT_BISECT if outer > inner else 0):  # (at the reach limit: nothing to bisect)
                 mid = 0.5 * (inner + outer)
                 if _small(res, p, x + sgn * mid, b, noise):
                     inner = mid
@@ -262,13 +262,14 @@ if AVAILABLE:
 
     @njit(cache=True)
     def _scan(
-        res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top
-    ):
+        res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
+        wv, wx, wdd,
+    ):  # fmt: skip
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
         hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
         coordinate judges curvature (NaN: theta), as in sweep._Search.scan."""
         M = th.shape[0]
-        valid = np.empty(M, dtype=np.bool_)
+        valid = wv[:M]  # work arrays of the pose (no allocation per sequence)
         for j in range(M):
             valid[j] = not math.isnan(f[j])
         for j in range(M):  # samples on a root (the ends of a resampled interval are its parent's)
@@ -298,10 +299,11 @@ if AVAILABLE:
             if (lo_open and abs(f[j]) <= nr) or (hi_open and abs(f[j]) <= nl):
                 _push(out_t, out_b, cnt, th[j], b)
         # second divided differences, in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate)
-        x = np.empty(M)
+        x = wx[:M]
         for j in range(M):
             x[j] = th[j] if math.isnan(xe) else math.sqrt(abs(th[j] - xe))
-        dd = np.full(M, np.nan)
+        dd = wdd[:M]
+        dd[:] = np.nan
         for j in range(1, M - 1):
             if valid[j - 1] and valid[j] and valid[j + 1]:
                 hl = x[j] - x[j - 1]
@@ -379,6 +381,12 @@ if AVAILABLE:
             stk_i = np.empty((STACK, 3), dtype=np.int64)
             stk_c = np.empty((STACK, 5))
             no_ctx = np.full(4, np.nan)
+            wv = np.empty(max(M, SUB + 2), dtype=np.bool_)
+            wx = np.empty(max(M, SUB + 2))
+            wdd = np.empty(max(M, SUB + 2))
+            buf_t = np.empty(SUB + 2)
+            buf_f = np.empty(SUB + 2)
+            buf_c = np.empty(4)
             f_all = np.empty((M, max(n_all, 1)))
             if n_all > 0:
                 for j in range(M):
@@ -421,12 +429,15 @@ if AVAILABLE:
                 seq_t, seq_f, level, el, er, ctx, xe = th, f, 0, False, False, no_ctx, np.nan
                 while True:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
-                          c, stk_t, stk_f, stk_i, stk_c, top)  # fmt: skip
+                          c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd)  # fmt: skip
                     if top[0] == 0:
                         break
                     top[0] -= 1
                     k0 = top[0]
-                    seq_t, seq_f, ctx, xe = stk_t[k0].copy(), stk_f[k0].copy(), stk_c[k0, :4].copy(), stk_c[k0, 4]
+                    buf_t[:] = stk_t[k0]  # copied: the scan pushes its own intervals from k0 on
+                    buf_f[:] = stk_f[k0]
+                    buf_c[:] = stk_c[k0, :4]
+                    seq_t, seq_f, ctx, xe = buf_t, buf_f, buf_c, stk_c[k0, 4]
                     level, el, er = stk_i[k0, 0], stk_i[k0, 1] == 1, stk_i[k0, 2] == 1
             cnt[i] = c[0]
             n0 = min(c[0], out_t.shape[1])
