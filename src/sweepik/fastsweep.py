@@ -53,6 +53,7 @@ CLUSTER_FAMILY_REL = _ref.CLUSTER_FAMILY_REL
 FLAT_PROBE_REL = _ref.FLAT_PROBE_REL
 FLAT_MAX_REL = _ref.FLAT_MAX_REL
 FLAT_BISECT = _ref.FLAT_BISECT
+FLAT_SHORT_TOL = _ref.FLAT_SHORT_TOL
 JUMP_NOISE = _ref.JUMP_NOISE
 MULT_LEVEL = _ref.MULT_LEVEL
 MULT_MAX = _ref.MULT_MAX
@@ -128,34 +129,44 @@ if AVAILABLE:
         if not (_small(res, p, x - d0, b, noise) or _small(res, p, x + d0, b, noise)):
             return x, x, x, False
         limit = FLAT_MAX_REL * span
-        reach = np.zeros(2)
-        n_open = 0
-        for side in range(2):
-            sgn = -1.0 if side == 0 else 1.0
-            inner, outer = 0.0, d0
-            if _small(res, p, x + sgn * outer, b, noise):
-                for _ in range(64):
-                    inner = outer
-                    if inner >= limit:
-                        break
-                    outer = min(2.0 * outer, limit)
-                    if not _small(res, p, x + sgn * outer, b, noise):
-                        break
-            at_limit = inner >= limit
-            for _ in range(FLAT_BISECT if outer > inner else 0):  # (at the reach limit: nothing to bisect)
-                mid = 0.5 * (inner + outer)
-                if _small(res, p, x + sgn * mid, b, noise):
-                    inner = mid
-                else:
-                    outer = mid
-            past = abs(res(p, x + sgn * outer, b))
-            far = abs(res(p, x + 2.0 * sgn * outer, b))
-            if at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise:
-                n_open += 1
-            reach[side] = inner
-        lo, hi = x - reach[0], x + reach[1]
-        family = n_open == 2 and hi - lo > CLUSTER_FAMILY_REL * span
+        in0, out0 = _flat_grow(res, p, x, b, noise, d0, limit, -1.0)
+        in1, out1 = _flat_grow(res, p, x, b, noise, d0, limit, 1.0)
+        short = out0 <= 0.5 * CLUSTER_FAMILY_REL * span and out1 <= 0.5 * CLUSTER_FAMILY_REL * span
+        r0, open0 = _flat_end(res, p, x, b, noise, in0, out0, limit, -1.0, short)
+        r1, open1 = _flat_end(res, p, x, b, noise, in1, out1, limit, 1.0, short)
+        lo, hi = x - r0, x + r1
+        family = open0 and open1 and hi - lo > CLUSTER_FAMILY_REL * span
         return 0.5 * (lo + hi), lo, hi, family
+
+    @njit(cache=True)
+    def _flat_grow(res, p, x, b, noise, d0, limit, sgn):
+        """(inner, outer): the residual is within the noise at x + sgn inner, not at x + sgn outer (doubling)."""
+        inner, outer = 0.0, d0
+        if _small(res, p, x + sgn * outer, b, noise):
+            for _ in range(64):
+                inner = outer
+                if inner >= limit:
+                    break
+                outer = min(2.0 * outer, limit)
+                if not _small(res, p, x + sgn * outer, b, noise):
+                    break
+        return inner, outer
+
+    @njit(cache=True)
+    def _flat_end(res, p, x, b, noise, inner, outer, limit, sgn, short):
+        """(reach, the stretch ends openly) on one side, as in sweep._Search._center_flat."""
+        at_limit = inner >= limit
+        for _ in range(FLAT_BISECT if outer > inner else 0):  # (at the reach limit: nothing to bisect)
+            if short and outer - inner <= FLAT_SHORT_TOL * inner:
+                break
+            mid = 0.5 * (inner + outer)
+            if _small(res, p, x + sgn * mid, b, noise):
+                inner = mid
+            else:
+                outer = mid
+        past = abs(res(p, x + sgn * outer, b))
+        far = abs(res(p, x + 2.0 * sgn * outer, b))
+        return inner, at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise
 
     @njit(cache=True)
     def _multiplicity(res, p, x, b, noise, span):

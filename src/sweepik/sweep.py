@@ -70,6 +70,10 @@ CLUSTER_FAMILY_REL = 1e-5
 FLAT_PROBE_REL = 1e-9
 FLAT_MAX_REL = 1e-2
 FLAT_BISECT = 30
+#: ... but a stretch too short to be a family (it marks a root of high multiplicity, see ``_center_flat``) only
+#: to this fraction of its half-width: its centre is the root, and rounding leaves the root undetermined across
+#: the whole stretch anyway (2^-12; 30 halvings would pin the ends to 1e-9 of it).
+FLAT_SHORT_TOL = 2.0**-12
 #: Bisection steps locating where a family ends between its last sample and the next one.
 FAMILY_BISECT = 40
 #: Minimum number of consecutive vanishing samples that make a family.
@@ -432,10 +436,11 @@ class _Search:
         pf, bf, tf = p[flat], b[flat], t[flat]
         reach = np.empty((flat.size, 2))
         open_end = np.empty((flat.size, 2), dtype=bool)
+        limit = FLAT_MAX_REL * self.span[pf]
+        inners, outers = np.zeros((flat.size, 2)), np.zeros((flat.size, 2))
         for side, sgn in enumerate((-1.0, 1.0)):
             inner = np.zeros(flat.size)
             outer = d0[flat].copy()
-            limit = FLAT_MAX_REL * self.span[pf]
             grow = self._small(pf, bf, tf + sgn * outer)
             for _ in range(64):  # double until the residual leaves the noise (or the reach limit)
                 if not grow.any():
@@ -443,12 +448,19 @@ class _Search:
                 inner = np.where(grow, outer, inner)
                 outer = np.where(grow, np.minimum(2.0 * outer, limit), outer)
                 grow = grow & (inner < limit) & self._small(pf, bf, tf + sgn * outer)
+            inners[:, side], outers[:, side] = inner, outer
+        # a stretch that cannot be a family (both sides within half of CLUSTER_FAMILY_REL) only gives the centre
+        # of a multiple root: its ends are bisected to FLAT_SHORT_TOL of their reach
+        short = np.all(outers <= 0.5 * CLUSTER_FAMILY_REL * self.span[pf][:, None], axis=1)
+        for side, sgn in enumerate((-1.0, 1.0)):
+            inner, outer = inners[:, side], outers[:, side]
             at_limit = inner >= limit
             for _ in range(FLAT_BISECT):  # boundary between inner (small) and outer (not small)
+                go = ~short | (outer - inner > FLAT_SHORT_TOL * inner)
                 mid = 0.5 * (inner + outer)
                 sm = self._small(pf, bf, tf + sgn * mid)
-                inner = np.where(sm, mid, inner)
-                outer = np.where(sm, outer, mid)
+                inner = np.where(go & sm, mid, inner)
+                outer = np.where(go & ~sm, mid, outer)
             past = np.abs(self.residual(pf, bf, (tf + sgn * outer)[:, None])[:, 0])
             # ... and keeps growing (a rounding blip inside a continuum falls back into the noise)
             far = np.abs(self.residual(pf, bf, (tf + 2.0 * sgn * outer)[:, None])[:, 0])
