@@ -274,7 +274,7 @@ if AVAILABLE:
     @njit(cache=True)
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
-        wv, wx, wdd,
+        wv, wx, wdd, res_all, n_all, edge_f, edge_ok,
     ):  # fmt: skip
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
         hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
@@ -351,8 +351,18 @@ if AVAILABLE:
                     stk_t[k0, k] = th[j] + (th[j + 1] - th[j]) * us[k]
                 stk_f[k0, 0] = f[j]
                 stk_f[k0, SUB + 1] = f[j + 1]
-                for k in range(1, SUB + 1):
-                    stk_f[k0, k] = res(p, stk_t[k0, k], b)
+                if level == 0 and near_edge and n_all > 0:
+                    # the uniform grid is every branch's, and a domain edge is usually every branch's too: the
+                    # sub-samples of an interval next to one are evaluated for all branches at once (the same values)
+                    if not edge_ok[j]:
+                        for k in range(1, SUB + 1):
+                            res_all(p, stk_t[k0, k], edge_f[j, k])
+                        edge_ok[j] = True
+                    for k in range(1, SUB + 1):
+                        stk_f[k0, k] = edge_f[j, k, b]
+                else:
+                    for k in range(1, SUB + 1):
+                        stk_f[k0, k] = res(p, stk_t[k0, k], b)
                 stk_i[k0, 0] = level + 1
                 stk_i[k0, 1] = 1 if open_l else 0
                 stk_i[k0, 2] = 1 if open_r else 0
@@ -399,6 +409,8 @@ if AVAILABLE:
             buf_f = np.empty(SUB + 2)
             buf_c = np.empty(4)
             f_all = np.empty((M, max(n_all, 1)))
+            edge_f = np.empty((M, SUB + 1, max(n_all, 1)))  # all-branch sub-samples of edge intervals (level 0)
+            edge_ok = np.zeros(M, dtype=np.bool_)
             if n_all > 0:
                 for j in range(M):
                     res_all(p, th[j], f_all[j])
@@ -440,7 +452,7 @@ if AVAILABLE:
                 seq_t, seq_f, level, el, er, ctx, xe = th, f, 0, False, False, no_ctx, np.nan
                 while True:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
-                          c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd)  # fmt: skip
+                          c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd, res_all, n_all, edge_f, edge_ok)  # fmt: skip
                     if top[0] == 0:
                         break
                     top[0] -= 1
