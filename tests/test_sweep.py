@@ -88,3 +88,33 @@ def test_subclass_overriding_the_residual_does_not_run_the_parents_kernel() -> N
     q = np.array([700.0, 0.4, 0.3, -0.5, 0.6, 0.2])
     sols = sweepik.solve(arm, arm.fk(q), reduction=NoResidual(arm))
     assert np.abs(sols.nearest(q) - q).max() < 1e-6
+
+
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+def test_all_branch_kernel_is_bitwise_the_branch_kernel() -> None:
+    """carm-d1's all-branch residual kernel (used for the uniform samples) gives exactly, bit for bit, what the
+    one-branch kernel gives: same roots, same extrema, same families as branch-by-branch evaluation."""
+    from sweepik.reductions import kernels
+
+    red = sweepik.get_reduction(CARM, "carm-d1")
+    q = _stress(400, seed=11)
+    q[:20, 0] = 800.0  # with theta2 = 0 below: the wrist on joint 2's axis at d1 = Pz (r = 0)
+    q[:20, 1] = 0.0
+    chain = CARM.fk(q)
+    params = red.kernel_params(chain)
+    hints = red.sample_hints(chain)
+    rng = np.random.default_rng(5)
+    lo, hi = red.search_range(chain).T
+    out = np.empty(4)
+    for i in range(len(q)):
+        thetas = np.concatenate([hints[i], rng.uniform(lo[i], hi[i], 40), [chain[i, 2, 3]]])
+        for th in thetas[np.isfinite(thetas)]:
+            kernels.carm_d1_residuals(params[i], float(th), out)
+            one = np.array([kernels.carm_d1_residual(params[i], float(th), b) for b in range(4)])
+            np.testing.assert_array_equal(out, one)
+    assert fastsweep._kernel_residuals(red) is kernels.carm_d1_residuals
+
+    class OwnKernel(sweepik.CArmD1):
+        kernel = (kernels.carm_theta2_residual, kernels.carm_theta2_configuration)
+
+    assert fastsweep._kernel_residuals(OwnKernel(CARM)) is None

@@ -53,9 +53,11 @@ CLUSTER_FAMILY_REL = _ref.CLUSTER_FAMILY_REL
 FLAT_PROBE_REL = _ref.FLAT_PROBE_REL
 FLAT_MAX_REL = _ref.FLAT_MAX_REL
 FLAT_BISECT = _ref.FLAT_BISECT
+FLAT_SHORT_TOL = _ref.FLAT_SHORT_TOL
 JUMP_NOISE = _ref.JUMP_NOISE
 MULT_LEVEL = _ref.MULT_LEVEL
 MULT_MAX = _ref.MULT_MAX
+FAR_NOISE = _ref.FAR_NOISE
 #: Candidates and family spans kept per pose (the C-Arm has at most 8 rail positions; edges and near misses add
 #: candidates). Overflow is reported and the pose is redone by the NumPy engine.
 MAX_CAND = 256
@@ -127,34 +129,44 @@ if AVAILABLE:
         if not (_small(res, p, x - d0, b, noise) or _small(res, p, x + d0, b, noise)):
             return x, x, x, False
         limit = FLAT_MAX_REL * span
-        reach = np.zeros(2)
-        n_open = 0
-        for side in range(2):
-            sgn = -1.0 if side == 0 else 1.0
-            inner, outer = 0.0, d0
-            if _small(res, p, x + sgn * outer, b, noise):
-                for _ in range(64):
-                    inner = outer
-                    if inner >= limit:
-                        break
-                    outer = min(2.0 * outer, limit)
-                    if not _small(res, p, x + sgn * outer, b, noise):
-                        break
-            at_limit = inner >= limit
-            for _ in range(FLAT_BISECT):
-                mid = 0.5 * (inner + outer)
-                if _small(res, p, x + sgn * mid, b, noise):
-                    inner = mid
-                else:
-                    outer = mid
-            past = abs(res(p, x + sgn * outer, b))
-            far = abs(res(p, x + 2.0 * sgn * outer, b))
-            if at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise:
-                n_open += 1
-            reach[side] = inner
-        lo, hi = x - reach[0], x + reach[1]
-        family = n_open == 2 and hi - lo > CLUSTER_FAMILY_REL * span
+        in0, out0 = _flat_grow(res, p, x, b, noise, d0, limit, -1.0)
+        in1, out1 = _flat_grow(res, p, x, b, noise, d0, limit, 1.0)
+        short = out0 <= 0.5 * CLUSTER_FAMILY_REL * span and out1 <= 0.5 * CLUSTER_FAMILY_REL * span
+        r0, open0 = _flat_end(res, p, x, b, noise, in0, out0, limit, -1.0, short)
+        r1, open1 = _flat_end(res, p, x, b, noise, in1, out1, limit, 1.0, short)
+        lo, hi = x - r0, x + r1
+        family = open0 and open1 and hi - lo > CLUSTER_FAMILY_REL * span
         return 0.5 * (lo + hi), lo, hi, family
+
+    @njit(cache=True)
+    def _flat_grow(res, p, x, b, noise, d0, limit, sgn):
+        """(inner, outer): the residual is within the noise at x + sgn inner, not at x + sgn outer (doubling)."""
+        inner, outer = 0.0, d0
+        if _small(res, p, x + sgn * outer, b, noise):
+            for _ in range(64):
+                inner = outer
+                if inner >= limit:
+                    break
+                outer = min(2.0 * outer, limit)
+                if not _small(res, p, x + sgn * outer, b, noise):
+                    break
+        return inner, outer
+
+    @njit(cache=True)
+    def _flat_end(res, p, x, b, noise, inner, outer, limit, sgn, short):
+        """(reach, the stretch ends openly) on one side, as in sweep._Search._center_flat."""
+        at_limit = inner >= limit
+        for _ in range(FLAT_BISECT if outer > inner else 0):  # (at the reach limit: nothing to bisect)
+            if short and outer - inner <= FLAT_SHORT_TOL * inner:
+                break
+            mid = 0.5 * (inner + outer)
+            if _small(res, p, x + sgn * mid, b, noise):
+                inner = mid
+            else:
+                outer = mid
+        past = abs(res(p, x + sgn * outer, b))
+        far = abs(res(p, x + 2.0 * sgn * outer, b))
+        return inner, at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise
 
     @njit(cache=True)
     def _multiplicity(res, p, x, b, noise, span):
@@ -213,6 +225,8 @@ if AVAILABLE:
                 break
             # root of the central difference g(x) = f(x + h) - f(x - h)
             xe = _root_diff(res, p, b, a, c, ga, gc, h)
+            if level == 0 and (1.0 if fc > 0 else -1.0) * res(p, xe, b) > FAR_NOISE * noise:
+                return  # located far from zero on fc's side: neither root nor touching (sweep.FAR_NOISE)
         fx = res(p, xe, b)
         if math.isnan(fx):
             return
@@ -220,7 +234,7 @@ if AVAILABLE:
         if s * fx < -noise:
             _push(out_t, out_b, cnt, _root(res, p, b, ta, xe, fa, fx, xtol), b)
             _push(out_t, out_b, cnt, _root(res, p, b, xe, tb, fx, fb, xtol), b)
-        else:
+        elif abs(fx) <= FAR_NOISE * noise:
             _push(out_t, out_b, cnt, xe, b)
 
     @njit(cache=True)
@@ -259,12 +273,14 @@ if AVAILABLE:
 
     @njit(cache=True)
     def _scan(
-        res, p, b, th, f, level, el, er, ctx, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top
-    ):
+        res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
+        wv, wx, wdd, res_all, n_all, edge_f, edge_ok,
+    ):  # fmt: skip
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
-        hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, as in sweep._Search.scan."""
+        hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
+        coordinate judges curvature (NaN: theta), as in sweep._Search.scan."""
         M = th.shape[0]
-        valid = np.empty(M, dtype=np.bool_)
+        valid = wv[:M]  # work arrays of the pose (no allocation per sequence)
         for j in range(M):
             valid[j] = not math.isnan(f[j])
         for j in range(M):  # samples on a root (the ends of a resampled interval are its parent's)
@@ -293,13 +309,17 @@ if AVAILABLE:
             nl = abs(f[j - 1]) if (j > 0 and valid[j - 1]) else np.inf
             if (lo_open and abs(f[j]) <= nr) or (hi_open and abs(f[j]) <= nl):
                 _push(out_t, out_b, cnt, th[j], b)
-        # second divided differences
-        dd = np.full(M, np.nan)
+        # second divided differences, in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate)
+        x = wx[:M]
+        for j in range(M):
+            x[j] = th[j] if math.isnan(xe) else math.sqrt(abs(th[j] - xe))
+        dd = wdd[:M]
+        dd[:] = np.nan
         for j in range(1, M - 1):
             if valid[j - 1] and valid[j] and valid[j + 1]:
-                hl = th[j] - th[j - 1]
-                hr = th[j + 1] - th[j]
-                if hl > 0 and hr > 0:
+                hl = x[j] - x[j - 1]
+                hr = x[j + 1] - x[j]
+                if hl != 0.0 and hr != 0.0:  # (decreasing where the edge is on the right: same dd)
                     dd[j] = 2.0 * ((f[j + 1] - f[j]) / hr - (f[j] - f[j - 1]) / hl) / (hl + hr)
         for j in range(M - 1):
             if not (valid[j] and valid[j + 1] and th[j + 1] > th[j]):
@@ -316,10 +336,11 @@ if AVAILABLE:
                     curv = abs(c1)
                 if not math.isnan(c2) and (math.isnan(curv) or abs(c2) > curv):
                     curv = abs(c2)
-                h = th[j + 1] - th[j]
+                h = x[j + 1] - x[j]
                 lowest = min(abs(f[j]), abs(f[j + 1]))
                 bend = (not math.isnan(curv)) and lowest <= BEND * curv * h * h
-                refine = bend or near_edge
+                own_edge = (open_l and th[j] == xe and not open_r) or (open_r and th[j + 1] == xe and not open_l)
+                refine = bend or (near_edge and not own_edge)
             if refine:
                 if top[0] >= stk_t.shape[0]:
                     cnt[0] += out_t.shape[0] + 1  # overflow: the caller redoes this pose with NumPy
@@ -330,8 +351,18 @@ if AVAILABLE:
                     stk_t[k0, k] = th[j] + (th[j + 1] - th[j]) * us[k]
                 stk_f[k0, 0] = f[j]
                 stk_f[k0, SUB + 1] = f[j + 1]
-                for k in range(1, SUB + 1):
-                    stk_f[k0, k] = res(p, stk_t[k0, k], b)
+                if level == 0 and near_edge and n_all > 0:
+                    # the uniform grid is every branch's, and a domain edge is usually every branch's too: the
+                    # sub-samples of an interval next to one are evaluated for all branches at once (the same values)
+                    if not edge_ok[j]:
+                        for k in range(1, SUB + 1):
+                            res_all(p, stk_t[k0, k], edge_f[j, k])
+                        edge_ok[j] = True
+                    for k in range(1, SUB + 1):
+                        stk_f[k0, k] = edge_f[j, k, b]
+                else:
+                    for k in range(1, SUB + 1):
+                        stk_f[k0, k] = res(p, stk_t[k0, k], b)
                 stk_i[k0, 0] = level + 1
                 stk_i[k0, 1] = 1 if open_l else 0
                 stk_i[k0, 2] = 1 if open_r else 0
@@ -343,6 +374,12 @@ if AVAILABLE:
                     stk_c[k0, 2], stk_c[k0, 3] = th[j + 2], f[j + 2]
                 else:
                     stk_c[k0, 2], stk_c[k0, 3] = ctx[2], ctx[3]
+                if open_l and not open_r:
+                    stk_c[k0, 4] = th[j]
+                elif open_r and not open_l:
+                    stk_c[k0, 4] = th[j + 1]
+                else:
+                    stk_c[k0, 4] = np.nan if open_l else xe
                 top[0] += 1
             elif prod < 0:
                 _push(out_t, out_b, cnt, _root(res, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
@@ -351,7 +388,9 @@ if AVAILABLE:
     _U_EDGE_ARR = _U_EDGE.copy()
 
     @njit(cache=True)
-    def _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
+    def _search_pose(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
+        """Pose ``i``. ``res_all``: every branch's residual at once (``Reduction.kernel_residuals``), used for the
+        uniform samples when ``n_all`` (the number of branches it fills) is not 0."""
         M = grid.shape[1]
         if True:
             p = params[i]
@@ -361,13 +400,29 @@ if AVAILABLE:
             stk_t = np.empty((STACK, SUB + 2))
             stk_f = np.empty((STACK, SUB + 2))
             stk_i = np.empty((STACK, 3), dtype=np.int64)
-            stk_c = np.empty((STACK, 4))
+            stk_c = np.empty((STACK, 5))
             no_ctx = np.full(4, np.nan)
+            wv = np.empty(max(M, SUB + 2), dtype=np.bool_)
+            wx = np.empty(max(M, SUB + 2))
+            wdd = np.empty(max(M, SUB + 2))
+            buf_t = np.empty(SUB + 2)
+            buf_f = np.empty(SUB + 2)
+            buf_c = np.empty(4)
+            f_all = np.empty((M, max(n_all, 1)))
+            edge_f = np.empty((M, SUB + 1, max(n_all, 1)))  # all-branch sub-samples of edge intervals (level 0)
+            edge_ok = np.zeros(M, dtype=np.bool_)
+            if n_all > 0:
+                for j in range(M):
+                    res_all(p, th[j], f_all[j])
             for bi in range(branches.shape[0]):
                 b = branches[bi]
                 f = np.empty(M)
-                for j in range(M):
-                    f[j] = res(p, th[j], b)
+                if n_all > 0:
+                    for j in range(M):
+                        f[j] = f_all[j, b]
+                else:
+                    for j in range(M):
+                        f[j] = res(p, th[j], b)
                 # families: runs of vanishing samples
                 j = 0
                 while j < M:
@@ -394,15 +449,18 @@ if AVAILABLE:
                         j += 1
                 top = np.zeros(1, dtype=np.int64)
                 # the sequence itself, then the resampled intervals it (and they) push on the stack
-                seq_t, seq_f, level, el, er, ctx = th, f, 0, False, False, no_ctx
+                seq_t, seq_f, level, el, er, ctx, xe = th, f, 0, False, False, no_ctx, np.nan
                 while True:
-                    _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, span[i], noise, xtol, out_t[i], out_b[i], c,
-                          stk_t, stk_f, stk_i, stk_c, top)  # fmt: skip
+                    _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
+                          c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd, res_all, n_all, edge_f, edge_ok)  # fmt: skip
                     if top[0] == 0:
                         break
                     top[0] -= 1
                     k0 = top[0]
-                    seq_t, seq_f, ctx = stk_t[k0].copy(), stk_f[k0].copy(), stk_c[k0].copy()
+                    buf_t[:] = stk_t[k0]  # copied: the scan pushes its own intervals from k0 on
+                    buf_f[:] = stk_f[k0]
+                    buf_c[:] = stk_c[k0, :4]
+                    seq_t, seq_f, ctx, xe = buf_t, buf_f, buf_c, stk_c[k0, 4]
                     level, el, er = stk_i[k0, 0], stk_i[k0, 1] == 1, stk_i[k0, 2] == 1
             cnt[i] = c[0]
             n0 = min(c[0], out_t.shape[1])
@@ -451,12 +509,14 @@ if AVAILABLE:
 
     from numba import float64, int64, types
 
-    from .reductions.kernels import RESIDUAL_SIG
+    from .reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG
 
     #: The engine's entry signature: the residual is a first-class function, so the engine is compiled once
     #: (and cached) for every reduction.
     _SEARCH_SIG = (
         types.FunctionType(RESIDUAL_SIG),
+        types.FunctionType(RESIDUALS_SIG),
+        int64,
         float64[:, ::1],
         float64[:, ::1],
         int64[::1],
@@ -471,14 +531,31 @@ if AVAILABLE:
     )
 
     @lazy_njit(_SEARCH_SIG, cache=True, parallel=True)
-    def _search_parallel(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
+    def _search_parallel(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in prange(grid.shape[0]):
-            _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
+            _search_pose(
+                res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i
+            )
 
     @lazy_njit(_SEARCH_SIG, cache=True)
-    def _search_serial(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
+    def _search_serial(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
         for i in range(grid.shape[0]):
-            _search_pose(res, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i)
+            _search_pose(
+                res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i
+            )
+
+    @lazy_njit(RESIDUALS_SIG, cache=True)
+    def _no_residuals(params, theta, out):  # pragma: no cover - never called (n_all = 0)
+        pass
+
+
+def _kernel_residuals(reduction):
+    """``reduction.kernel_residuals`` if the class that sets ``kernel`` sets it too (else None: a subclass with
+    its own ``kernel`` must not get its parent's all-branch kernel)."""
+    mro = type(reduction).__mro__
+    owner = next((c for c in mro if "kernel" in vars(c)), None)
+    # read from the class: a compiled function stored as a class attribute would bind to the instance
+    return None if owner is None else vars(owner).get("kernel_residuals")
 
 
 def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
@@ -496,8 +573,11 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
     span = (hi - lo).astype(np.float64)
     # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
     run = _search_parallel if N >= PARALLEL_MIN else _search_serial
+    res_all = _kernel_residuals(reduction)
     run(
         first_class(reduction.kernel[0]),
+        first_class(_no_residuals if res_all is None else res_all),
+        0 if res_all is None else reduction.n_branches,
         params,
         np.ascontiguousarray(theta),
         np.asarray(reduction.search_branches, dtype=np.int64),

@@ -45,7 +45,9 @@ SUB_SAMPLES = 8
 MAX_LEVELS = 4
 #: An interval is resampled when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola dips h^2 |f''| / 8
 #: below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step), and always next to
-#: a domain edge or range end (no curvature estimate there; square-root behaviour at a domain edge).
+#: a domain edge at the first level (square-root behaviour there: no curvature estimate in theta). Below that,
+#: curvature is judged in the coordinate sqrt(|theta - edge|), in which the residual is smooth
+#: (``_edge_coordinate``): the intervals next to the edge are resampled only where that test says so.
 BEND = 1.0
 #: An interior extremum of |residual| is examined only if its sample is within EXTREMUM_REACH |f''| h^2 of
 #: zero: 8 times the deepest dip a parabola through the three samples can have (|f''| h^2 / 2).
@@ -68,6 +70,10 @@ CLUSTER_FAMILY_REL = 1e-5
 FLAT_PROBE_REL = 1e-9
 FLAT_MAX_REL = 1e-2
 FLAT_BISECT = 30
+#: ... but a stretch too short to be a family (it marks a root of high multiplicity, see ``_center_flat``) only
+#: to this fraction of its half-width: its centre is the root, and rounding leaves the root undetermined across
+#: the whole stretch anyway (2^-12; 30 halvings would pin the ends to 1e-9 of it).
+FLAT_SHORT_TOL = 2.0**-12
 #: Bisection steps locating where a family ends between its last sample and the next one.
 FAMILY_BISECT = 40
 #: Minimum number of consecutive vanishing samples that make a family.
@@ -83,6 +89,13 @@ JUMP_NOISE = 1e3
 MULT_LEVEL = 1e4
 #: Largest multiplicity reported (rounding decides nothing finer).
 MULT_MAX = 8
+#: A located extremum of |residual| whose |residual| exceeds FAR_NOISE x the residual's noise (on the side of its
+#: samples) is not a candidate: 1e-2 for residuals of O(1) sines and cosines (noise 1e-14; C-Arm: the sine of the
+#: wrist's misalignment), 1e-2 of the arm's size for the pose-error residual; far above what certification
+#: (2e-13 of the arm's size) or the Newton polish (candidates within 1e-6 of it) accept. Extrema found that far
+#: after their first location are not located further. (Samples next to a NaN stay candidates whatever their
+#: residual: next to a family's samples, masked as NaN, their flat-stretch probe can join two pieces of it.)
+FAR_NOISE = 1e12
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
 XTOL_REL = 1e-16
 #: Half-step of the central difference used to locate extrema, relative to the theta* range.
@@ -157,6 +170,15 @@ def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samp
     return grid
 
 
+def _edge_coordinate(theta: Array, edge: Array) -> Array:
+    """The coordinate in which an interval's curvature is judged: theta, or ``sqrt(|theta - edge|)`` where
+    ``edge`` (broadcast against ``theta``) is finite. At a branch-domain edge the residual behaves like
+    ``a + b sqrt(|theta - edge|) + ...`` (the square root of the branch's discriminant): analytic in that
+    coordinate, unbounded in curvature in theta. Judged in theta, the intervals next to an edge always look bent
+    and are resampled down to the last level; judged in the square root, only where a root can hide."""
+    return np.where(np.isfinite(edge), np.sqrt(np.abs(theta - edge)), theta)
+
+
 class _Search:
     """Candidate search over residual sequences ``theta, f (S, M)`` with pose/branch per sequence."""
 
@@ -169,6 +191,8 @@ class _Search:
         self.roots_t: list[Array] = []
         self.br: list[tuple[IntArray, IntArray, Array, Array, Array, Array]] = []
         self.spans: list[FamilySpan] = []
+        #: |residual| above which a sample or extremum is no candidate (see ``FAR_NOISE``)
+        self.far = FAR_NOISE * reduction.residual_noise
 
     def residual(self, pose: IntArray, branch: IntArray, theta: Array) -> Array:
         """Residual ``(K, M)`` of one branch per row."""
@@ -192,6 +216,7 @@ class _Search:
         edge_left: NDArray[np.bool_] | None = None,
         edge_right: NDArray[np.bool_] | None = None,
         ctx: tuple[Array, Array, Array, Array] | None = None,
+        edge_x: Array | None = None,
     ) -> None:
         """Find candidates on sequences ``th, f (S, M)`` (``valid``: usable samples); recurse into bends.
 
@@ -199,10 +224,14 @@ class _Search:
         ``ctx``: (theta, f) of the samples just left and right of a resampled interval (its parent's neighbours,
         NaN where there is none), so that its end samples get the extremum test with their nearest neighbours:
         a double root just beside a parent sample lies in the first or last sub-interval at every level.
+        ``edge_x (S,)``: the domain edge whose neighbouring interval this sequence resamples (NaN if none): there
+        curvature is judged in the coordinate sqrt(|theta - edge|) (see ``_edge_coordinate``).
         """
         S, M = f.shape
         if edge_left is None or edge_right is None:
             edge_left = edge_right = np.zeros(S, dtype=bool)
+        if edge_x is None:
+            edge_x = np.full(S, np.nan)
         absf = np.abs(f)
         fin = np.where(valid, f, np.nan)
         t0, t1 = th[:, :-1], th[:, 1:]
@@ -262,25 +291,33 @@ class _Search:
         self._root(p[d_i], b[d_i], th[d_i, d_j])
         # 5) intervals that may hide a pair of roots (besides a sign change they may have) are resampled;
         #    sign changes of the other intervals are bracketed
-        h = t1 - t0
         prod = fin[:, :-1] * fin[:, 1:]
         if level < MAX_LEVELS:
             with np.errstate(invalid="ignore", divide="ignore"):
+                # curvature in theta, or in sqrt(|theta - edge|) below an edge's interval
+                x = _edge_coordinate(th, edge_x[:, None])
                 dd = np.full((S, M), np.nan)  # second divided difference at interior samples
                 if M >= 3:
-                    hl, hr = th[:, 1:-1] - th[:, :-2], th[:, 2:] - th[:, 1:-1]
+                    hl, hr = x[:, 1:-1] - x[:, :-2], x[:, 2:] - x[:, 1:-1]
                     dd[:, 1:-1] = (
                         2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
                     )
                 curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
                 lowest = np.minimum(absf[:, :-1], absf[:, 1:])
-                bend = lowest <= BEND * curv * h * h
+                hx = x[:, 1:] - x[:, :-1]
+                bend = lowest <= BEND * curv * hx * hx
                 # sample j borders a domain edge on its left / right
                 open_l = np.concatenate([edge_left[:, None], ~valid[:, :-1]], axis=1)
                 open_r = np.concatenate([~valid[:, 1:], edge_right[:, None]], axis=1)
                 near_edge = open_l[:, :-1] | open_r[:, 1:]
+                # an interval next to an edge is resampled unconditionally, except next to the edge whose
+                # coordinate judges the curvature (there the bend test in that coordinate decides)
+                ex = edge_x[:, None]
+                own_edge = (open_l[:, :-1] & (t0 == ex) & ~open_r[:, 1:]) | (
+                    open_r[:, 1:] & (t1 == ex) & ~open_l[:, :-1]
+                )
             nonzero = np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0
-            refine = both & nonzero & (bend | near_edge)
+            refine = both & nonzero & (bend | (near_edge & ~own_edge))
         else:
             refine = np.zeros_like(both)
         s_i, s_j = np.nonzero(both & ~refine & (prod < 0))
@@ -306,7 +343,11 @@ class _Search:
         cl_f = np.where(left, fin[r_i, jl], nan if ctx is None else ctx[1][r_i])
         cr_t = np.where(right, th[r_i, jr], nan if ctx is None else ctx[2][r_i])
         cr_f = np.where(right, fin[r_i, jr], nan if ctx is None else ctx[3][r_i])
-        self.scan(pp, bb, sub, fs, vs, level + 1, open_l[r_i, r_j], open_r[r_i, r_j + 1], (cl_t, cl_f, cr_t, cr_f))
+        # an interval next to one edge: its sub-sequences judge curvature in that edge's coordinate; next to two
+        # edges: in theta; next to none: as their parent
+        el, er = open_l[r_i, r_j], open_r[r_i, r_j + 1]
+        ex = np.where(el & ~er, th[r_i, r_j], np.where(er & ~el, th[r_i, r_j + 1], np.where(el, np.nan, edge_x[r_i])))
+        self.scan(pp, bb, sub, fs, vs, level + 1, el, er, (cl_t, cl_f, cr_t, cr_f), ex)
 
     def _extrema(
         self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array, fa: Array, fb: Array
@@ -320,6 +361,8 @@ class _Search:
 
         xe = tc.copy()
         a, c = ta, tb
+        far = np.zeros(p.size, dtype=bool)
+        idx_ok = ~far
         # root of the central difference g(x) = f(x + h) - f(x - h), then again with h / DIFF_SHRINK around it:
         # the first step's truncation error (next to a domain edge f''' is large) shrinks by DIFF_SHRINK^2
         for level in range(DIFF_LEVELS):
@@ -330,7 +373,7 @@ class _Search:
             lo_, hi_ = a + h, c - h
             ga = fe(lo_ + h, idx) - fe(lo_ - h, idx)
             gc = fe(hi_ + h, idx) - fe(hi_ - h, idx)
-            ok = (ga * gc < 0) & (lo_ < hi_)
+            ok = (ga * gc < 0) & (lo_ < hi_) & idx_ok
             if not ok.any():
                 break
             k = np.nonzero(ok)[0]
@@ -340,6 +383,10 @@ class _Search:
                 return fe(x + hk[s], k[s]) - fe(x - hk[s], k[s])
 
             xe[k] = find_roots(g, lo_[k], hi_[k], ga[k], gc[k], 1e-3 * float(hk.min()))
+            if level == 0:  # an extremum located this far from zero (on fc's side) is neither root nor touching
+                f0 = fe(xe, idx)
+                far |= np.sign(fc) * f0 > self.far
+                idx_ok = ~far
         fx = fe(xe, idx)
         # a dip below zero within the residual's rounding noise is a double root, not two roots: bracketing
         # it would return arbitrary points of the flat bottom (where |f| < noise) instead of the extremum
@@ -348,7 +395,7 @@ class _Search:
         if k.size:
             self.br.append((p[k], b[k], ta[k], xe[k], fa[k], fx[k]))
             self.br.append((p[k], b[k], xe[k], tb[k], fx[k], fb[k]))
-        k = np.nonzero(~cross & np.isfinite(fx))[0]
+        k = np.nonzero(~cross & np.isfinite(fx) & ~far & (np.abs(fx) <= self.far))[0]
         self._root(p[k], b[k], xe[k])
 
     def finish(self) -> Candidates:
@@ -389,10 +436,11 @@ class _Search:
         pf, bf, tf = p[flat], b[flat], t[flat]
         reach = np.empty((flat.size, 2))
         open_end = np.empty((flat.size, 2), dtype=bool)
+        limit = FLAT_MAX_REL * self.span[pf]
+        inners, outers = np.zeros((flat.size, 2)), np.zeros((flat.size, 2))
         for side, sgn in enumerate((-1.0, 1.0)):
             inner = np.zeros(flat.size)
             outer = d0[flat].copy()
-            limit = FLAT_MAX_REL * self.span[pf]
             grow = self._small(pf, bf, tf + sgn * outer)
             for _ in range(64):  # double until the residual leaves the noise (or the reach limit)
                 if not grow.any():
@@ -400,12 +448,19 @@ class _Search:
                 inner = np.where(grow, outer, inner)
                 outer = np.where(grow, np.minimum(2.0 * outer, limit), outer)
                 grow = grow & (inner < limit) & self._small(pf, bf, tf + sgn * outer)
+            inners[:, side], outers[:, side] = inner, outer
+        # a stretch that cannot be a family (both sides within half of CLUSTER_FAMILY_REL) only gives the centre
+        # of a multiple root: its ends are bisected to FLAT_SHORT_TOL of their reach
+        short = np.all(outers <= 0.5 * CLUSTER_FAMILY_REL * self.span[pf][:, None], axis=1)
+        for side, sgn in enumerate((-1.0, 1.0)):
+            inner, outer = inners[:, side], outers[:, side]
             at_limit = inner >= limit
             for _ in range(FLAT_BISECT):  # boundary between inner (small) and outer (not small)
+                go = ~short | (outer - inner > FLAT_SHORT_TOL * inner)
                 mid = 0.5 * (inner + outer)
                 sm = self._small(pf, bf, tf + sgn * mid)
-                inner = np.where(sm, mid, inner)
-                outer = np.where(sm, outer, mid)
+                inner = np.where(go & sm, mid, inner)
+                outer = np.where(go & ~sm, mid, outer)
             past = np.abs(self.residual(pf, bf, (tf + sgn * outer)[:, None])[:, 0])
             # ... and keeps growing (a rounding blip inside a continuum falls back into the noise)
             far = np.abs(self.residual(pf, bf, (tf + 2.0 * sgn * outer)[:, None])[:, 0])

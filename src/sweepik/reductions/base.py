@@ -57,6 +57,11 @@ class Reduction(ABC):
     #: Compiled scalar kernels ``(residual, configuration)`` with the signatures ``reductions.kernels.RESIDUAL_SIG``
     #: and ``CONFIGURATION_SIG`` over rows of ``kernel_params(poses)`` (None: the NumPy engine is used).
     kernel: tuple[Any, Any] | None = None
+    #: Optional compiled kernel ``residuals(params, theta, out)`` (signature ``reductions.kernels.RESIDUALS_SIG``)
+    #: writing every branch's residual at theta* into ``out (n_branches,)``, bit for bit what ``kernel[0]`` gives
+    #: branch by branch, at less than ``n_branches`` times its cost (the branches share most of the work). The
+    #: engine uses it for the uniform samples; it is ignored unless set by the class that sets ``kernel``.
+    kernel_residuals: Any = None
     #: No sweep: every branch of ``solve_rest`` (at any theta*) is a candidate (a closed-form decomposition).
     closed_form: bool = False
     #: Classes of branches whose residuals are identical (they differ in the configuration only, e.g. by a

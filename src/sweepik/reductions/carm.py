@@ -166,6 +166,7 @@ class CArmD1(_CArmBase):
 
     name = "carm-d1"
     kernel = (kernels.carm_d1_residual, kernels.carm_d1_configuration)
+    kernel_residuals = kernels.carm_d1_residuals
     fallback = "carm-theta2"
     blind_spots = "d1 = Pz with Px = 0 (wrist on joint 2's axis): solved separately as a special slice"
 

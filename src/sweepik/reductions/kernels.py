@@ -60,6 +60,40 @@ def _carm_d1(p, d1: float, b: int) -> float:
     return _elbow_residual(c2, s2, u, Py, zx, zy, zz, eps, L1, L2)
 
 
+def _carm_d1_all(p, d1: float, out) -> None:
+    """The residuals of the four branches at rail position d1 into ``out[:4]``: bit for bit those of
+    ``_carm_d1(p, d1, b)``, with what the branches share (the rail-to-wrist distance, the elbow's square root)
+    computed once. The branches differ by the signs sigma and eps only, and IEEE arithmetic is symmetric under a
+    change of sign (``fl(-a * b) = -fl(a * b)``, the same for division, sums and differences), so each branch's
+    sign-flipped operands are exactly its own intermediate values."""
+    Px, Py, Pz, zx, zy, zz, L1, L2 = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    t = Pz - d1
+    r = math.hypot(Px, t)
+    if not r > 0.0:  # the wrist on joint 2's axis: branch by branch
+        for b in range(4):
+            out[b] = _carm_d1(p, d1, b)
+        return
+    # _d1_position: c2 = sigma Px / r, s2 = sigma t / r, u = sigma r; c2 zx + s2 zz = sigma a
+    a = Px / r * zx + t / r * zz
+    # _elbow: u * u = r * r for both signs
+    rho2 = r * r + Py * Py
+    k = (rho2 + L2 * L2 - L1 * L1) / (2.0 * L2)
+    disc = rho2 - k * k
+    if disc < -DISC_TOL * (L1 + L2) ** 2:
+        for b in range(4):
+            out[b] = math.nan
+        return
+    sq = math.sqrt(max(disc, 0.0))
+    kr, sp, kp, sr = k * r, sq * Py, k * Py, sq * r
+    for b in range(4):
+        sigma = 1.0 if b < 2 else -1.0
+        eps = 1.0 if b % 2 == 0 else -1.0
+        # k u - s Py and k Py + s u with u = sigma r, s = eps sq
+        c34 = (sigma * kr - eps * sp) / rho2
+        s34 = (kp + (eps * sigma) * sr) / rho2
+        out[b] = c34 * (sigma * a) + s34 * zy
+
+
 def _carm_theta2(p, th2: float, b: int) -> float:
     Px, Py, zx, zy, zz, L1, L2 = p[0], p[1], p[3], p[4], p[5], p[6], p[7]
     eps = 1.0 if b == 0 else -1.0
@@ -73,6 +107,9 @@ if _njit is not None:
     from numba import float64, int64, void
 
     RESIDUAL_SIG = float64(float64[::1], float64, int64)
+    #: ``residuals(params, theta, out)``: every branch's residual at theta* into ``out`` (optional, see
+    #: ``Reduction.kernel_residuals``).
+    RESIDUALS_SIG = void(float64[::1], float64, float64[::1])
     CONFIGURATION_SIG = void(float64[::1], float64, int64, float64[::1])
     _elbow = _njit(cache=True)(_elbow)
     _d1_position = _njit(cache=True)(_d1_position)
@@ -108,13 +145,17 @@ def lazy_njit(sig: Any, **options: Any) -> Any:
 
 carm_d1_residual: Any
 carm_theta2_residual: Any
+carm_d1_residuals: Any
 carm_d1_configuration: Any
 carm_theta2_configuration: Any
 if _njit is not None:
     carm_d1_residual = LazyKernel(_carm_d1, RESIDUAL_SIG, cache=True)
     carm_theta2_residual = LazyKernel(_carm_theta2, RESIDUAL_SIG, cache=True)
+    _carm_d1 = _njit(cache=True)(_carm_d1)  # compiled code (_carm_d1_all) calls the dispatcher
+    carm_d1_residuals = LazyKernel(_carm_d1_all, RESIDUALS_SIG, cache=True)
 else:  # pragma: no cover
     carm_d1_residual, carm_theta2_residual = _carm_d1, _carm_theta2
+    carm_d1_residuals = _carm_d1_all
 
 
 _FIRST_CLASS: dict[Any, Any] = {}
