@@ -351,3 +351,19 @@ def test_revolute_family_interval_is_at_most_the_circle() -> None:
         for fam in sol.families:
             lo, hi = fam.interval
             assert -np.pi <= lo < hi <= np.pi
+
+
+@pytest.mark.parametrize("reduction", ["carm-d1", "carm-theta2"])
+@pytest.mark.parametrize("theta3", [1e-12, 1e-11])
+def test_a_hair_off_the_wrist_on_joint_2_axis_is_not_unreachable(reduction: str, theta3: float) -> None:
+    """theta3 ~ 0 with theta4 = -90 deg puts the wrist 1e-10 mm off joint 2's axis: the residual is flat at rounding
+    level along theta2 (a near continuum whose members miss the pose by ~7e-10 mm, just above the acceptance
+    tolerance). It used to be answered 'unreachable'; its members are now polished onto certified solutions."""
+    arm = sweepik.load_robot("carm")
+    for q in ([0.0, 0.5, theta3, -np.pi / 2, 0.0, -np.pi], [1.0, 0.5, theta3, -np.pi / 2, 0.1, -np.pi]):
+        T = arm.fk(np.array(q))
+        sols = sweepik.solve(arm, T, reduction=reduction)
+        assert len(sols) or sols.families, sols.reason
+        if len(sols):
+            assert np.all(sols.error_geodesic <= 2e-13 * arm.length_scale)
+            assert np.abs(arm.fk(sols.q) - T).max() < 1e-9

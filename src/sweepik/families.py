@@ -172,8 +172,9 @@ def families_of(
     for k in range(len(spans)):
         for s_, e_ in zip(np.nonzero(edges[k] == 1)[0], np.nonzero(edges[k] == -1)[0], strict=True):
             pieces.append((k, int(s_), int(e_ - 1)))
+    near_p, near_q = _near_family_members(robot, red, chain, pose, branch, grid, ok, used)
     if not pieces:
-        return out, np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
+        return out, near_p, near_q
     K, S, E = (np.array(x) for x in zip(*pieces, strict=True))
     M = grid.shape[1]
     # bisect each cut between the last sample inside and the first outside
@@ -217,7 +218,37 @@ def families_of(
         if pk.size
         else np.zeros((0, robot.n_joints))
     )
-    return out, used[pose[pk]].astype(np.intp), q_pts
+    return out, np.concatenate([used[pose[pk]].astype(np.intp), near_p]), np.concatenate([q_pts, near_q])
+
+
+#: Members sampled along a span none of whose members is a solution, returned as candidates to polish.
+NEAR_FAMILY_SAMPLES = 9
+
+
+def _near_family_members(
+    robot: Robot,
+    red: Reduction,
+    chain: Array,
+    pose: NDArray[np.intp],
+    branch: NDArray[np.intp],
+    grid: Array,
+    ok: NDArray[np.bool_],
+    used: NDArray[np.intp],
+) -> tuple[NDArray[np.intp], Array]:
+    """A flat stretch of the residual none of whose members reaches the pose is a *near* continuum: the pose lies
+    off a self-motion set by a hair (the C-Arm's wrist 1e-10 mm off joint 2's axis), its residual is flat at
+    rounding level, and its solutions are isolated points next to the set. Members spread along each such span
+    ``(pose index, q)`` go to the solver's candidates, where the Newton polish on the full pose moves them onto
+    those solutions (or they fail certification)."""
+    none = np.nonzero(~ok.any(axis=1))[0]
+    if none.size == 0:
+        return np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
+    cols = np.linspace(0, grid.shape[1] - 1, NEAR_FAMILY_SAMPLES).round().astype(np.intp)
+    theta = grid[none][:, cols]
+    k = np.repeat(none, cols.size)
+    q = family_members(robot, red, chain, pose[k], branch[k], theta.ravel())
+    finite = np.all(np.isfinite(q), axis=-1)
+    return used[pose[k]][finite].astype(np.intp), q[finite]
 
 
 #: Two points are the same member when every joint agrees within this (radians modulo 2 pi / relative length).
