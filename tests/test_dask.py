@@ -33,6 +33,7 @@ from sweepik import (
     solve_dask,
     solve_many,
 )
+from sweepik import errors as sweepik_errors
 from sweepik.cli import main
 from sweepik.store import store_info
 
@@ -251,3 +252,21 @@ def test_cli_sample(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     other = str(tmp_path / "o.npy")
     assert main(["sample", "ur5", "5", "--out", other, "--q-out", str(tmp_path / "o_q.npy")]) == 0
     assert "seed " in capsys.readouterr().out and np.load(tmp_path / "o_q.npy").shape == (5, 6)
+
+
+def test_default_chunking_is_solve_many_bit_for_bit_on_a_swept_arm(client: Client, tmp_path: Path) -> None:
+    """The generic sweeps' sample grid depends on the batch (spare samples for other poses' hints): the default
+    chunk size follows solve_many's batches, so a swept 6R arm's store equals solve_many bit for bit."""
+    import sweepik
+
+    arm = sweepik.load_robot("fanuc_crx10ia")
+    from sweepik.verify import random_configurations
+
+    P = arm.fk(random_configurations(arm, 2500, np.random.default_rng(5)))
+    assert_same_batch(solve_dask(arm, P, client, out=tmp_path / "f.zarr"), solve_many(arm, P))
+
+
+@pytest.mark.parametrize("address", ["not an address", "tcp://localhost:notaport", "http://x:1"])
+def test_malformed_scheduler_address_is_a_clear_error(address: str) -> None:
+    with pytest.raises(sweepik_errors.SweepikError, match="address"):
+        solve_dask(CARM, test_poses(CARM, 2, CARM_FAMILY_Q, seed=1), address)

@@ -202,6 +202,42 @@ def _open_npy(path: Path) -> NDArray[Any]:
 
 
 @contextlib.contextmanager
+def _client_at(distributed: Any, address: str) -> Iterator[Any]:
+    """A client of the scheduler at ``address`` with a worker, or a SweepikError within ``CONNECT_TIMEOUT_S`` (x2):
+    a malformed address, nothing listening, a port that accepts but is no scheduler (Dask's own timeout does not
+    bound that handshake: the connection runs in a thread given a hard deadline), or a scheduler without workers."""
+    import concurrent.futures
+
+    from distributed.comm import parse_address
+
+    try:
+        parse_address(address)
+        distributed.comm.get_address_host_port(address)
+    except (ValueError, TypeError) as exc:
+        raise SweepikError(f"not a Dask scheduler address {address!r}: {exc}") from None
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=1)
+    pending = pool.submit(distributed.Client, address, timeout=CONNECT_TIMEOUT_S)
+    try:
+        c = pending.result(timeout=CONNECT_TIMEOUT_S + 5.0)
+    except concurrent.futures.TimeoutError:
+        raise SweepikError(
+            f"the Dask scheduler at {address!r} did not answer within {CONNECT_TIMEOUT_S:g} s (is it a scheduler?)"
+        ) from None
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise SweepikError(f"cannot reach the Dask scheduler at {address!r}: {exc}") from None
+    finally:
+        pool.shutdown(wait=False)
+    with c:
+        try:
+            c.wait_for_workers(1, timeout=CONNECT_TIMEOUT_S)
+        except (TimeoutError, OSError):
+            raise SweepikError(
+                f"the Dask scheduler at {address!r} has no workers (none joined within {CONNECT_TIMEOUT_S:g} s)"
+            ) from None
+        yield c
+
+
+@contextlib.contextmanager
 def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
     """The client to use: ``client`` itself; a new one for a scheduler address; a local cluster (processes,
     one thread each) when None. Clients and clusters made here are closed on exit."""
@@ -211,7 +247,7 @@ def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
     if client is None:
         n = (os.cpu_count() or 1) if n_workers is None else check_int(n_workers, "n_workers", 1, 4096)
         cluster = distributed.LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL
         )
         try:
             with distributed.Client(cluster) as c:
@@ -219,11 +255,7 @@ def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
         finally:
             cluster.close()
     elif isinstance(client, str):
-        try:
-            c = distributed.Client(client, timeout=CONNECT_TIMEOUT_S)
-        except (OSError, TimeoutError) as exc:
-            raise SweepikError(f"cannot reach the Dask scheduler at {client!r}: {exc}") from None
-        with c:
+        with _client_at(distributed, client) as c:
             yield c
     elif isinstance(client, distributed.Client):
         yield client
@@ -234,13 +266,15 @@ def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
 
 
 def auto_chunk_size(n_poses: int, threads: int) -> int:
-    """Poses per chunk when ``chunk_size`` is not given: ``CHUNKS_PER_THREAD`` chunks per worker thread, between
-    ``MIN_AUTO_CHUNK`` and ``MAX_AUTO_CHUNK`` poses, a multiple of the solver's chunk above it."""
+    """Poses per chunk when ``chunk_size`` is not given: a multiple of the solver's ``CHUNK`` (2,048 poses), so that
+    the solver's batches are ``solve_many``'s and so are the results, bit for bit (on arms whose sample hints depend
+    on the batch, e.g. the generic sweeps, another chunking moves some solutions by rounding, ~1e-13);
+    ``CHUNKS_PER_THREAD`` chunks per worker thread up to ``MAX_AUTO_CHUNK`` poses; up to ``CHUNK`` poses, one."""
     from .solver import CHUNK
 
-    target = max(MIN_AUTO_CHUNK, -(-n_poses // (CHUNKS_PER_THREAD * max(threads, 1))))
-    if target > CHUNK:
-        target = -(-target // CHUNK) * CHUNK
+    if n_poses <= CHUNK:  # one chunk, as solve_many solves it
+        return max(1, n_poses)
+    target = -(-max(MIN_AUTO_CHUNK, -(-n_poses // (CHUNKS_PER_THREAD * max(threads, 1)))) // CHUNK) * CHUNK
     return int(min(target, MAX_AUTO_CHUNK))
 
 

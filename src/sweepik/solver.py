@@ -378,7 +378,9 @@ MAX_SAMPLES = 100_000
 #: Largest ``chunk_size`` accepted (any larger value behaves like this one).
 MAX_CHUNK = 2**31
 #: Pose-samples per chunk (chunk x ``n_samples``): a larger ``n_samples`` runs in smaller chunks, so memory stays
-#: that of the defaults (2048 poses x 64 samples). Chunking does not change results.
+#: that of the defaults (2048 poses x 64 samples). Chunking changes no solution (on arms whose sample hints depend
+#: on the batch, e.g. the generic sweeps, some move by rounding, ~1e-13: a pose's grid takes a spare sample for each
+#: hint another pose of its batch has).
 SAMPLE_BUDGET = CHUNK * N_SAMPLES
 #: The paper's strategy sweeps theta* in 10 mm (or 1 degree) steps over its whole range: a range needing more
 #: coarse samples than this (2 km of rail in mm) is refused, as its memory (~2 kB per pose-sample) and time grow
@@ -425,7 +427,7 @@ def solve_many(
     Vectorised over poses, samples and branches, in chunks of at most ``chunk_size`` poses (an integer in
     [1, ``MAX_CHUNK``]; a large ``n_samples`` or the paper's strategy on a long range use smaller chunks, so that
     memory stays bounded). Returns a :class:`~sweepik.batch.SolutionBatch`: a sequence of one :class:`Solutions`
-    per pose (identical to calling :func:`solve` on each pose; built when indexed or iterated), whose columns
+    per pose (the solutions :func:`solve` gives each pose, to rounding; built when indexed or iterated), whose columns
     (``offsets``, ``q``, ``error``, ...) hold every solution without a Python object per pose. An empty batch
     (``[]`` or an array ``(0, 4, 4)``) gives an empty one, after the other arguments are checked. Other arguments
     and errors: see :func:`solve`; :func:`iter_solve` yields the same results without holding them all.
