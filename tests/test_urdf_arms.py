@@ -117,3 +117,15 @@ def test_bad_urdf_through_the_cli(text: str, tmp_path: Path, capsys: pytest.Capt
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and str(path) in err and "Traceback" not in err, err
+
+
+def test_bench_arms_takes_a_urdf_chain(capsys: pytest.CaptureFixture[str]) -> None:
+    from sweepik.cli import main
+
+    path = str(_urdf("ur_description/urdf/ur5_robot.urdf"))
+    argv = ["bench", "--arms", path, "--base-link", "base_link", "--tip-link", "tool0", "--single", "3"]
+    assert main([*argv, "--batch", "8", "--memory", "0", "--repeats", "1", "--json"]) == 0
+    import json
+
+    row = json.loads(capsys.readouterr().out)["arms"]["ur5"]
+    assert row["plan"] == "closed form" and row["sweepik"]["batched_us"] > 0

@@ -262,14 +262,14 @@ def _flags(name: str, closed: bool, cell: dict[str, Any], peers: dict[str, dict[
 
 
 def bench_arms(
-    names: list[str] | None = None,
+    names: list[str | Robot] | None = None,
     single: int = 300,
     batch: int = 2000,
     memory: int = 10_000,
     repeats: int = 3,
     progress: Progress = _no_progress,
 ) -> dict[str, Any]:
-    """Per arm (every bundled one by default; names or robot files): sweepik's plan, single-pose median (us),
+    """Per arm (every bundled one by default; names, robot files or Robots): sweepik's plan, single-pose median (us),
     batched time per pose (best of ``repeats``, us), peak memory of ``solve_many`` on ``memory`` poses (a child
     process; 0 skips it), the installed peers on the same poses (raw calls: their answers are not FK-checked), and
     the targets missed. Random in-limit configurations, seed 1."""
@@ -280,7 +280,8 @@ def bench_arms(
     rows: dict[str, Any] = {}
     arms = list(names) if names else list(bundled_robots())
     robots = [load_robot(n) for n in arms]  # bad names fail before anything is timed
-    for k, (name, robot) in enumerate(zip(arms, robots, strict=True)):
+    for k, (arm, robot) in enumerate(zip(arms, robots, strict=True)):
+        name = arm if isinstance(arm, str) else robot.name
         progress("bench: arms", k, len(arms))
         q = random_configurations(robot, max(single, batch, 8), np.random.default_rng(1))
         locked = _bench_lock(robot)
@@ -313,8 +314,8 @@ def bench_arms(
                 "batched_us": _batch_us(many, poses[:batch], repeats),
             }
         row["peers"] = peers
-        if memory and not locked:
-            row["peak_rss_mib"] = bench_memory(memory, name)["peak_rss_mib"]
+        if memory and not locked and isinstance(arm, str):  # (the child process loads the arm by name or path)
+            row["peak_rss_mib"] = bench_memory(memory, arm)["peak_rss_mib"]
         if single:
             row["misses"] = _flags(name, closed, fastest, peers)
         rows[name] = row

@@ -6,6 +6,7 @@ import argparse
 import importlib.util
 import json
 from pathlib import Path
+from typing import Any
 
 from .cli_common import (
     DEFAULT_ROBOT,
@@ -138,6 +139,7 @@ def add_bench_parser(sub: _SubParsers) -> None:
         metavar="N",
         help=f"repeats of the grid run, 1 to {MAX_BENCH_REPEATS} (best is kept; default 3)",
     )
+    _add_robot_options(p)
     _add_json(p, "")
 
 
@@ -150,7 +152,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
     memory = args.memory if args.memory is not None else (10_000 if arms else 100_000)
     try:
         if arms:
-            result = bench_arms(args.arms, single, args.batch, memory, args.repeats, progress)
+            names: list[Any] = list(args.arms)
+            if args.base_link or args.tip_link:  # URDF files with a chosen chain: loaded here, timed as Robots
+                names = [_load_robot(n, args) for n in names]
+            result = bench_arms(names, single, args.batch, memory, args.repeats, progress)
         else:
             result = run_bench(single, args.paper, memory, args.repeats, progress, batch=args.batch)
     finally:
