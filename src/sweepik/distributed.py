@@ -77,8 +77,13 @@ def _dask() -> Any:
 def _solve_task(robot: Robot, poses: ArrayLike, options: Mapping[str, Any], start: int) -> Block:
     """The solutions of one chunk of poses ``(n, 4, 4)`` (poses ``start:start + n`` of the run), as one Block:
     ``solve_many``'s steps (checks, reduction, sub-chunks of the solver's chunk size, locked joints)."""
+    from .fastsweep import AVAILABLE
     from .solver import CHUNK, _expanded, _held, _prepare, _solve_chunk
 
+    if AVAILABLE:  # Dask runs a task per worker thread: the compiled kernels must not fan out to every core too
+        import numba
+
+        numba.set_num_threads(1)
     arr = as_float_array(poses, "poses")
     what = f"poses[{start}:{start + arr.shape[0]}]" if arr.ndim == 3 else "poses"
     P = check_poses(arr, what)
