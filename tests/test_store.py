@@ -8,6 +8,7 @@ cluster."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -267,3 +268,34 @@ def test_store_layout_is_plain_zarr(tmp_path: Path) -> None:
     np.testing.assert_array_equal(g["q"][...][b[1] : b[2]], ref[9].q)
     assert root.attrs["robot_toml"].startswith("# written by sweepik")
     assert root.attrs["options"]["strategy"] == "precise"
+
+
+def test_a_second_writer_and_another_version_are_refused(tmp_path: Path) -> None:
+    """A store being written by a live process (its lock) is refused to a second run; a lock left by a process
+    that is gone is taken over; a store written by another sweepik version is not resumed."""
+    import socket
+
+    import zarr
+
+    from sweepik.store import LOCK_FILE
+
+    P = test_poses(CARM, 20, CARM_FAMILY_Q, seed=3)
+    path = tmp_path / "s.zarr"
+    write_store(path, CARM, P, 10, chunks=[0])
+    opts = options(CARM)
+    (path / LOCK_FILE).write_text(f"{os.getppid()} {socket.gethostname()}")  # a live process, not this one
+    with pytest.raises(StoreError, match="another run"):
+        StoreWriter(path, CARM, opts, len(P), 10, resume=True)
+    (path / LOCK_FILE).write_text(f"{2**22 + 12345} {socket.gethostname()}")  # no such process: stale
+    writer = StoreWriter(path, CARM, opts, len(P), 10, resume=True)
+    for k in range(1, writer.n_chunks):
+        s, e = writer.span(k)
+        writer.write(k, _solve_task(CARM, P[s:e], opts, s))
+    writer.finish()
+    assert not (path / LOCK_FILE).exists()
+    assert_same_batch(load_solutions(path), solve_many(CARM, P))
+    other = tmp_path / "o.zarr"
+    write_store(other, CARM, P, 10, chunks=[0])
+    zarr.open_group(str(other), mode="r+").attrs["sweepik_version"] = "0.0.1-other"
+    with pytest.raises(StoreError, match="written by sweepik 0.0.1-other"):
+        StoreWriter(other, CARM, opts, len(P), 10, resume=True)

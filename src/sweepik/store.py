@@ -282,8 +282,14 @@ class StoreWriter:
             if not resume:
                 raise StoreError(f"{self.path}: already exists; resume it (resume=True, --resume) or give a new path")
             self.root = _open_root(self.path, "r+")
-            _remove_partial_files(self.path)
             attrs = dict(self.root.attrs)
+            from . import __version__
+
+            if attrs.get("sweepik_version") != __version__:
+                raise StoreError(
+                    f"{self.path}: cannot resume: the store was written by sweepik {attrs.get('sweepik_version')}, "
+                    f"this is {__version__} (its solutions could differ): solve into a new store"
+                )
             for key, what in (
                 ("robot", "robot"),
                 ("options", "solver options"),
@@ -293,8 +299,10 @@ class StoreWriter:
                 if attrs.get(key) != head[key]:
                     raise StoreError(
                         f"{self.path}: cannot resume: the store was written with another {what} "
-                        f"({_short(attrs.get(key))}, now {_short(head[key])})"
+                        f"({_difference(attrs.get(key), head[key])})"
                     )
+            _take_lock(self.path)
+            _remove_partial_files(self.path)
             self.chunks = self.root.require_group(CHUNKS)
         else:
             if not self.path.parent.is_dir():
@@ -307,6 +315,7 @@ class StoreWriter:
             attrs = {**head, "robot_toml": robot_to_toml(robot), "sweepik_version": __version__, "complete": False}
             # the root group is born with its attributes (one write): a reader never sees it without them
             self.root = zarr.create_group(str(self.path), overwrite=False, attributes=attrs, zarr_format=3)
+            _take_lock(self.path)
             self.chunks = self.root.create_group(CHUNKS)
 
     @property
@@ -379,7 +388,65 @@ class StoreWriter:
             raise StoreError(f"{self.path}: {len(missing)} of {self.n_chunks} chunks are missing (first: {missing[0]})")
         summary = _sum_stats(done[k]["stats"] for k in range(self.n_chunks))
         self.root.attrs.update({"summary": summary, "complete": True})
+        with contextlib.suppress(OSError):
+            (self.path / LOCK_FILE).unlink()
         return summary
+
+
+#: A run writing a store holds this file in it (process id and host), created exclusively: a second run on the
+#: same store is refused while the first is alive (a stale one, of a process that is gone, is taken over).
+LOCK_FILE = "sweepik.lock"
+
+
+def _take_lock(path: Path) -> None:
+    import socket
+
+    lock = path / LOCK_FILE
+    me = f"{os.getpid()} {socket.gethostname()}"
+    for _ in range(3):
+        try:
+            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            try:
+                pid_text, _, host = lock.read_text().partition(" ")
+                pid = int(pid_text)
+            except (OSError, ValueError):
+                pid, host = -1, ""
+            if host == socket.gethostname() and (pid == os.getpid() or not _alive(pid)):
+                with contextlib.suppress(OSError):
+                    lock.unlink()  # ours (an earlier call of this process) or a process that is gone
+                continue
+            raise StoreError(
+                f"{path}: another run (process {pid} on {host or 'an unknown host'}) is writing this store; wait "
+                f"for it to end, or delete {lock} if that run is gone"
+            ) from None
+        except OSError as exc:
+            raise StoreError(f"{path}: cannot write the store: {exc}") from None
+        with os.fdopen(fd, "w") as f:
+            f.write(me)
+        return
+    raise StoreError(f"{path}: cannot take the store's lock {lock}")
+
+
+def _alive(pid: int) -> bool:
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _difference(stored: Any, now: Any) -> str:
+    """Where two JSON-like values first differ, readably (a robot's field, an option)."""
+    if isinstance(stored, dict) and isinstance(now, dict):
+        for key in sorted(set(stored) | set(now), key=str):
+            if stored.get(key) != now.get(key):
+                return f"{key}: {_short(stored.get(key))}, now {_short(now.get(key))}"
+    return f"{_short(stored)}, now {_short(now)}"
 
 
 def _groups(group: Any) -> list[tuple[str, Any]]:
