@@ -105,6 +105,11 @@ class SolutionBatch(Sequence[Solutions]):
     def __len__(self) -> int:
         return int(self._starts[-1])
 
+    @property
+    def blocks(self) -> list[Block]:
+        """The solver's chunks, in order (each a :class:`Block` of consecutive poses)."""
+        return list(self._blocks)
+
     def _locate(self, i: int) -> tuple[Block, int]:
         n = len(self)
         if not -n <= i < n:

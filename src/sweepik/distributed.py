@@ -76,30 +76,30 @@ def _dask() -> Any:
 
 def _solve_task(robot: Robot, poses: ArrayLike, options: Mapping[str, Any], start: int) -> Block:
     """The solutions of one chunk of poses ``(n, 4, 4)`` (poses ``start:start + n`` of the run), as one Block:
-    ``solve_many``'s steps (checks, reduction, sub-chunks of the solver's chunk size, locked joints)."""
+    ``solve_many`` on the chunk (a bad pose is named by its place in the run)."""
     from .fastsweep import AVAILABLE
-    from .solver import CHUNK, _expanded, _held, _prepare, _solve_chunk
+    from .solver import solve_many
 
     if AVAILABLE:  # Dask runs a task per worker thread: the compiled kernels must not fan out to every core too
         import numba
 
         numba.set_num_threads(1)
     arr = as_float_array(poses, "poses")
-    what = f"poses[{start}:{start + arr.shape[0]}]" if arr.ndim == 3 else "poses"
-    P = check_poses(arr, what)
-    if not P.flags.writeable:  # a chunk unpickled from a message is read-only; the compiled kernels want writable
-        P = P.copy()
+    P = check_poses(arr, f"poses[{start}:{start + arr.shape[0]}]" if arr.ndim == 3 else "poses")
     if P.ndim != 3:
         raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
     o = options
-    held = _held(robot, o["locked"])
-    arm = robot if held is None else held.arm
-    red, strat, lim, ns, cs = _prepare(
-        arm, P, o["reduction"], o["strategy"], o["limits"], o["n_samples"], CHUNK, o["free_joint"], held
+    batch = solve_many(
+        robot,
+        P,
+        reduction=o["reduction"],
+        free_joint=o["free_joint"],
+        strategy=o["strategy"],
+        limits=o["limits"],
+        n_samples=o["n_samples"],
+        locked=o["locked"],
     )
-    return merge_blocks(
-        [_expanded(_solve_chunk(arm, red, P[s : s + cs], strat, lim, ns), held) for s in range(0, len(P), cs)]
-    )
+    return merge_blocks(batch.blocks)
 
 
 def _checked_options(
@@ -466,8 +466,9 @@ def solve_dask(
         out: a directory to write the store to (Zarr, see :mod:`sweepik.store`), chunk by chunk as chunks finish,
             marked complete at the end; :func:`~sweepik.store.load_solutions` reads it back. It must not exist,
             unless ``resume``.
-        chunk_size: poses per task (and per chunk of the store); default: about 8 chunks per worker thread, between
-            64 and 16,384 poses. With ``resume``, the store's.
+        chunk_size: poses per task (and per chunk of the store); default: :func:`auto_chunk_size` (a multiple of
+            ``solve_many``'s 2,048-pose batches, so that the results are its results bit for bit; one chunk up to
+            2,048 poses). With ``resume``, the store's.
         resume: continue the store at ``out``: only the chunks it lacks are solved (StoreError if it was written
             for other poses, another robot or other options).
         progress: ``progress("solve", done, total)`` (poses) after each chunk.

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import kinematics
 from ._validate import MAX_JOINT_VALUE
 from .chain import rotation_about
 from .errors import LockedJointError, RobotDefinitionError
@@ -45,19 +46,6 @@ def _motion(axis: Array, revolute: bool, value: float) -> Array:
     return M
 
 
-def _fixed_part(robot: Robot, i: int) -> Array:
-    """The transform of DH row ``i`` at joint value 0, without its motion (see the module docstring)."""
-    j = robot.joints[i]
-    ca, sa, ct, st = math.cos(j.alpha), math.sin(j.alpha), math.cos(j.theta), math.sin(j.theta)
-    rx = np.array([[1, 0, 0, 0], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1.0]])
-    rz = np.array([[ct, -st, 0, 0], [st, ct, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-    tx, tz = np.eye(4), np.eye(4)
-    tx[0, 3], tz[2, 3] = j.a, j.d
-    if robot.dh_convention == "modified":
-        return np.asarray(rx @ tx @ rz @ tz)
-    return np.asarray(rz @ tz @ tx @ rx)
-
-
 def joint_origins(robot: Robot) -> tuple[Array, Array, Array]:
     """``(origins (n, 4, 4), axes (n, 3), T_last_tool (4, 4))``: the arm in origin + axis form.
 
@@ -69,7 +57,8 @@ def joint_origins(robot: Robot) -> tuple[Array, Array, Array]:
         origins = np.array([j.origin for j in robot.joints], dtype=np.float64)
         axes = np.array([j.axis for j in robot.joints], dtype=np.float64)
         return origins, axes, np.array(robot.T_flange_tool)
-    fixed = np.array([_fixed_part(robot, i) for i in range(n)])
+    # a DH row at joint value 0 is its fixed part (the motion about z commutes with the row's part along z)
+    fixed = kinematics.link_transforms(robot, np.zeros(n))
     axes = np.tile([0.0, 0.0, 1.0], (n, 1))
     if robot.dh_convention == "modified":
         return fixed, axes, np.array(robot.T_flange_tool)

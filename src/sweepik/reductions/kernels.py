@@ -135,7 +135,8 @@ class LazyKernel:
         return self._dispatcher
 
     def __call__(self, *args: Any) -> Any:
-        return self.dispatcher(*args)
+        d = self._dispatcher
+        return (self.dispatcher if d is None else d)(*args)
 
 
 def lazy_njit(sig: Any, **options: Any) -> Any:
