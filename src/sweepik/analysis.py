@@ -13,7 +13,7 @@ from .reductions.decompose import explain
 from .robot import Robot
 from .robot_file import load_robot
 
-__all__ = ["analyze", "lock_options"]
+__all__ = ["analyze", "lock_options", "plan_line"]
 
 #: Where in a joint's range the "generic value" of a lock lies (a fraction of the range from the lower limit, not
 #: a simple ratio, so that it is no special angle such as 0 or 90 degrees).
@@ -88,3 +88,15 @@ def analyze(robot: Robot | str, locked: Mapping[Any, float] | None = None) -> di
             "'locks' tells which lock gives a closed form or a sweep"
         )
     return info
+
+
+def plan_line(plan: dict[str, Any]) -> str:
+    """One line describing a plan of ``analyze``, e.g. ``closed form, 8 branches`` or ``sweep joint 1 (d1), 4
+    branches``."""
+    if plan["closed_form"]:
+        head = "closed form"
+    else:
+        head = f"sweep joint {plan['free_joint_number']} ({plan['free_joint_name']})"
+    chain = ", reversed chain" if plan["chain"] == "reversed" else ""
+    blind = ", blind spot" if plan["blind_spot"] else ""
+    return f"{head}, {plan['branches']} branches{chain}{blind}"

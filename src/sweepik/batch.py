@@ -93,6 +93,7 @@ class SolutionBatch(Sequence[Solutions]):
     * ``pose_index (K,)``: the pose of each row;
     * ``q (K, n)``, ``error (K,)``, ``error_geodesic (K,)``, ``within_limits (K,)``, ``multiplicity (K,)``: as in
       :class:`Solutions`;
+    * ``n_reachable (N,)``: each pose's solutions before the joint limits were applied;
     * ``families``: ``{pose index: families}`` for the few poses that have self-motion families;
     * ``reason(i)``: why pose ``i`` has no solution (None if it has some).
     """
@@ -192,6 +193,11 @@ class SolutionBatch(Sequence[Solutions]):
     @cached_property
     def multiplicity(self) -> NDArray[np.intp]:
         return self._stack("multiplicity", (0,), np.intp)
+
+    @cached_property
+    def n_reachable(self) -> NDArray[np.intp]:
+        """``(N,)`` each pose's solutions before the joint limits were applied (``counts`` is after)."""
+        return self._stack("n_reachable", (0,), np.intp).astype(np.intp)
 
     @cached_property
     def families(self) -> dict[int, tuple[Family, ...]]:

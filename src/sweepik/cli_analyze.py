@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from .analysis import analyze
+from .analysis import analyze, plan_line
 from .cli_common import (
     _add_json,
     _add_robot_options,
@@ -37,18 +37,6 @@ def add_analyze_parser(sub: _SubParsers) -> None:
     p.add_argument("--rad", action="store_true", help="--lock values of revolute joints in radians")
     _add_robot_options(p, lock=True)
     _add_json(p)
-
-
-def plan_line(plan: dict[str, Any]) -> str:
-    """One line describing a plan of ``analyze``, e.g. ``closed form, 8 branches`` or ``sweep joint 1 (d1), 4
-    branches``."""
-    if plan["closed_form"]:
-        head = "closed form"
-    else:
-        head = f"sweep joint {plan['free_joint_number']} ({plan['free_joint_name']})"
-    chain = ", reversed chain" if plan["chain"] == "reversed" else ""
-    blind = ", blind spot" if plan["blind_spot"] else ""
-    return f"{head}, {plan['branches']} branches{chain}{blind}"
 
 
 def _print_locks(robot: Any, locks: list[dict[str, Any]]) -> None:

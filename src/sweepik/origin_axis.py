@@ -66,6 +66,20 @@ def joint_origins(robot: Robot) -> tuple[Array, Array, Array]:
     return origins, axes, fixed[-1] @ robot.T_flange_tool
 
 
+def link_masses(robot: Robot) -> tuple[Array, Array]:
+    """``(masses (n,), coms (n, 3))``: each joint's link mass (kg) and centre of mass in that joint's frame of the
+    origin + axis form (:func:`joint_origins`); the same point as ``Joint.com`` in the robot's own link frame.
+
+    Only standard DH moves the frame: its link frame i is the origin + axis frame i times row i's fixed part.
+    """
+    masses = np.array([j.mass for j in robot.joints], dtype=np.float64)
+    coms = np.array([j.com for j in robot.joints], dtype=np.float64).reshape(-1, 3)
+    if robot.dh_convention == "standard":
+        fixed = kinematics.link_transforms(robot, np.zeros(robot.n_joints))
+        coms = np.einsum("kij,kj->ki", fixed[:, :3, :3], coms) + fixed[:, :3, 3]
+    return masses, coms
+
+
 def _as_origin_tuple(T: Array) -> tuple[tuple[float, ...], ...]:
     return tuple(tuple(float(v) for v in row) for row in T)
 
@@ -75,9 +89,19 @@ def origin_axis_form(robot: Robot) -> Robot:
     if robot.dh_convention == "none":
         return robot
     origins, axes, tool = joint_origins(robot)
+    masses, coms = link_masses(robot)
     joints = tuple(
-        Joint(type=j.type, lower=j.lower, upper=j.upper, name=name, origin=_as_origin_tuple(org), axis=tuple(a))
-        for j, name, org, a in zip(robot.joints, robot.joint_names, origins, axes, strict=True)
+        Joint(
+            type=j.type,
+            lower=j.lower,
+            upper=j.upper,
+            name=name,
+            origin=_as_origin_tuple(org),
+            axis=tuple(a),
+            mass=float(m),
+            com=tuple(c),
+        )
+        for j, name, org, a, m, c in zip(robot.joints, robot.joint_names, origins, axes, masses, coms, strict=True)
     )
     return Robot(
         name=robot.name,
@@ -88,6 +112,7 @@ def origin_axis_form(robot: Robot) -> Robot:
         length_unit=robot.length_unit,
         default_reduction=None,
         description=robot.description,
+        gravity=robot.gravity,
     )
 
 
@@ -188,18 +213,21 @@ def hold_joints(robot: Robot, locked: Mapping[Any, Any], n_free: int | None = 6)
 @lru_cache(maxsize=64)
 def _hold(robot: Robot, held: tuple[tuple[int, float], ...]) -> HeldJoints:
     origins, axes, tool = joint_origins(robot)
+    masses, coms = link_masses(robot)
     values = dict(held)
     free = tuple(k for k in range(robot.n_joints) if k not in values)
     if not free:
         raise LockedJointError(f"{robot.name!r}: every joint is locked, nothing is left to solve for")
-    carry = np.eye(4)
+    carry = np.eye(4)  # from the last free joint's frame (or the base) to the current one
     base = np.array(robot.T_world_base)
-    joints = []
+    joints: list[Joint] = []
     for k in range(robot.n_joints):
         j = robot.joints[k]
         org = carry @ origins[k]
         if k in values:
             carry = org @ _motion(axes[k], j.is_revolute, values[k])
+            if joints and masses[k] > 0.0:  # a held link rides on the last free one (on the base: no effect)
+                joints[-1] = joints[-1].with_added_mass(float(masses[k]), carry[:3, :3] @ coms[k] + carry[:3, 3])
             continue
         carry = np.eye(4)
         joints.append(
@@ -210,6 +238,8 @@ def _hold(robot: Robot, held: tuple[tuple[int, float], ...]) -> HeldJoints:
                 name=robot.joint_names[k],
                 origin=_as_origin_tuple(org),
                 axis=tuple(axes[k]),
+                mass=float(masses[k]),
+                com=tuple(coms[k]),
             )
         )
     units = ["rad" if r else robot.length_unit for r in robot.is_revolute]
@@ -223,6 +253,7 @@ def _hold(robot: Robot, held: tuple[tuple[int, float], ...]) -> HeldJoints:
             T_flange_tool=carry @ tool,
             length_unit=robot.length_unit,
             description=robot.description,
+            gravity=robot.gravity,
         )
     except RobotDefinitionError as exc:  # pragma: no cover - the parts are valid transforms by construction
         raise LockedJointError(str(exc)) from None

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Literal
 
@@ -69,16 +69,23 @@ class Joint:
     #: at q = 0 (rows, as nested tuples), and the joint axis in that frame (normalised on construction).
     origin: tuple[tuple[float, ...], ...] | None = None
     axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    #: Mass (kg) of the link this joint moves and its centre of mass in this joint's link frame (length unit; the
+    #: frame ``Robot.frames(q)[i + 1]`` of joint i). Only the statics (:mod:`sweepik.statics`) use them.
+    mass: float = 0.0
+    com: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
         label = self.name or "joint"
         if self.type not in ("revolute", "prismatic"):
             raise RobotDefinitionError(f"{label}: type must be 'revolute' or 'prismatic', got {self.type!r}")
-        for f in ("a", "alpha", "d", "theta", "lower", "upper"):
+        for f in ("a", "alpha", "d", "theta", "lower", "upper", "mass"):
             v = getattr(self, f)
             if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(float(v)):
                 raise RobotDefinitionError(f"{label}: {f} must be a finite number, got {v!r}")
             object.__setattr__(self, f, float(v))
+        if self.mass < 0.0:
+            raise RobotDefinitionError(f"{label}: mass must be >= 0 kg, got {self.mass!r}")
+        object.__setattr__(self, "com", _finite_triple(self.com, f"{label}: com"))
         if self.lower > self.upper:
             raise RobotDefinitionError(f"{label}: lower limit {self.lower:g} is above upper limit {self.upper:g}")
         try:
@@ -100,10 +107,29 @@ class Joint:
     def is_revolute(self) -> bool:
         return self.type == "revolute"
 
+    def with_added_mass(self, mass: float, com: ArrayLike) -> Joint:
+        """This joint with a point mass ``mass`` (kg) at ``com`` (its link frame) added to its link: the masses
+        add, the centre of mass is their weighted mean (a link held rigidly to this one merges so)."""
+        total = self.mass + float(mass)
+        if total <= 0.0:
+            return self
+        c = (self.mass * np.array(self.com) + float(mass) * np.asarray(com, dtype=np.float64)) / total
+        return replace(self, mass=total, com=(float(c[0]), float(c[1]), float(c[2])))
+
     @property
     def offset(self) -> float:
         """Constant added to the joint value: ``theta`` for a revolute joint, ``d`` for a prismatic one."""
         return self.theta if self.is_revolute else self.d
+
+
+def _finite_triple(v: object, what: str) -> tuple[float, float, float]:
+    try:
+        arr = np.array(v, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = np.zeros(0)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise RobotDefinitionError(f"{what} must be 3 finite numbers, got {v!r}")
+    return (float(arr[0]), float(arr[1]), float(arr[2]))
 
 
 def _frozen(T: ArrayLike | None, what: str) -> Array:
@@ -131,6 +157,9 @@ class Robot:
     length_unit: str = "mm"
     default_reduction: str | None = None
     description: str = ""
+    #: Direction of gravity in the world frame (a unit vector; normalised on construction): only the statics
+    #: (:mod:`sweepik.statics`) use it. Default: -z of the world frame.
+    gravity: tuple[float, float, float] = (0.0, 0.0, -1.0)
 
     def __post_init__(self) -> None:
         if self.dh_convention not in ("modified", "standard", "none"):
@@ -153,6 +182,13 @@ class Robot:
                     f"{label}: DH parameters a/alpha/d/theta are not used with dh_convention 'none'"
                 )
         object.__setattr__(self, "joints", joints)
+        g = np.array(_finite_triple(self.gravity, f"{self.name}: gravity"))
+        if float(np.linalg.norm(g)) < AXIS_MIN_NORM:
+            raise RobotDefinitionError(f"{self.name}: gravity must be a direction (not all zero), got {self.gravity!r}")
+        norm = float(np.linalg.norm(g))
+        if abs(norm - 1.0) > 4 * np.finfo(float).eps:  # a unit vector stays as it is: equal robots stay equal
+            g = g / norm
+        object.__setattr__(self, "gravity", _finite_triple(g, "gravity"))
         object.__setattr__(self, "T_world_base", _frozen(self.T_world_base, f"{self.name}: base transform"))
         object.__setattr__(self, "T_flange_tool", _frozen(self.T_flange_tool, f"{self.name}: tool transform"))
         for attr, values in (
@@ -189,6 +225,7 @@ class Robot:
             self.length_unit,
             self.default_reduction,
             self.description,
+            self.gravity,
         )
 
     def __eq__(self, other: object) -> bool:
@@ -212,6 +249,7 @@ class Robot:
                 self.length_unit,
                 self.default_reduction,
                 self.description,
+                self.gravity,
             ),
         )
 

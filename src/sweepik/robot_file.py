@@ -6,6 +6,7 @@ File format (angles in degrees, lengths in ``length_unit``)::
     dh_convention = "modified"        # or "standard"; or "none": joints by origin and axis (below)
     length_unit = "mm"
     default_reduction = "carm-d1"     # optional: the IK reduction ``solve`` uses by default
+    gravity = [0.0, 1.0, 0.0]         # optional: direction of gravity in the world frame (default [0, 0, -1])
 
     [[joints]]
     name = "d1"
@@ -15,6 +16,8 @@ File format (angles in degrees, lengths in ``length_unit``)::
     d = 0.0
     theta = 0.0
     limits = [0.0, 2000.0]            # degrees for revolute joints, length unit for prismatic ones
+    mass = 2.5                        # optional: kg, the link this joint moves (default 0)
+    com = [0.0, 0.0, 120.0]           # optional: its centre of mass in this joint's link frame (length unit)
 
     [base]                            # optional, likewise [tool]
     xyz = [0.0, 0.0, 0.0]
@@ -67,8 +70,19 @@ __all__ = ["load_robot", "bundled_robots", "robot_from_dict", "robot_to_toml"]
 _REQUIRED = ("type", "limits")
 _DH_KEYS = ("a", "alpha", "d", "theta")
 _ORIGIN_AXIS_KEYS = ("origin", "axis")
-_KNOWN_JOINT_KEYS = {"name", "type", "limits", *_DH_KEYS, *_ORIGIN_AXIS_KEYS}
-_KNOWN_TOP_KEYS = {"name", "description", "dh_convention", "length_unit", "default_reduction", "joints", "base", "tool"}
+_MASS_KEYS = ("mass", "com")
+_KNOWN_JOINT_KEYS = {"name", "type", "limits", *_DH_KEYS, *_ORIGIN_AXIS_KEYS, *_MASS_KEYS}
+_KNOWN_TOP_KEYS = {
+    "name",
+    "description",
+    "dh_convention",
+    "length_unit",
+    "default_reduction",
+    "gravity",
+    "joints",
+    "base",
+    "tool",
+}
 
 
 def bundled_robots() -> list[str]:
@@ -90,6 +104,8 @@ MAX_ANGLE_DEG = 1e6
 #: stays finite. Huge limits are allowed on purpose: ``[-1e300, 1e300]`` is a joint without a practical end
 #: (``Robot.length_scale`` caps how much a prismatic range counts).
 MAX_LIMIT = 1e300
+#: Link masses (kg) beyond this are refused (a typo, not a link: the heaviest industrial arms weigh a few tonnes).
+MAX_MASS = 1e6
 
 
 def _number(value: Any, where: str, field: str, bound: float) -> float:
@@ -222,6 +238,7 @@ def robot_from_dict(data: dict[str, Any], source: str = "<dict>") -> Robot:
                 upper=float(hi),
                 name=_text(jd, "name", where, f"q{i + 1}") or f"q{i + 1}",
                 **_joint_geometry(jd, where, conv),
+                **_joint_mass(jd, where),
             )
         )
     return Robot(
@@ -233,7 +250,23 @@ def robot_from_dict(data: dict[str, Any], source: str = "<dict>") -> Robot:
         length_unit=_text(data, "length_unit", source, "mm") or "mm",
         default_reduction=_text(data, "default_reduction", source, None),
         description=_text(data, "description", source, "") or "",
+        gravity=_gravity(data, source),
     )
+
+
+def _joint_mass(jd: dict[str, Any], where: str) -> dict[str, Any]:
+    """``mass`` (kg, >= 0) and ``com`` (length unit, in the joint's link frame) of a joint's link."""
+    mass = _number(jd.get("mass", 0.0), where, "mass", MAX_MASS)
+    if mass < 0.0:
+        raise RobotFileError(f"{where}: field 'mass' must be >= 0 kg, got {_short(jd.get('mass'))}")
+    return {"mass": mass, "com": tuple(_triple(jd, "com", where, MAX_LENGTH, [0.0, 0.0, 0.0]))}
+
+
+def _gravity(data: dict[str, Any], source: str) -> tuple[float, float, float]:
+    g = _triple(data, "gravity", source, MAX_LENGTH, [0.0, 0.0, -1.0])
+    if float(np.linalg.norm(g)) < 1e-9:
+        raise RobotFileError(f"{source}: field 'gravity' must be a direction (not all zero), got {_short(g)}")
+    return (g[0], g[1], g[2])
 
 
 def load_robot(name_or_path: str | Path | Robot, base_link: str | None = None, tip_link: str | None = None) -> Robot:
@@ -341,6 +374,8 @@ def robot_to_toml(robot: Robot) -> str:
     lines += [f"dh_convention = {_toml_value(robot.dh_convention)}", f"length_unit = {_toml_value(robot.length_unit)}"]
     if robot.default_reduction:
         lines.append(f"default_reduction = {_toml_value(robot.default_reduction)}")
+    if robot.gravity != (0.0, 0.0, -1.0):
+        lines.append(f"gravity = {_toml_value(list(robot.gravity))}")
     for name, j in zip(robot.joint_names, robot.joints, strict=True):
         lim = [j.lower, j.upper]
         lim = [float(np.degrees(x)) for x in lim] if j.is_revolute else lim
@@ -353,6 +388,8 @@ def robot_to_toml(robot: Robot) -> str:
             lines += [f"a = {_toml_value(j.a)}", f"alpha = {_toml_value(float(np.degrees(j.alpha)))}"]
             lines += [f"d = {_toml_value(j.d)}", f"theta = {_toml_value(float(np.degrees(j.theta)))}"]
         lines.append(f"limits = {_toml_value(lim)}")
+        if j.mass or j.com != (0.0, 0.0, 0.0):
+            lines += [f"mass = {_toml_value(j.mass)}", f"com = {_toml_value(list(j.com))}"]
     for table, T in (("base", robot.T_world_base), ("tool", robot.T_flange_tool)):
         if not np.array_equal(T, np.eye(4)):
             lines += ["", f"[{table}]"]

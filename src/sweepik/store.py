@@ -108,6 +108,8 @@ def robot_to_json(robot: Robot) -> dict[str, Any]:
                 "name": j.name,
                 "origin": None if j.origin is None else [list(row) for row in j.origin],
                 "axis": list(j.axis),
+                "mass": j.mass,
+                "com": list(j.com),
             }
             for j in robot.joints
         ],
@@ -117,6 +119,7 @@ def robot_to_json(robot: Robot) -> dict[str, Any]:
         "length_unit": robot.length_unit,
         "default_reduction": robot.default_reduction,
         "description": robot.description,
+        "gravity": list(robot.gravity),
     }
 
 
@@ -126,7 +129,8 @@ def robot_from_json(data: Mapping[str, Any]) -> Robot:
     for jd in data["joints"]:
         origin = None if jd["origin"] is None else tuple(tuple(float(v) for v in row) for row in jd["origin"])
         fields = {k: jd[k] for k in ("type", "a", "alpha", "d", "theta", "lower", "upper", "name")}
-        joints.append(Joint(**fields, origin=origin, axis=tuple(jd["axis"])))
+        mass = {"mass": jd.get("mass", 0.0), "com": tuple(jd.get("com", (0.0, 0.0, 0.0)))}
+        joints.append(Joint(**fields, origin=origin, axis=tuple(jd["axis"]), **mass))
     return Robot(
         name=data["name"],
         joints=tuple(joints),
@@ -136,6 +140,7 @@ def robot_from_json(data: Mapping[str, Any]) -> Robot:
         length_unit=data["length_unit"],
         default_reduction=data["default_reduction"],
         description=data["description"],
+        gravity=tuple(data.get("gravity", (0.0, 0.0, -1.0))),
     )
 
 

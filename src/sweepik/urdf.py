@@ -15,7 +15,12 @@ Reading is safe by construction: the XML goes through ``defusedxml`` with docume
 (so no entity expansion, no external entity, nothing fetched), the size is bounded before parsing
 (``MAX_URDF_BYTES``, and ``MAX_URDF_TAGS`` counted in C), the parser builds no tree (it keeps only the links and
 joints of ``<robot>`` and stops at ``MAX_URDF_JOINTS`` joints or ``MAX_URDF_DEPTH`` levels of nesting), and
-meshes, ``package://`` resources, visuals, collisions and inertials are never looked at.
+meshes, ``package://`` resources, visuals and collisions are never looked at.
+
+Masses: a link's ``<inertial>`` gives its ``<mass value>`` (kg) and centre of mass (``<origin xyz>``, in the link's
+frame); a chain link becomes the mass and ``com`` of the joint that moves it, and links rigidly attached to it on
+the chain (fixed joints) are merged into it. Links before the first moving joint ride on the base (no effect on
+joint torques) and links off the chain are left out; inertia tensors are not used (statics needs none).
 """
 
 from __future__ import annotations
@@ -35,10 +40,10 @@ from numpy.typing import NDArray
 
 from ._validate import as_path, read_file_bytes, short_repr
 from .errors import RobotDefinitionError, UnknownOptionError, UrdfError
-from .origin_axis import joint_origins
+from .origin_axis import joint_origins, link_masses
 from .pose import matrix_from_rpy, rpy_from_matrix
 from .robot import AXIS_MIN_NORM, Joint, Robot
-from .robot_file import MAX_ANGLE_DEG, MAX_LENGTH, MAX_LIMIT
+from .robot_file import MAX_ANGLE_DEG, MAX_LENGTH, MAX_LIMIT, MAX_MASS
 from .units import mm_per_unit
 
 __all__ = [
@@ -126,6 +131,10 @@ class _Collector:
         self.joints: list[_RawJoint] = []
         self._joint_names: set[str] = set()
         self._joint: _RawJoint | None = None
+        self._link: str | None = None
+        self._in_inertial = False
+        #: link name -> attributes of its ``<inertial>``'s ``<mass>`` and ``<origin>`` children
+        self.inertials: dict[str, dict[str, dict[str, str]]] = {}
 
     def start(self, tag: str, attrib: dict[str, str]) -> None:
         self.depth += 1
@@ -145,6 +154,12 @@ class _Collector:
             if len(self.links) > MAX_URDF_JOINTS:
                 raise UrdfError(f"{src}: more than {MAX_URDF_JOINTS + 1} links; sweepik reads at most that many")
             self.links[name] = None
+            self._link = name
+        elif self.depth == 3 and self._link is not None and tag == "inertial":
+            self._in_inertial = True
+            self.inertials.setdefault(self._link, {})
+        elif self.depth == 4 and self._in_inertial and self._link is not None and tag in ("mass", "origin"):
+            self.inertials[self._link][tag] = dict(attrib)
         elif self.depth == 2 and tag == "joint":
             name = attrib.get("name")
             where = f"{src}: joint {name!r}" if name else f"{src}: joint #{len(self.joints) + 1}"
@@ -170,6 +185,9 @@ class _Collector:
     def end(self, tag: str) -> None:
         if self.depth == 2:
             self._joint = None
+            self._link = None
+        elif self.depth == 3:
+            self._in_inertial = False
         self.depth -= 1
 
     def data(self, text: str) -> None:
@@ -412,12 +430,30 @@ def robot_from_urdf(
     path = _path(parent_of, base, tip)
     if path is None:
         raise UrdfError(f"{source}: tip_link {tip!r} is not below base_link {base!r}")
-    return _chain_robot(path, found.robot_name or Path(source).stem or "urdf", source, base, tip)
+    masses = {link: _inertial(attrs, f"{source}: link {link!r}") for link, attrs in found.inertials.items()}
+    return _chain_robot(path, found.robot_name or Path(source).stem or "urdf", source, base, tip, masses)
 
 
-def _chain_robot(path: list[_UrdfJoint], name: str, source: str, base: str, tip: str) -> Robot:
+def _inertial(attrs: dict[str, dict[str, str]], where: str) -> tuple[float, Array]:
+    """A link's mass (kg) and centre of mass (its frame, metres) from its ``<inertial>``."""
+    mass = _numbers(attrs.get("mass", {}).get("value"), 1, where, "inertial mass value", MAX_MASS, "0")[0]
+    if mass < 0.0:
+        raise UrdfError(f"{where}: inertial mass value must be >= 0 kg, got {mass:g}")
+    com = _numbers(attrs.get("origin", {}).get("xyz"), 3, where, "inertial origin xyz", MAX_LENGTH, "0 0 0")
+    return mass, np.array(com)
+
+
+def _chain_robot(
+    path: list[_UrdfJoint],
+    name: str,
+    source: str,
+    base: str,
+    tip: str,
+    masses: dict[str, tuple[float, Array]] | None = None,
+) -> Robot:
+    masses = masses or {}
     carry = np.eye(4)
-    joints = []
+    joints: list[Joint] = []
     for j in path:
         where = f"{source}: joint {j.name!r}"
         if j.mimic:
@@ -428,8 +464,11 @@ def _chain_robot(path: list[_UrdfJoint], name: str, source: str, base: str, tip:
                 f"revolute, continuous, prismatic and fixed joints"
             )
         T = carry @ j.origin
+        m, c = masses.get(j.child, (0.0, np.zeros(3)))
         if j.type == "fixed":
             carry = T
+            if joints and m > 0.0:  # rigidly on the last moving link: merge (before the first one: the base)
+                joints[-1] = joints[-1].with_added_mass(m, carry[:3, :3] @ c + carry[:3, 3])
             continue
         carry = np.eye(4)
         try:
@@ -441,6 +480,8 @@ def _chain_robot(path: list[_UrdfJoint], name: str, source: str, base: str, tip:
                     name=j.name,
                     origin=tuple(tuple(float(v) for v in row) for row in T),
                     axis=(float(j.axis[0]), float(j.axis[1]), float(j.axis[2])),
+                    mass=m,
+                    com=(float(c[0]), float(c[1]), float(c[2])),
                 )
             )
         except RobotDefinitionError as exc:
@@ -505,7 +546,8 @@ def urdf_text(robot: Robot) -> str:
     name; repeats get a ``_2`` suffix, and so does a fixed joint's name that a moving joint has taken) moves
     ``link{i-1}`` -> ``link{i}`` with the origin and axis of :func:`~sweepik.origin_axis.joint_origins` (any DH
     convention); ``tool_joint`` (fixed, ``link{N}`` -> ``tool``) carries the rest of the chain and
-    ``T_flange_tool``. Lengths are converted to metres, angles stay radians;
+    ``T_flange_tool``. Link i's ``<inertial>`` holds joint i's link mass and centre of mass (no inertia tensor:
+    sweepik does not know it). Lengths are converted to metres, angles stay radians;
     revolute joints are written ``revolute`` with their limits, prismatic ones ``prismatic`` with limits in
     metres. Effort and velocity, which URDF's ``<limit>`` requires and sweepik does not know, are written as 0.
     Numbers are written with all their digits, so ``robot_from_urdf(urdf_text(r))`` (base ``world``, tip
@@ -520,6 +562,7 @@ def urdf_text(robot: Robot) -> str:
         raise UnknownOptionError(f"urdf_text needs a Robot, got {type(robot).__name__} {short_repr(robot, 40)}")
     m = mm_per_unit(robot.length_unit) / 1000.0
     origins, axes, T_last_tool = joint_origins(robot)
+    masses, coms = link_masses(robot)
     n = robot.n_joints
     # the robot's joint names first: a fixed joint gives way to a moving one called "base_joint" or "tool_joint"
     unique = _unique([*robot.joint_names, "base_joint", "tool_joint"])
@@ -532,7 +575,11 @@ def urdf_text(robot: Robot) -> str:
     root.append(ET.Comment(" written by sweepik: lengths in metres, angles in radians "))
     ET.SubElement(root, "link", name=link_names[0])
     for k, jname in enumerate(names):
-        ET.SubElement(root, "link", name=link_names[k + 1])
+        link = ET.SubElement(root, "link", name=link_names[k + 1])
+        if 0 < k <= n and masses[k - 1] > 0.0:
+            inertial = ET.SubElement(link, "inertial")
+            ET.SubElement(inertial, "origin", xyz=" ".join(_num(v * m) for v in coms[k - 1]))
+            ET.SubElement(inertial, "mass", value=_num(masses[k - 1]))
         moving = 0 < k <= n
         j = robot.joints[k - 1] if moving else None
         joint = ET.SubElement(root, "joint", name=jname, type="fixed" if j is None else j.type)
