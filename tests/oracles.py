@@ -490,3 +490,28 @@ def ikgeo_solutions(
     if reverse:
         Q = Q[:, ::-1]
     return _filter(robot, target, Q, is_ls, "ik_geo", info, decomposition=name, kind=kind, reversed=reverse)
+
+
+def in_metres(robot: Any, name: str) -> Any:
+    """The DH ``robot`` (length unit mm) written again in metres, from a robot file's dict: the same arm through
+    another description (lengths, prismatic limits, centres of mass / 1000; masses and gravity unchanged)."""
+    from sweepik.robot_file import robot_from_dict
+
+    assert robot.length_unit == "mm" and robot.dh_convention != "none"
+    joints = []
+    for j in robot.joints:
+        limits = [np.degrees(j.lower), np.degrees(j.upper)] if j.is_revolute else [j.lower / 1000, j.upper / 1000]
+        joints.append(
+            {
+                "type": j.type,
+                "a": j.a / 1000,
+                "alpha": np.degrees(j.alpha),
+                "d": j.d / 1000,
+                "theta": np.degrees(j.theta),
+                "limits": limits,
+                "mass": j.mass,
+                "com": [c / 1000 for c in j.com],
+            }
+        )
+    data = {"name": name, "length_unit": "m", "dh_convention": robot.dh_convention, "gravity": list(robot.gravity)}
+    return robot_from_dict({**data, "joints": joints})

@@ -8,6 +8,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from oracles import in_metres
 
 from sweepik import load_robot
 from sweepik.errors import LockedJointError, RobotDefinitionError, RobotFileError, UnknownOptionError
@@ -92,28 +93,7 @@ def test_vertical_rail_carries_the_weight() -> None:
 def test_same_arm_in_metres() -> None:
     mm = _with_masses(load_robot("carm"), np.random.default_rng(5))
     assert mm.length_unit == "mm"
-    data = {
-        "name": "carm_m",
-        "length_unit": "m",
-        "dh_convention": mm.dh_convention,
-        "gravity": list(mm.gravity),
-        "joints": [
-            {
-                "type": j.type,
-                "a": j.a / 1000,
-                "alpha": np.degrees(j.alpha),
-                "d": j.d / 1000,
-                "theta": np.degrees(j.theta),
-                "limits": [np.degrees(j.lower), np.degrees(j.upper)]
-                if j.is_revolute
-                else [j.lower / 1000, j.upper / 1000],
-                "mass": j.mass,
-                "com": [c / 1000 for c in j.com],
-            }
-            for j in mm.joints
-        ],
-    }
-    m = robot_from_dict(data)
+    m = in_metres(mm, "carm_m")
     q = random_configurations(mm, 20, np.random.default_rng(6))
     qm = np.where(mm.is_revolute, q, q / 1000)
     a = gravity_torques(mm, q, payload=3.0, payload_com=(10.0, -20.0, 30.0))

@@ -3,7 +3,8 @@
 Public API: robots (``load_robot`` for bundled arms, TOML robot files and URDF; ``Robot``, ``Joint``;
 ``read_urdf``, ``urdf_text``, ``robot_to_toml``), pose helpers and error metrics, and the solvers ``solve``,
 ``solve_many`` and ``iter_solve`` (``locked=`` for arms with more than six joints), ``solve_dask`` (on a Dask
-cluster, optionally into an on-disk store) and ``load_solutions``. See the README and
+cluster, optionally into an on-disk store) and ``load_solutions``; design tools: ``compare_designs`` (what
+``sweepik design`` runs), ``gravity_torques`` (statics) and ``workspace_volume``. See the README and
 docs/conventions.md for units and conventions.
 """
 
@@ -11,6 +12,7 @@ from importlib.metadata import PackageNotFoundError, version
 
 from .analysis import analyze
 from .batch import SolutionBatch
+from .design import DesignComparison, compare_designs
 from .distributed import solve_dask
 from .errors import (
     InvalidPoseError,
@@ -41,8 +43,10 @@ from .robot import Joint, Robot
 from .robot_file import bundled_robots, load_robot, robot_from_dict, robot_to_toml
 from .solutions import Family, Solutions
 from .solver import STRATEGIES, iter_solve, solve, solve_many
+from .statics import gravity_torques
 from .store import StoreError, load_solutions
 from .urdf import read_urdf, urdf_text
+from .workspace import WorkspaceVolume, workspace_volume
 
 try:
     __version__ = version("sweepik")
@@ -76,6 +80,11 @@ __all__ = [
     "GeometricReduction",
     "Plan",
     "analyze",
+    "compare_designs",
+    "DesignComparison",
+    "gravity_torques",
+    "workspace_volume",
+    "WorkspaceVolume",
     "zyz_from_matrix",
     "matrix_from_zyz",
     "pose_from_xyz_zyz",

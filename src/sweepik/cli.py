@@ -67,6 +67,7 @@ from .cli_common import (
     _SubParsers,
 )
 from .cli_convert import add_convert_parser, cmd_convert
+from .cli_design import add_design_parser, cmd_design
 from .cli_solve import add_path_parser, add_solve_parser, cmd_path, cmd_solve
 from .cli_verify import add_bench_parser, add_verify_parser, cmd_bench, cmd_verify
 
@@ -249,6 +250,7 @@ _COMMANDS: dict[str, tuple[_AddParser, _Run]] = {
     "bench": (add_bench_parser, cmd_bench),
     "convert": (add_convert_parser, cmd_convert),
     "sample": (add_sample_parser, cmd_sample),
+    "design": (add_design_parser, cmd_design),
 }
 
 

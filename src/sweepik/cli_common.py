@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import math
 import os
@@ -320,6 +321,16 @@ def _check_output_path(path: str, directory: bool = False, suffixes: Sequence[st
         raise CliInputError(f"{path}: cannot write there: directory {str(parent)!r} is not writable")
     if not directory and p.exists() and not os.access(p, os.W_OK):
         raise CliInputError(f"{path}: file exists and is not writable")
+
+
+def _check_report_and_json(args: argparse.Namespace) -> None:
+    """Before any work: ``--report DIR`` must be writable and matplotlib installed; ``--json FILE`` writable."""
+    if args.report:
+        _check_output_path(args.report, directory=True)
+        if importlib.util.find_spec("matplotlib") is None:
+            raise CliInputError(f"--report {args.report}: the figures need matplotlib: pip install 'sweepik[plot]'")
+    if args.json and args.json != "-":
+        _check_output_path(args.json)
 
 
 # --------------------------------------------------------------------------------------------------

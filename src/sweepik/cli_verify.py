@@ -3,17 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 from pathlib import Path
 from typing import Any
 
 from .cli_common import (
     DEFAULT_ROBOT,
-    CliInputError,
     _add_json,
     _add_robot_options,
-    _check_output_path,
+    _check_report_and_json,
     _count,
     _load_robot,
     _nonnegative_int,
@@ -61,12 +59,7 @@ def add_verify_parser(sub: _SubParsers) -> None:
 def cmd_verify(args: argparse.Namespace) -> int:
     from .verify import format_table, run_verify, write_report
 
-    if args.report:
-        _check_output_path(args.report, directory=True)
-        if importlib.util.find_spec("matplotlib") is None:
-            raise CliInputError(f"--report {args.report}: the figures need matplotlib: pip install 'sweepik[plot]'")
-    if args.json and args.json != "-":
-        _check_output_path(args.json)
+    _check_report_and_json(args)
     robot = _load_robot(args.robot, args)
     progress = _Progress()
     try:
