@@ -378,50 +378,33 @@ def _unit_format(unit: str) -> Callable[[float], str]:
     return lambda v: f"{v:.2f} {unit}"
 
 
+def _percent(digits: int) -> Callable[[float], str]:
+    return lambda v: f"{100 * v:.{digits}f} %"
+
+
+#: The criteria compared for every candidate: (name, value of a candidate, larger is better, format, why, tie).
+_CRITERIA: list[tuple[str, Callable[[Candidate], float | None], bool, Callable[[float], str], str, float]] = [
+    ("IK time per pose", lambda c: c.ik["seconds_per_pose"], False, lambda v: f"{v * 1e6:.1f} µs",
+     "solving faster", TIME_TIE),
+    ("task poses reached", lambda c: c.ik["reached_share"], True, _percent(1), "reaching more of the task", TIE),
+    ("mean solutions per reached pose", lambda c: c.ik["mean_solutions"], True, lambda v: f"{v:.2f}",
+     "more ways to reach a pose", TIE),
+    ("poses with a multiple root", lambda c: c.ik["multiple_root_share"], False, _percent(2),
+     "fewer singular poses in the task", TIE),
+    ("solutions within joint limits", lambda c: c.ik["within_limits_share"], True, _percent(1),
+     "joint limits cut fewer solutions", TIE),
+    ("median smallest singular value", lambda c: c.manipulability["sigma_min"]["p50"], True, lambda v: f"{v:.4g}",
+     "further from singularities", TIE),
+]  # fmt: skip
+
+
 def _verdicts(cands: list[Candidate]) -> list[dict[str, Any]]:
     noise = EFFORT_NOISE * max((s["max"] or 0.0) for c in cands for s in c.effort["per_joint"])
     out = [
-        _verdict(
-            cands,
-            "IK time per pose",
-            [c.ik["seconds_per_pose"] for c in cands],
-            False,
-            lambda v: f"{v * 1e6:.1f} µs",
-            why="solving faster",
-            tie=TIME_TIE,
-        ),
-        _verdict(
-            cands,
-            "task poses reached",
-            [c.ik["reached_share"] for c in cands],
-            True,
-            lambda v: f"{100 * v:.1f} %",
-            why="reaching more of the task",
-        ),
-        _verdict(
-            cands,
-            "mean solutions per reached pose",
-            [c.ik["mean_solutions"] for c in cands],
-            True,
-            lambda v: f"{v:.2f}",
-            why="more ways to reach a pose",
-        ),
-        _verdict(
-            cands,
-            "poses with a multiple root",
-            [c.ik["multiple_root_share"] for c in cands],
-            False,
-            lambda v: f"{100 * v:.2f} %",
-            why="fewer singular poses in the task",
-        ),
-        _verdict(
-            cands,
-            "solutions within joint limits",
-            [c.ik["within_limits_share"] for c in cands],
-            True,
-            lambda v: f"{100 * v:.1f} %",
-            why="joint limits cut fewer solutions",
-        ),
+        _verdict(cands, what, [get(c) for c in cands], larger, fmt, why=why, tie=tie)
+        for what, get, larger, fmt, why, tie in _CRITERIA
+    ]
+    out.append(
         _verdict(
             cands,
             "reachable volume",
@@ -430,15 +413,9 @@ def _verdicts(cands: list[Candidate]) -> list[dict[str, Any]]:
             lambda v: f"{v:.4g} m³",
             margin=[c.workspace["uncertainty_m3"] for c in cands],
             why="a larger workspace (beyond the estimates' uncertainty)",
-        ),
-        _verdict(
-            cands,
-            "median smallest singular value",
-            [c.manipulability["sigma_min"]["p50"] for c in cands],
-            True,
-            lambda v: f"{v:.4g}",
-            why="further from singularities",
-        ),
+        )
+    )
+    out.append(
         _verdict(
             cands,
             "largest holding torque (revolute joints)",
@@ -447,8 +424,8 @@ def _verdicts(cands: list[Candidate]) -> list[dict[str, Any]]:
             _unit_format("N·m"),
             why="smaller actuators",
             floor=noise,
-        ),
-    ]
+        )
+    )
     n = min(c.robot.n_joints for c in cands)
     for i in range(n):
         units = {c.effort["units"][i] for c in cands}
