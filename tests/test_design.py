@@ -148,3 +148,44 @@ def test_cli_bad_input(extra: list[str], capsys: pytest.CaptureFixture[str]) -> 
 def test_cli_unknown_robot(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["design", "ur5", "no_such_arm"]) == 2
     assert "no_such_arm" in capsys.readouterr().err
+
+
+def test_a_candidate_reaching_nothing_wins_nothing() -> None:
+    """One pose only the C-Arm reaches: the swapped arm has no torques, so no effort verdict goes either way."""
+    carm = load_robot("carm")
+    pose = carm.fk([500, 0.3, 0.2, -0.4, 0.5, 0.6])
+    cmp = compare_designs(["carm", "carm_swapped"], poses=pose[None], payload=12.0, workspace_samples=5000)
+    assert cmp.candidates[1].ik["reached_share"] == 0.0
+    assert cmp.candidates[1].ik["mean_solutions"] is None
+    for v in cmp.verdicts:
+        if "effort" in v["criterion"] or "torque" in v["criterion"] or "singular" in v["criterion"]:
+            assert v["winner"] is None, v
+
+
+def test_region_one_candidate_cannot_reach() -> None:
+    """A box only the UR10 reaches: the task is the UR10's poses there, the UR3 reaches none of them."""
+    cmp = compare_designs(
+        ["ur10", "ur3"], region=[[0.8, 1.3], [-0.6, 0.6], [-0.3, 0.6]], samples=40, workspace_samples=5000
+    )
+    assert cmp.task["n_poses"] > 0
+    assert cmp.candidates[0].ik["reached_share"] == 1.0 and cmp.candidates[1].ik["reached_share"] == 0.0
+
+
+def test_cli_json_to_stdout_with_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "new_dir"
+    argv = ["design", "ur5", "ur10", "--samples", "30", "--workspace-samples", "5000"]
+    assert main([*argv, "--json", "-", "--report", str(out)]) == 0
+    data = json.loads(capsys.readouterr().out)  # only the JSON on stdout
+    assert len(data["candidates"]) == 2
+    # the JSON may go into the report directory, created for it
+    other = tmp_path / "fresh"
+    assert main([*argv, "--report", str(other), "--json", str(other / "d.json")]) == 0
+    assert (other / "d.json").exists() and (other / "report.md").exists()
+
+
+def test_unsolvable_candidate_refused_first(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["design", "ur5", "franka_panda", "--samples", "10"]) == 2
+    err = capsys.readouterr().err
+    assert "franka_panda" in err and "--lock" in err
+    with pytest.raises(UnknownOptionError, match="payload_com"):
+        compare_designs(["ur5"], payload=1.0, payload_com=(1e300, 0, 0), samples=10, workspace_samples=1000)

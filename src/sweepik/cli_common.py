@@ -324,11 +324,16 @@ def _check_output_path(path: str, directory: bool = False, suffixes: Sequence[st
 
 
 def _check_report_and_json(args: argparse.Namespace) -> None:
-    """Before any work: ``--report DIR`` must be writable and matplotlib installed; ``--json FILE`` writable."""
+    """Before any work: ``--report DIR`` must be writable and matplotlib installed (the directory is created now,
+    so that ``--json DIR/file.json`` may go into it); ``--json FILE`` writable."""
     if args.report:
         _check_output_path(args.report, directory=True)
         if importlib.util.find_spec("matplotlib") is None:
             raise CliInputError(f"--report {args.report}: the figures need matplotlib: pip install 'sweepik[plot]'")
+        try:
+            Path(args.report).mkdir(exist_ok=True)
+        except OSError as exc:
+            raise CliInputError(f"--report {args.report}: cannot create the directory: {exc.strerror}") from None
     if args.json and args.json != "-":
         _check_output_path(args.json)
 

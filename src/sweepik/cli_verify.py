@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -75,7 +76,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
             print(f"results written to {args.json}")
     if args.report:
         path = write_report(result, args.report)
-        print(f"report written to {path}")
+        print(f"report written to {path}", file=sys.stderr if args.json == "-" else sys.stdout)
     return 0
 
 

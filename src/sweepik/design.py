@@ -25,6 +25,7 @@ its own unit. All candidates share the world frame (each robot file's ``[base]``
 from __future__ import annotations
 
 import time
+import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -34,7 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._validate import as_float_array, check_bool, check_int, check_poses
 from .analysis import analyze, plan_line
-from .errors import UnknownOptionError
+from .errors import LockedJointError, UnknownOptionError
 from .reductions import get_reduction
 from .robot import Robot
 from .robot_file import load_robot
@@ -52,11 +53,14 @@ Progress = Callable[[str, int, int], None]
 #: Largest task (poses) and workspace sample (configurations) accepted.
 MAX_DESIGN_SAMPLES = 1_000_000
 MAX_WORKSPACE_SAMPLES = 10_000_000
-#: Poses solved first, untimed, so that seconds per pose leaves out the one-off compilation: as many as a batch
-#: needs to take the engine's parallel paths (``fastsweep.PARALLEL_MIN`` poses, 16 times that for FK).
-WARMUP_POSES = 2048
-#: With ``region``: draw at most this many times ``samples`` configurations looking for poses inside it.
+#: Seconds per pose: the best of ``TIMING_REPEATS`` runs of ``solve_many`` on the first ``TIMED_POSES`` task poses,
+#: after the whole task was solved once (which compiles what the arm needs, whatever the batch size).
+TIMED_POSES = 2048
+TIMING_REPEATS = 3
+#: With ``region``: draw at most ``REGION_TRIES`` times ``max(share, REGION_DRAW)`` configurations of a candidate
+#: looking for its share of poses inside it (a candidate that puts none there simply adds none to the task).
 REGION_TRIES = 50
+REGION_DRAW = 2000
 #: Percentiles of |tau| and of the manipulability measures reported.
 PERCENTILES = (5, 50, 95, 99)
 
@@ -177,19 +181,21 @@ def _task(
         factor = 1.0 / _scale(robot, first)
         found: list[Array] = []
         got = 0
-        for _ in range(REGION_TRIES if box is not None else 1):
-            T = _in_unit(robot.fk(random_configurations(robot, n, rng)), factor)
+        draw = n if box is None else max(n, REGION_DRAW)
+        for _ in range(REGION_TRIES if box is not None and n > 0 else 1):
+            T = _in_unit(robot.fk(random_configurations(robot, draw, rng)), factor)
             T = T[_inside(T, box)]
             found.append(T[: n - got])
             got += len(found[-1])
             if got >= n:
                 break
-        if box is not None and got == 0:
-            raise UnknownOptionError(
-                f"{robot.name}: none of {REGION_TRIES * n:,} random configurations puts the tool inside the region"
-            )
         parts.append(np.concatenate(found))
     P = np.concatenate(parts)
+    if P.shape[0] == 0:
+        raise UnknownOptionError(
+            "no candidate puts its tool inside the region in "
+            f"{REGION_TRIES * REGION_DRAW:,} random configurations: the task is empty"
+        )
     counts = ", ".join(f"{len(p)} of {r.name}" for p, r in zip(parts, robots, strict=True))
     where = " with the tool inside the region" if box is not None else ""
     return P, f"poses of random in-limit configurations{where} ({counts})"
@@ -207,6 +213,16 @@ def _stats(x: Array) -> dict[str, Any]:
     out: dict[str, Any] = {"n": int(x.size), "max": float(x.max()), "min": float(x.min()), "mean": float(x.mean())}
     out.update({f"p{p}": float(v) for p, v in zip(PERCENTILES, np.percentile(x, PERCENTILES), strict=True)})
     return out
+
+
+def _check_solvable(robot: Robot) -> None:
+    """LockedJointError / NoReductionError (naming the arm) if ``solve`` cannot solve this candidate."""
+    if robot.n_joints != 6:
+        raise LockedJointError(
+            f"candidate {robot.name!r} has {robot.n_joints} joints; design compares six-joint arms: write it with "
+            "joints held, e.g. 'sweepik convert ROBOT --lock NAME=VALUE -o arm6.toml', and compare that file"
+        )
+    get_reduction(robot, None, None)
 
 
 def _decomposition(robot: Robot) -> dict[str, Any]:
@@ -230,11 +246,14 @@ def _decomposition(robot: Robot) -> dict[str, Any]:
 
 def _ik(robot: Robot, P: Array) -> tuple[dict[str, Any], Any]:
     t0 = time.perf_counter()
-    solve_many(robot, P[:WARMUP_POSES])
-    first = time.perf_counter() - t0
-    t0 = time.perf_counter()
     batch = solve_many(robot, P)
-    elapsed = time.perf_counter() - t0
+    first = time.perf_counter() - t0  # with the one-off compilation of what this arm needs
+    timed = P[:TIMED_POSES]
+    runs = []
+    for _ in range(TIMING_REPEATS):
+        t0 = time.perf_counter()
+        solve_many(robot, timed)
+        runs.append((time.perf_counter() - t0) / max(timed.shape[0], 1))
     counts = batch.counts
     n = len(batch)
     hist = np.bincount(counts) if n else np.zeros(1, dtype=np.intp)
@@ -246,10 +265,11 @@ def _ik(robot: Robot, P: Array) -> tuple[dict[str, Any], Any]:
     reaching = int(batch.n_reachable.sum())
     ik = {
         "n_poses": n,
-        "seconds_per_pose": elapsed / max(n, 1),
+        "seconds_per_pose": min(runs),
+        "seconds_per_pose_runs": runs,
         "first_call_seconds": first,
         "solutions_histogram": {str(k): int(v) for k, v in enumerate(hist) if v},
-        "mean_solutions": float(counts[counts > 0].mean()) if np.any(counts > 0) else 0.0,
+        "mean_solutions": float(counts[counts > 0].mean()) if np.any(counts > 0) else None,
         "max_solutions": int(counts.max()) if n else 0,
         "reached_share": float(np.mean((counts > 0) | families)) if n else 0.0,
         "multiple_root_share": float(multiple.mean()) if n else 0.0,
@@ -305,7 +325,7 @@ def _measure(
 ) -> Candidate:
     ik, batch = _ik(robot, P)
     q = batch.q
-    volume = workspace_volume(robot, workspace_samples, rng=rng)
+    volume = workspace_volume(robot, workspace_samples, rng=rng)  # rng: this candidate's own stream
     return Candidate(
         robot=robot,
         decomposition=_decomposition(robot),
@@ -327,6 +347,9 @@ def _measure(
 #: timings, noisier, use ``TIME_TIE``.
 TIE = 0.01
 TIME_TIE = 0.1
+#: Reachable volumes differ only if they are further apart than this many times the sum of their uncertainties (an
+#: estimate from few samples can sit low by about its uncertainty).
+VOLUME_MARGIN = 2.0
 #: A holding effort below this fraction of the largest in the comparison is rounding noise: zero.
 EFFORT_NOISE = 1e-9
 
@@ -337,7 +360,7 @@ def _best(
     """Index of the best value and whether it beats every other by more than their combined margins (or, without
     margins, by more than ``tie`` times the larger magnitude), and by more than ``floor`` (the noise level)."""
     known = {i: float(v) for i, v in enumerate(values) if v is not None}
-    if not known:
+    if len(known) < len(values) or not known:  # a candidate without the measurement (no pose reached): no verdict
         return None, False
     pick = (max if larger else min)(known, key=lambda i: known[i])
     best = known[pick]
@@ -411,8 +434,8 @@ def _verdicts(cands: list[Candidate]) -> list[dict[str, Any]]:
             [c.workspace["volume_m3"] for c in cands],
             True,
             lambda v: f"{v:.4g} m³",
-            margin=[c.workspace["uncertainty_m3"] for c in cands],
-            why="a larger workspace (beyond the estimates' uncertainty)",
+            margin=[VOLUME_MARGIN * c.workspace["uncertainty_m3"] for c in cands],
+            why=f"a larger workspace (beyond {VOLUME_MARGIN:g} times the estimates' uncertainties)",
         )
     )
     out.append(
@@ -484,6 +507,8 @@ def compare_designs(
     seed = check_int(seed, "seed", 0, 2**63 - 1)
     links = check_bool(links, "links")
     box = _check_region(region)
+    for arm in arms:  # every candidate solvable before any work
+        _check_solvable(arm)
     report = _no_progress if progress is None else progress
     first = arms[0]
     # checked once here, in the first candidate's unit (gravity_torques checks it again per candidate)
@@ -495,7 +520,8 @@ def compare_designs(
     cands = []
     for k, robot in enumerate(arms):
         factor = _scale(robot, first)
-        cands.append(_measure(robot, _in_unit(P, factor), float(payload), com * factor, links, workspace_samples, rng))
+        own = np.random.default_rng([seed, zlib.crc32(robot.name.encode())])  # not dependent on the order
+        cands.append(_measure(robot, _in_unit(P, factor), float(payload), com * factor, links, workspace_samples, own))
         report("design", k + 1, len(arms))
     task = {
         "n_poses": int(P.shape[0]),

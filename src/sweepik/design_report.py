@@ -47,7 +47,7 @@ def _rows(cmp: DesignComparison) -> list[tuple[str, list[str]]]:
         row("task poses reached", lambda c: _num(c.ik["reached_share"], ".1f", 100, "%")),
         row(
             "solutions per reached pose (mean / max)",
-            lambda c: f"{c.ik['mean_solutions']:.2f} / {c.ik['max_solutions']}",
+            lambda c: f"{_num(c.ik['mean_solutions'], '.2f')} / {c.ik['max_solutions']}",
         ),
         row("poses with a multiple root", lambda c: _num(c.ik["multiple_root_share"], ".2f", 100, "%")),
         row("poses with a self-motion family", lambda c: _num(c.ik["self_motion_share"], ".2f", 100, "%")),
@@ -142,7 +142,7 @@ def _workspace_figure(cmp: DesignComparison, c: Candidate, path: Path) -> Path:
     unit = cmp.task["length_unit"]
     fig, axes = plt.subplots(1, 3, figsize=(13.0, 4.4))
     lo, hi = P.min(axis=0), P.max(axis=0)
-    pad = 0.05 * float(np.max(hi - lo) if P.size else 1.0)
+    pad = max(0.05 * float(np.max(hi - lo)) if P.size else 1.0, 1e-3 * (1.0 + float(np.max(np.abs(P), initial=0.0))))
     sc = None
     for ax, (a, b) in zip(axes, _PLANES, strict=True):
         sc = ax.scatter(P[order, a], P[order, b], c=counts[order], cmap=cmap, norm=norm, s=6, linewidths=0)
@@ -179,7 +179,11 @@ def _effort_figure(cmp: DesignComparison, path: Path) -> Path:
         if i >= n:
             ax.set_visible(False)
             continue
-        have = [(j, c) for j, c in enumerate(cmp.candidates) if i < c.robot.n_joints]
+        have = [(j, c) for j, c in enumerate(cmp.candidates) if i < c.robot.n_joints and c.effort["per_joint"][i]["n"]]
+        if not have:
+            ax.text(0.5, 0.5, "no pose reached", transform=ax.transAxes, ha="center", va="center", fontsize=9)
+            ax.set_title(f"joint {i + 1}", fontsize=9)
+            continue
         mx = [c.effort["per_joint"][i]["max"] or 0.0 for _, c in have]
         p95 = [c.effort["per_joint"][i]["p95"] or 0.0 for _, c in have]
         med = [c.effort["per_joint"][i]["p50"] or 0.0 for _, c in have]
@@ -199,8 +203,11 @@ def _effort_figure(cmp: DesignComparison, path: Path) -> Path:
         ax.set_xticks(x)
         ax.set_xticklabels([c.name for c in cmp.candidates], fontsize=8, rotation=15)
         ax.grid(True, axis="y", alpha=0.3)
+        for j in sorted(set(range(len(cmp.candidates))) - {j for j, _ in have}):
+            ax.text(x[j], 0.5, "not reached", transform=ax.get_xaxis_transform(), ha="center", va="center",
+                    rotation=90, fontsize=8)  # fmt: skip
     load = cmp.payload
-    masses = any(j.mass > 0 for c in cmp.candidates for j in c.robot.joints)
+    masses = _any_masses(cmp)
     fig.suptitle(
         f"Static holding effort over all in-limit solutions of the task: payload {load['mass_kg']:g} kg"
         + (" and link masses" if load["links"] and masses else ", no link masses"),
@@ -235,6 +242,10 @@ def _manipulability_figure(cmp: DesignComparison, path: Path) -> Path:
     fig.suptitle("Distance to singularity over all in-limit solutions of the task", fontsize=10)
     fig.tight_layout()
     return _save(fig, path)
+
+
+def _any_masses(cmp: DesignComparison) -> bool:
+    return any(j.mass > 0 for c in cmp.candidates for j in c.robot.joints)
 
 
 def save_design_figures(cmp: DesignComparison, directory: str | PathLike[str]) -> dict[str, Path]:
@@ -277,7 +288,13 @@ def write_design_report(cmp: DesignComparison, directory: str | PathLike[str]) -
         "",
         f"**Task**: {cmp.task['n_poses']:,} tool poses, {cmp.task['source']} (seed {cmp.task['seed']}). "
         f"**Payload**: {load['mass_kg']:g} kg at ({com}) {load['com_unit']} in the tool frame"
-        + ("; link masses from the robot files" if load["links"] else "; link masses ignored")
+        + (
+            "; link masses from the robot files"
+            if load["links"] and _any_masses(cmp)
+            else "; no link masses (none in the robot files)"
+            if load["links"]
+            else "; link masses ignored"
+        )
         + ".",
         "",
         "Gravity: "

@@ -29,6 +29,7 @@ from . import kinematics
 from ._validate import check_configuration
 from .errors import UnknownOptionError
 from .robot import Robot
+from .robot_file import MAX_LENGTH
 from .units import mm_per_unit
 
 __all__ = ["STANDARD_GRAVITY", "gravity_torques", "potential_energy", "torque_units"]
@@ -56,9 +57,10 @@ def _check_payload(robot: Robot, payload: float, payload_com: ArrayLike) -> tupl
         c = np.array(payload_com, dtype=np.float64)
     except (TypeError, ValueError):
         c = np.zeros(0)
-    if c.shape != (3,) or not np.all(np.isfinite(c)):
+    if c.shape != (3,) or not np.all(np.isfinite(c)) or np.any(np.abs(c) > MAX_LENGTH):
         raise UnknownOptionError(
-            f"payload_com must be 3 finite numbers (tool frame, {robot.length_unit}), got {payload_com!r}"
+            f"payload_com must be 3 finite numbers of magnitude at most {MAX_LENGTH:g} (tool frame, "
+            f"{robot.length_unit}), got {payload_com!r}"
         )
     return m, c
 
