@@ -34,9 +34,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import float64, int64, njit, prange, types
+from numba import float64, int64, njit, types
 from numpy.typing import NDArray
 
+from .. import parallel
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
 from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, LazyKernel, first_class, lazy_njit
@@ -414,15 +415,9 @@ def _swing_pose(params, lo, hi, n, periodic, ks, out, i):
             xm, am, x0, a0 = x0, a0, x1, a1
 
 
-@njit(cache=True, parallel=True)
-def _swing_parallel(params, lo, hi, n, periodic, ks, out):
-    for i in prange(params.shape[0]):
-        _swing_pose(params, lo, hi, n, periodic, ks, out, i)
-
-
-@njit(cache=True)
-def _swing_serial(params, lo, hi, n, periodic, ks, out):
-    for i in range(params.shape[0]):
+@njit(cache=True, nogil=True)
+def _swing(params, lo, hi, n, periodic, ks, out, start, stop):
+    for i in range(start, stop):
         _swing_pose(params, lo, hi, n, periodic, ks, out, i)
 
 
@@ -433,8 +428,7 @@ def swing_hints(params, lo, hi, n, periodic, ks, out):
     ``_amplitude``). Batches use both cores, as the engine's search."""
     from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
 
-    run = _swing_parallel if params.shape[0] >= PARALLEL_MIN else _swing_serial
-    run(params, lo, hi, n, periodic, ks, out)
+    parallel.run(_swing, params.shape[0], PARALLEL_MIN, params, lo, hi, n, periodic, ks, out)
 
 
 wrist_residual = LazyKernel(_no_residual, RESIDUAL_SIG, cache=True)
