@@ -125,8 +125,9 @@ _BLOCK_ELEMENTS = 1 << 22
 if AVAILABLE:
     import math
 
-    from numba import boolean, float64, int64, njit
+    from numba import boolean, float64, int64
 
+    from ._jit import internal
     from .reductions.kernels import lazy_njit
 
     @lazy_njit(
@@ -152,7 +153,7 @@ if AVAILABLE:
                     ok = False
             inside[k] = ok
 
-    @njit(cache=True)
+    @internal
     def _group_order(pose):  # pragma: no cover
         """The candidates ordered by pose, keeping their order within a pose: a stable sort of ``pose``, counting
         the candidates of each pose (no compiled np.argsort: it adds seconds to the first compilation)."""

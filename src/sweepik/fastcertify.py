@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import parallel
+from ._jit import internal
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
 from .reductions.kernels import first_class, lazy_njit
@@ -31,13 +32,13 @@ _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
 J_CUTOFF_FACTOR = 1e-4
 
 if AVAILABLE:
-    from numba import float64, int64, njit, types
+    from numba import float64, int64, types
 
     from .reductions.kernels import CONFIGURATION_SIG
 
     _CFG = types.FunctionType(CONFIGURATION_SIG)
 
-    @njit(cache=True)
+    @internal
     def _poe_fk(H, P, rev, R_end, q):
         """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain as 12 scalars (rotation
         row by row, then position): scalar locals only, no array allocated (this runs once per candidate)."""
@@ -91,11 +92,11 @@ if AVAILABLE:
             pz,
         )
 
-    @njit(cache=True)
+    @internal
     def _wrap(x):
         return math.pi - ((math.pi - x) % (2.0 * math.pi))
 
-    @njit(cache=True)
+    @internal
     def _zyz(r00, r01, r02, r10, r11, r12, r20, r21, r22):
         """Z-Y-Z angles of a rotation given by its entries, as pose.zyz_from_matrix."""
         sb = math.hypot(r20, r21)
@@ -112,7 +113,7 @@ if AVAILABLE:
             gamma = math.atan2(ca * r10 - sa * r00, ca * r11 - sa * r01)
         return _wrap(alpha), beta, _wrap(gamma)
 
-    @njit(cache=True)
+    @internal
     def _errors(T, Td, weight):
         """(geodesic error, paper J) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``."""
         r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T

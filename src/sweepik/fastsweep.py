@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from . import parallel
 from . import sweep as _ref
+from ._jit import internal
 from .reductions.kernels import first_class, lazy_njit
 from .robot import Robot
 
@@ -72,7 +73,7 @@ _U_EDGE = _ref._U_EDGE
 
 if AVAILABLE:
 
-    @njit(cache=True)
+    @internal
     def _root(res, p, b, a, c, fa, fc, xtol):
         """Chandrupatla's bracketed root finder (scalar), as rootfind.find_roots."""
         eps = 2.220446049250313e-16
@@ -118,12 +119,12 @@ if AVAILABLE:
             t = min(max(t, tlim), 1.0 - tlim)
         return x
 
-    @njit(cache=True)
+    @internal
     def _small(res, p, x, b, noise):
         f = res(p, x, b)
         return (not math.isnan(f)) and abs(f) <= noise
 
-    @njit(cache=True)
+    @internal
     def _center_flat(res, p, x, b, noise, span):
         """As sweep._Search._center_flat, for one root: (centre, lo, hi, is a family)."""
         d0 = FLAT_PROBE_REL * span
@@ -139,7 +140,7 @@ if AVAILABLE:
         family = open0 and open1 and hi - lo > CLUSTER_FAMILY_REL * span
         return 0.5 * (lo + hi), lo, hi, family
 
-    @njit(cache=True)
+    @internal
     def _flat_grow(res, p, x, b, noise, d0, limit, sgn):
         """(inner, outer): the residual is within the noise at x + sgn inner, not at x + sgn outer (doubling)."""
         inner, outer = 0.0, d0
@@ -153,7 +154,7 @@ if AVAILABLE:
                     break
         return inner, outer
 
-    @njit(cache=True)
+    @internal
     def _flat_end(res, p, x, b, noise, inner, outer, limit, sgn, short):
         """(reach, the stretch ends openly) on one side, as in sweep._Search._center_flat."""
         at_limit = inner >= limit
@@ -169,7 +170,7 @@ if AVAILABLE:
         far = abs(res(p, x + 2.0 * sgn * outer, b))
         return inner, at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise
 
-    @njit(cache=True)
+    @internal
     def _multiplicity(res, p, x, b, noise, span):
         """As sweep._Search._multiplicity, for one root."""
         level = MULT_LEVEL * noise
@@ -191,7 +192,7 @@ if AVAILABLE:
         m = total / count if count > 0 else 1.0
         return int(min(max(round(m), 1), MULT_MAX))
 
-    @njit(cache=True)
+    @internal
     def _extend(res, p, b, inside, outside):
         for _ in range(FAMILY_BISECT):
             mid = 0.5 * (inside + outside)
@@ -202,14 +203,14 @@ if AVAILABLE:
                 outside = mid
         return inside
 
-    @njit(cache=True)
+    @internal
     def _push(out_t, out_b, cnt, x, b):
         if cnt[0] < out_t.shape[0]:
             out_t[cnt[0]] = x
             out_b[cnt[0]] = b
         cnt[0] += 1
 
-    @njit(cache=True)
+    @internal
     def _extremum(res, p, b, ta, tc, tb, fa, fc, fb, span, noise, xtol, out_t, out_b, cnt):
         xe = tc
         lo, hi = ta, tb
@@ -238,11 +239,11 @@ if AVAILABLE:
         elif abs(fx) <= FAR_NOISE * noise:
             _push(out_t, out_b, cnt, xe, b)
 
-    @njit(cache=True)
+    @internal
     def _g(res, p, x, b, h):
         return res(p, x + h, b) - res(p, x - h, b)
 
-    @njit(cache=True)
+    @internal
     def _root_diff(res, p, b, a, c, ga, gc, h):
         """Root of the central difference between a and c (Illinois-safeguarded bisection)."""
         xtol = 1e-3 * h
@@ -272,7 +273,7 @@ if AVAILABLE:
                 side = 1
         return x
 
-    @njit(cache=True)
+    @internal
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
         wv, wx, wdd, res_all, n_all, edge_f, edge_ok,
@@ -386,7 +387,7 @@ if AVAILABLE:
             elif prod < 0:
                 _push(out_t, out_b, cnt, _root(res, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
 
-    @njit(cache=True)
+    @internal
     def _sort_pairs(keys, values, n):
         """The first ``n`` pairs ``(keys[k], values[k])`` sorted in place, by key, then by value (insertion sort: a
         pose has a few dozen candidates at most; ``values`` are never NaN)."""
@@ -645,7 +646,7 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
 
 if AVAILABLE:
 
-    @njit(cache=True)
+    @internal
     def _fk_one(a, alpha, d, theta, rev, base, q, out, k):
         """Flange pose of configuration ``q[k]`` of a modified-DH chain (world frame, tool not applied)."""
         n = a.shape[0]

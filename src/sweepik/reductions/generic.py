@@ -140,8 +140,15 @@ class GeometricReduction(Reduction):
             "parallel": (geometric.wrist_residual, geometric.parallel_configuration),
         }[plan.family]
         self.kernel = self._kernels
-        if not plan.closed_form:
-            self.twins = tuple(tuple(c) for c in _classes(self._probe(self._kernels[0], self.n_branches)) if len(c) > 1)
+
+    @cached_property
+    def twins(self) -> tuple[tuple[int, ...], ...]:  # type: ignore[override]
+        """Classes of branches with identical residuals (probed; none for a closed form). Found when first asked
+        for, not when the reduction is made: a closed form's fallback is made for every batch, and probing it
+        compiles the pair family's kernels (seconds on a fresh install) that only degenerate poses need."""
+        if self.plan.closed_form:
+            return ()
+        return tuple(tuple(c) for c in _classes(self._probe(self._kernels[0], self.n_branches)) if len(c) > 1)
 
     def _probe(self, fn: Any, count: int) -> Array:
         """``fn(params, theta*, k)`` for k < count at random poses and theta* values: ``(poses, samples, count)``."""

@@ -35,9 +35,11 @@ import math
 
 import numpy as np
 from numba import float64, int64, njit, types
+from numba.extending import register_jitable
 from numpy.typing import NDArray
 
 from .. import parallel
+from .._jit import internal
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
 from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, LazyKernel, first_class, lazy_njit
@@ -67,17 +69,19 @@ _T, _W, _O, _FREE = LAYOUT["t"], LAYOUT["W"], LAYOUT["O"], LAYOUT["free"]
 _CASE, _REVERSED, _POS_BRANCHES = LAYOUT["case"], LAYOUT["reversed"], LAYOUT["pos_branches"]
 
 
-@njit(cache=True)
+# Read with constant offsets all over the kernels: as jitable functions (typed for an int64 offset first), not
+# dispatchers, which Numba compiles once per literal offset (_h was compiled 7 times, _v 5 times).
+@register_jitable
 def _v(p, i):
     return (p[i], p[i + 1], p[i + 2])
 
 
-@njit(cache=True)
+@register_jitable
 def _h(p, i):
     return _v(p, _H + 3 * i)
 
 
-@njit(cache=True)
+@internal
 def _mat(p, v):
     """``M v`` for the target orientation ``M`` of the row."""
     m = _M
@@ -88,7 +92,7 @@ def _mat(p, v):
     )
 
 
-@njit(cache=True)
+@internal
 def _mat_t(p, v):
     """``M^T v``."""
     m = _M
@@ -99,7 +103,7 @@ def _mat_t(p, v):
     )
 
 
-@njit(cache=True)
+@internal
 def _arm(p, x, branch):
     """Motions ``(m0, m1, m2, m3)`` (``position.motion``) of the first four joints with joint ``free`` at ``x``,
     and the cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the position case's steps (``position.place``)."""
@@ -136,13 +140,13 @@ def _arm(p, x, branch):
     return ma, mb, mc, mx, c1, c2, a1, a2
 
 
-@njit(cache=True)
+@internal
 def _missing(m0, m1, m2, m3):
     """Some motion is NaN (an unknown case, dependent prismatic directions)."""
     return math.isnan(m0[0] + m0[2] + m1[0] + m1[2] + m2[0] + m2[2] + m3[0] + m3[2])
 
 
-@njit(cache=True)
+@internal
 def _back(p, m0, m1, m2, m3, v):
     """``R_04^T v = R_3^T R_2^T R_1^T R_0^T v``: ``v`` seen from frame 4 (joint 0's rotation undone first)."""
     ms = (m0, m1, m2, m3)
@@ -152,7 +156,7 @@ def _back(p, m0, m1, m2, m3, v):
     return v
 
 
-@njit(cache=True)
+@internal
 def _fore(p, m0, m1, m2, m3, v):
     """``R_04 v``."""
     ms = (m0, m1, m2, m3)
@@ -170,7 +174,7 @@ def _pair_residual(p, x, branch):
     return dot(_fore(p, m0, m1, m2, m3, h4), _mat(p, h5)) - dot(h4, h5)
 
 
-@njit(cache=True)
+@internal
 def _last_two(p, m0, m1, m2, m3, h4, h5):
     """Joints 5 and 6 (indices 4, 5) turning the tool onto the target, given the first four."""
     q4, _ = sp1(h5, _back(p, m0, m1, m2, m3, _mat(p, h5)), h4)
@@ -179,7 +183,7 @@ def _last_two(p, m0, m1, m2, m3, h4, h5):
     return q4, q5
 
 
-@njit(cache=True)
+@internal
 def _write(p, out, m0, m1, m2, m3, q4, q5):
     """The configuration in the robot's joint order (reversed for a reversed chain)."""
     qs = (
@@ -195,7 +199,7 @@ def _write(p, out, m0, m1, m2, m3, q4, q5):
         out[5 - i if rev else i] = qs[i]
 
 
-@njit(cache=True)
+@internal
 def _step(p, x, k):
     """Cosine and amplitude of the position case's first step (k = 0) or of its second step on the first step's
     branch k - 1 (k = 1, 2)."""
@@ -243,10 +247,10 @@ def _wrist_configuration(p, x, branch, out):
     e = orthogonal(h5)
     w = rot(h4, -q4, rot(h3, -q3, _back(p, m0, m1, m2, m3, _mat(p, e))))
     q5, _ = sp1(e, w, h5)
-    _write(p, out, m0, m1, m2, motion(True, q3), q4, q5)
+    _write(p, out, m0, m1, m2, (math.cos(q3), math.sin(q3), 0.0), q4, q5)  # (motion(True, q3))
 
 
-@njit(cache=True)
+@internal
 def _o3(p):
     """Joint 4's point (index 3) at the zero configuration."""
     o = _v(p, _P)
@@ -255,7 +259,7 @@ def _o3(p):
     return o
 
 
-@njit(cache=True)
+@internal
 def _parallel_g(p, m0, v):
     """``R_0^T M v``: the target orientation seen after joint 1."""
     w = _mat(p, v)
@@ -264,7 +268,7 @@ def _parallel_g(p, m0, v):
     return w
 
 
-@njit(cache=True)
+@internal
 def _parallel_first(p, branch):
     """The parallel family's first steps: motion of joint 1, ``(cos, sin)`` of joint 5, and cosines ``(c0, c4)``
     (``|c| <= 1`` inside the branch's domain; NaN: no such branch). Joint 5 moves ``W`` (joint 6's point) by
@@ -345,7 +349,7 @@ def _amplitude(p, x, k):
     return _step(p, x, k)[1]
 
 
-amplitude = LazyKernel(_amplitude.py_func, RESIDUAL_SIG, cache=True)  # for the engine; compiled code calls _amplitude
+amplitude = LazyKernel(_amplitude, RESIDUAL_SIG)  # for the engine: the overload compiled code (_swing_pose) calls
 
 #: Swing hints: up to this many local minima of each step's amplitude per pose, ...
 SWING_MINIMA = 4
@@ -362,7 +366,7 @@ SWING_DEPTH = 2.0
 SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
-@njit(cache=True)
+@internal
 def _swing_pose(params, lo, hi, n, periodic, ks, out, i):
     """Swing hints of pose i (``swing_hints``)."""
     g = (math.sqrt(5.0) - 1.0) / 2.0

@@ -39,6 +39,7 @@ import math
 
 from numba import njit
 
+from .._jit import internal
 from ..subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
 from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
@@ -67,7 +68,7 @@ def motion(rev, x):
     return 1.0, 0.0, x
 
 
-@njit(cache=True)
+@internal
 def angle(rev, m):
     """The joint value of motion ``m`` (radians or travel)."""
     if rev:
@@ -75,17 +76,17 @@ def angle(rev, m):
     return m[2]
 
 
-@njit(cache=True)
+@internal
 def _rev(c, s):
     return c, s, 0.0
 
 
-@njit(cache=True)
+@internal
 def _pris(t):
     return 1.0, 0.0, t
 
 
-@njit(cache=True)
+@internal
 def move(h, rev, m, v):
     """``T(v)``: ``v`` rotated about ``h`` (revolute) or translated along it (prismatic) by motion ``m``."""
     if rev:
@@ -93,7 +94,7 @@ def move(h, rev, m, v):
     return add(v, scale(m[2], h))
 
 
-@njit(cache=True)
+@internal
 def move_back(h, rev, m, v):
     """The inverse of ``move``."""
     if rev:
@@ -101,7 +102,7 @@ def move_back(h, rev, m, v):
     return sub(v, scale(m[2], h))
 
 
-@njit(cache=True)
+@internal
 def _turn(h, rev, m, v):
     """The rotation part of ``move`` (directions)."""
     if rev:
@@ -136,7 +137,7 @@ def reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, t):
     return tp, h0, h1, h2, s1, s2, add(s3, move(h3, r3, x, s4))
 
 
-@njit(cache=True)
+@internal
 def _line_cos(disc, d):
     """A line-sphere discriminant as the cosine of a circle subproblem (|c| <= 1 inside the domain)."""
     if d > 0.0:
@@ -144,7 +145,7 @@ def _line_cos(disc, d):
     return 0.0 if disc >= 0.0 else math.inf
 
 
-@njit(cache=True)
+@internal
 def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Motions ``(ma, mb, mc)`` (see ``motion``) of ``branch`` putting ``W`` at ``tp``, the cosines ``(c1, c2)`` of
     its two-solution steps (0 for a one-solution step): ``|c| <= 1`` inside the branch's domain, and their
@@ -170,7 +171,8 @@ def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         w = add(pbc, move(hc, rc, mc, pcw))
         ua, va, ub, vb, c2, r2 = sp3_cs(w, scale(-1.0, pab), hb, norm(tp))
         mb = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-        ca, sa = sp1_cs(add(pab, move(hb, True, mb, w)), tp, ha)
+        # (rot_cs for move(hb, True, ...): a constant True would have move compiled once more, for its literal type)
+        ca, sa = sp1_cs(add(pab, rot_cs(hb, mb[0], mb[1], w)), tp, ha)
         return _rev(ca, sa), mb, mc, c1, c2, r1, r2
     if case == 1:  # bc_par: the height along h_b does not depend on qb, qc
         height = dot(hb, add(add(pab, pbc), pcw))
@@ -183,7 +185,7 @@ def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         target = sub(move_back(ha, ra, ma, tp), pab)
         ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, pbc), hc, norm(target))
         mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-        cb, sb = sp1_cs(add(pbc, move(hc, True, mc, pcw)), target, hb)
+        cb, sb = sp1_cs(add(pbc, rot_cs(hc, mc[0], mc[1], pcw)), target, hb)
         return ma, _rev(cb, sb), mc, c1, c2, r1, r2
     if case == 2:  # ab_int: |W - O| depends on qc only
         base = add(sub(pab, o), pbc)
@@ -227,14 +229,14 @@ def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         n = unit(n)
         ua, va, ub, vb, c2, r2 = sp4_cs(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
         mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-        qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), move(hc, True, mc, pcw)))
+        qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), rot_cs(hc, mc[0], mc[1], pcw)))
         return _pris(qa), _pris(qb), mc, c1, c2, r1, r2
     if case == 6:  # ac_par: the height along ha fixes the prismatic b
         qb = lp4(ha, add(add(pab, pbc), pcw), hb, dot(ha, tp))
         w = add(add(pab, scale(qb, hb)), pbc)
         ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, w), hc, norm(tp))
         mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-        ca, sa = sp1_cs(add(w, move(hc, True, mc, pcw)), tp, ha)
+        ca, sa = sp1_cs(add(w, rot_cs(hc, mc[0], mc[1], pcw)), tp, ha)
         return _rev(ca, sa), _pris(qb), mc, c1, c2, r1, r2
     nan = (math.nan, math.nan, math.nan)
     return nan, nan, nan, math.nan, math.nan, math.nan, math.nan
