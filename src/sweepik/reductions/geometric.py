@@ -199,21 +199,18 @@ def _write(p, out, m0, m1, m2, m3, q4, q5):
         out[5 - i if rev else i] = qs[i]
 
 
-@internal
-def _step(p, x, k):
-    """Cosine and amplitude of the position case's first step (k = 0) or of its second step on the first step's
-    branch k - 1 (k = 1, 2)."""
-    if k == 0:
-        arm = _arm(p, x, 0)
-        return arm[4], arm[6]
-    arm = _arm(p, x, 2 * (k - 1))
-    return arm[5], arm[7]
+# Steps of the position case: k = 0 is its first step, k = 1, 2 its second step on the first step's branch k - 1.
+# ``_arm(p, x, b)`` with ``b = 0`` for k = 0, else ``2 (k - 1)``, holds step k's cosine at index 4 (k = 0) or 5 and
+# its amplitude at 6 or 7. (The kernels below call _arm themselves rather than through a helper: each compiled level
+# re-optimises everything it calls.)
 
 
 def _pair_margin(p, x, k):
-    """``1 - c^2`` of step k (``_step``): positive inside the branch domains, zero at their edges (found by the
-    same sweep, and sampled as hints)."""
-    c = _step(p, x, k)[0]
+    """``1 - c^2`` of step k's cosine c: positive inside the branch domains, zero at their edges (found by the same
+    sweep, and sampled as hints)."""
+    b = 0 if k == 0 else 2 * (k - 1)  # (one call: a constant branch would compile _arm and place once more)
+    arm = _arm(p, x, b)
+    c = arm[4] if k == 0 else arm[5]
     return 1.0 - c * c
 
 
@@ -343,13 +340,14 @@ pair_configuration = LazyKernel(_pair_configuration, CONFIGURATION_SIG, cache=Tr
 pair_margin = LazyKernel(_pair_margin, RESIDUAL_SIG, cache=True)
 
 
-@njit(cache=True)
 def _amplitude(p, x, k):
-    """Amplitude of step k (``_step``)."""
-    return _step(p, x, k)[1]
+    """Amplitude of step k (see ``_pair_margin``)."""
+    b = 0 if k == 0 else 2 * (k - 1)
+    arm = _arm(p, x, b)
+    return arm[6] if k == 0 else arm[7]
 
 
-amplitude = LazyKernel(_amplitude, RESIDUAL_SIG)  # for the engine: the overload compiled code (_swing_pose) calls
+amplitude = LazyKernel(_amplitude, RESIDUAL_SIG, cache=True)
 
 #: Swing hints: up to this many local minima of each step's amplitude per pose, ...
 SWING_MINIMA = 4
@@ -366,63 +364,60 @@ SWING_DEPTH = 2.0
 SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
-@internal
-def _swing_pose(params, lo, hi, n, periodic, ks, out, i):
-    """Swing hints of pose i (``swing_hints``)."""
-    g = (math.sqrt(5.0) - 1.0) / 2.0
-    p = params[i]
-    h = (hi[i] - lo[i]) / n
-    cnt = 0
-    for k in ks:
-        found = 0
-        xm, am = lo[i] - h, _amplitude(p, lo[i] - h, k)
-        x0, a0 = lo[i], _amplitude(p, lo[i], k)
-        for j in range(1, n + 2):
-            x1 = lo[i] + j * h
-            a1 = _amplitude(p, x1, k)
-            # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
-            # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
-            deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
-            if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
-                a, b = xm, x1
-                c, d = b - g * (b - a), a + g * (b - a)
-                fc, fd = _amplitude(p, c, k), _amplitude(p, d, k)
-                for _ in range(SWING_GOLDEN):
-                    # located well enough: the bracket is a small part of the window it centres
-                    fm = min(fc, fd)
-                    slope = max(abs(am - fm) / max(c - xm, 1e-300), abs(a1 - fm) / max(x1 - d, 1e-300))
-                    if b - a < SWING_LOCATE * fm / max(slope, 1e-300):
-                        break
-                    if fc < fd:
-                        b, d, fd = d, c, fc
-                        c = b - g * (b - a)
-                        fc = _amplitude(p, c, k)
-                    else:
-                        a, c, fc = c, d, fd
-                        d = a + g * (b - a)
-                        fd = _amplitude(p, d, k)
-                xs = 0.5 * (a + b)
-                rs = _amplitude(p, xs, k)
-                slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
-                if slope > 0.0 and rs < slope * h:
-                    w = rs / slope
-                    for m in range(SWING_SAMPLES + 1):
-                        t = xs
-                        if m > 0:
-                            t = xs + w * math.tan(math.pi * (m / (SWING_SAMPLES + 1.0) - 0.5))
-                        if periodic:
-                            t = lo[i] + (t - lo[i]) % (hi[i] - lo[i])
-                        if lo[i] <= t <= hi[i]:
-                            out[i, cnt] = t
-                            cnt += 1
-                    found += 1
-            xm, am, x0, a0 = x0, a0, x1, a1
-
-
 @njit(cache=True, nogil=True)
-def _swing(params, lo, hi, n, periodic, ks, out, start, stop):
+def _swing(amp, params, lo, hi, n, periodic, ks, out, start, stop):
+    """Swing hints of poses ``start .. stop - 1`` (``swing_hints``). ``amp``: ``amplitude`` as a first-class
+    function (called, not linked in: Numba re-optimises everything a compiled function links, and the amplitude
+    links the whole position case); one function rather than a loop calling a per-pose one, for the same reason."""
     for i in range(start, stop):
-        _swing_pose(params, lo, hi, n, periodic, ks, out, i)
+        g = (math.sqrt(5.0) - 1.0) / 2.0
+        p = params[i]
+        h = (hi[i] - lo[i]) / n
+        cnt = 0
+        for k in ks:
+            found = 0
+            xm, am = lo[i] - h, amp(p, lo[i] - h, k)
+            x0, a0 = lo[i], amp(p, lo[i], k)
+            for j in range(1, n + 2):
+                x1 = lo[i] + j * h
+                a1 = amp(p, x1, k)
+                # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
+                # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
+                deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
+                if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
+                    a, b = xm, x1
+                    c, d = b - g * (b - a), a + g * (b - a)
+                    fc, fd = amp(p, c, k), amp(p, d, k)
+                    for _ in range(SWING_GOLDEN):
+                        # located well enough: the bracket is a small part of the window it centres
+                        fm = min(fc, fd)
+                        slope = max(abs(am - fm) / max(c - xm, 1e-300), abs(a1 - fm) / max(x1 - d, 1e-300))
+                        if b - a < SWING_LOCATE * fm / max(slope, 1e-300):
+                            break
+                        if fc < fd:
+                            b, d, fd = d, c, fc
+                            c = b - g * (b - a)
+                            fc = amp(p, c, k)
+                        else:
+                            a, c, fc = c, d, fd
+                            d = a + g * (b - a)
+                            fd = amp(p, d, k)
+                    xs = 0.5 * (a + b)
+                    rs = amp(p, xs, k)
+                    slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
+                    if slope > 0.0 and rs < slope * h:
+                        w = rs / slope
+                        for m in range(SWING_SAMPLES + 1):
+                            t = xs
+                            if m > 0:
+                                t = xs + w * math.tan(math.pi * (m / (SWING_SAMPLES + 1.0) - 0.5))
+                            if periodic:
+                                t = lo[i] + (t - lo[i]) % (hi[i] - lo[i])
+                            if lo[i] <= t <= hi[i]:
+                                out[i, cnt] = t
+                                cnt += 1
+                        found += 1
+                xm, am, x0, a0 = x0, a0, x1, a1
 
 
 def swing_hints(params, lo, hi, n, periodic, ks, out):
@@ -432,7 +427,7 @@ def swing_hints(params, lo, hi, n, periodic, ks, out):
     ``_amplitude``). Batches use both cores, as the engine's search."""
     from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
 
-    parallel.run(_swing, params.shape[0], PARALLEL_MIN, params, lo, hi, n, periodic, ks, out)
+    parallel.run(_swing, params.shape[0], PARALLEL_MIN, first_class(amplitude), params, lo, hi, n, periodic, ks, out)
 
 
 wrist_residual = LazyKernel(_no_residual, RESIDUAL_SIG, cache=True)
