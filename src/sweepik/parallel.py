@@ -30,8 +30,11 @@ _pool_lock = threading.Lock()
 
 def threads() -> int:
     """Threads a batch kernel may use in the calling thread (Numba's setting, see the module docstring)."""
-    import numba
-    from numba.np.ufunc import parallel
+    try:
+        import numba
+        from numba.np.ufunc import parallel
+    except ImportError:  # pragma: no cover - without numba nothing releases the GIL
+        return 1
 
     # numba.get_num_threads() starts Numba's own thread pool (~60 ms) to read a setting that only
     # numba.set_num_threads changes, and set_num_threads starts that pool itself
