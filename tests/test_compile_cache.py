@@ -17,7 +17,7 @@ from sweepik import fastsweep
 
 SCRIPT = """
 import numpy as np, sweepik
-for name, kw in (("ur5", {}), ("carm", {"reduction": "auto"}), ("fanuc_crx10ia", {}), ("carm", {})):
+for name, kw in (("ur5", {}), ("carm", {"reduction": "auto"}), ("fanuc_crx10ia", {}), ("carm", {}), ("puma560", {})):
     robot = sweepik.load_robot(name)
     sweepik.solve(robot, robot.fk(np.full(6, 0.3)), **kw)
     sweepik.solve_many(robot, robot.fk(np.full((70, 6), 0.3)), **kw)

@@ -195,6 +195,31 @@ def test_trig2_roots_double_root_and_degenerate():
     assert trig2_roots(1.0, 0.0, 0.0, 0.0, 0.0)[1] == 0
 
 
+def test_companion_roots_are_numba_np_roots():
+    """trig2_roots' eigenvalue step is Numba's np.roots without its general-purpose checks: the same companion matrix
+    and LAPACK call, so the same roots to the bit (quadratics and quartics, some with zero inner coefficients)."""
+    from numba import njit
+
+    from sweepik.subproblems.trig import _companion_roots
+
+    @njit
+    def ours(c):
+        return _companion_roots(c, c.shape[0])
+
+    @njit
+    def numba_roots(c):
+        return np.roots(c)
+
+    rng = np.random.default_rng(7)
+    for trial in range(2000):
+        c = rng.normal(size=5 if trial % 3 else 3) + 1j * rng.normal(size=5 if trial % 3 else 3)
+        if trial % 7 == 0:
+            c[1] = 0.0
+        if trial % 11 == 0:
+            c = np.round(c, 1) + (0.05 + 0.05j)  # (first and last coefficients stay nonzero)
+        assert ours(c).tobytes() == numba_roots(c).tobytes(), c
+
+
 def _sp6_data(rng):
     return [(rng.normal(size=3), _unit(rng), rng.normal(size=3)) for _ in range(4)]
 

@@ -14,6 +14,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from . import parallel
+from ._jit import internal
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
 from .reductions.kernels import first_class, lazy_njit
@@ -30,13 +32,13 @@ _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
 J_CUTOFF_FACTOR = 1e-4
 
 if AVAILABLE:
-    from numba import float64, int64, njit, prange, types
+    from numba import float64, int64, types
 
     from .reductions.kernels import CONFIGURATION_SIG
 
     _CFG = types.FunctionType(CONFIGURATION_SIG)
 
-    @njit(cache=True)
+    @internal
     def _poe_fk(H, P, rev, R_end, q):
         """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain as 12 scalars (rotation
         row by row, then position): scalar locals only, no array allocated (this runs once per candidate)."""
@@ -90,11 +92,11 @@ if AVAILABLE:
             pz,
         )
 
-    @njit(cache=True)
+    @internal
     def _wrap(x):
         return math.pi - ((math.pi - x) % (2.0 * math.pi))
 
-    @njit(cache=True)
+    @internal
     def _zyz(r00, r01, r02, r10, r11, r12, r20, r21, r22):
         """Z-Y-Z angles of a rotation given by its entries, as pose.zyz_from_matrix."""
         sb = math.hypot(r20, r21)
@@ -111,7 +113,7 @@ if AVAILABLE:
             gamma = math.atan2(ca * r10 - sa * r00, ca * r11 - sa * r01)
         return _wrap(alpha), beta, _wrap(gamma)
 
-    @njit(cache=True)
+    @internal
     def _errors(T, Td, weight):
         """(geodesic error, paper J) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``."""
         r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
@@ -141,15 +143,6 @@ if AVAILABLE:
         jo = math.sqrt(da * da + db * db + dg * dg)
         return geo, math.sqrt(dp * dp + (weight * jo) ** 2)
 
-    @njit(cache=True)
-    def _certify_one(cfg, params, world, theta, branch, H, P, rev, R_end, weight, q, i, k):
-        """Configuration of candidate k (pose i) into q[k]; returns (geodesic error, paper J)."""
-        cfg(params[i], theta[k], branch[k], q[k])
-        for j in range(q.shape[1]):
-            if not math.isfinite(q[k, j]):
-                return np.inf, np.inf
-        return _errors(_poe_fk(H, P, rev, R_end, q[k]), world[i], weight)
-
     _CERTIFY_SIG = (
         _CFG,
         float64[:, ::1],
@@ -165,21 +158,26 @@ if AVAILABLE:
         float64[:, ::1],
         float64[::1],
         float64[::1],
+        int64,
+        int64,
     )
 
-    @lazy_njit(_CERTIFY_SIG, cache=True, parallel=True)
-    def _certify_parallel(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper):
-        for k in prange(pose.shape[0]):
-            err_geo[k], err_paper[k] = _certify_one(
-                cfg, params, world, theta, branch, H, P, rev, R_end, weight, q, pose[k], k
-            )
-
-    @lazy_njit(_CERTIFY_SIG, cache=True)
-    def _certify_serial(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper):
-        for k in range(pose.shape[0]):
-            err_geo[k], err_paper[k] = _certify_one(
-                cfg, params, world, theta, branch, H, P, rev, R_end, weight, q, pose[k], k
-            )
+    @lazy_njit(_CERTIFY_SIG, cache=True, nogil=True)
+    def _certify(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper, start, stop):
+        """Candidates ``start .. stop - 1``: the configuration of candidate k (pose ``pose[k]``) into ``q[k]``, its
+        geodesic error and paper J (inf where the branch does not exist)."""
+        for k in range(start, stop):
+            i = pose[k]
+            cfg(params[i], theta[k], branch[k], q[k])
+            finite = True
+            for j in range(q.shape[1]):
+                if not math.isfinite(q[k, j]):
+                    finite = False
+                    break
+            if finite:
+                err_geo[k], err_paper[k] = _errors(_poe_fk(H, P, rev, R_end, q[k]), world[i], weight)
+            else:
+                err_geo[k], err_paper[k] = np.inf, np.inf
 
 
 def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, params: Array | None = None):
@@ -189,9 +187,11 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, 
     q = np.empty((K, robot.n_joints))
     eg = np.empty(K)
     ep = np.empty(K)
-    run = _certify_parallel if K >= 16 * PARALLEL_MIN else _certify_serial
     ch = robot.chain
-    run(
+    parallel.run(
+        _certify,
+        K,
+        16 * PARALLEL_MIN,
         first_class(red.kernel[1]),
         np.ascontiguousarray(red.kernel_params(chain) if params is None else params, dtype=np.float64),
         np.array(world, dtype=np.float64, order="C", copy=not world.flags.writeable or None),  # compiled: writable

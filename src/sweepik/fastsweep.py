@@ -2,7 +2,7 @@
 residual kernel. Same algorithm and constants as :mod:`sweepik.sweep` (the reference, used for every other
 reduction): per pose and branch, sample theta*, bracket sign changes (Chandrupatla), locate extrema, keep
 domain-edge samples, resample bending or edge-adjacent intervals recursively, detect families and merge
-noise-level clusters. Poses run in parallel threads (``prange``).
+noise-level clusters. Poses run in parallel threads (:mod:`sweepik.parallel`).
 
 Why: the NumPy engine spends most of its time in Python-level bookkeeping of small arrays; per pose the
 search is a few hundred scalar residual evaluations, which compiled code does in microseconds.
@@ -24,12 +24,14 @@ import os
 import numpy as np
 from numpy.typing import NDArray
 
+from . import parallel
 from . import sweep as _ref
+from ._jit import internal
 from .reductions.kernels import first_class, lazy_njit
 from .robot import Robot
 
 try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
-    from numba import njit, prange
+    from numba import njit
 
     #: The compiled kernels are used; set SWEEPIK_DISABLE_NUMBA=1 to run the NumPy reference engine.
     AVAILABLE = not os.environ.get("SWEEPIK_DISABLE_NUMBA")
@@ -71,7 +73,7 @@ _U_EDGE = _ref._U_EDGE
 
 if AVAILABLE:
 
-    @njit(cache=True)
+    @internal
     def _root(res, p, b, a, c, fa, fc, xtol):
         """Chandrupatla's bracketed root finder (scalar), as rootfind.find_roots."""
         eps = 2.220446049250313e-16
@@ -117,12 +119,12 @@ if AVAILABLE:
             t = min(max(t, tlim), 1.0 - tlim)
         return x
 
-    @njit(cache=True)
+    @internal
     def _small(res, p, x, b, noise):
         f = res(p, x, b)
         return (not math.isnan(f)) and abs(f) <= noise
 
-    @njit(cache=True)
+    @internal
     def _center_flat(res, p, x, b, noise, span):
         """As sweep._Search._center_flat, for one root: (centre, lo, hi, is a family)."""
         d0 = FLAT_PROBE_REL * span
@@ -138,7 +140,7 @@ if AVAILABLE:
         family = open0 and open1 and hi - lo > CLUSTER_FAMILY_REL * span
         return 0.5 * (lo + hi), lo, hi, family
 
-    @njit(cache=True)
+    @internal
     def _flat_grow(res, p, x, b, noise, d0, limit, sgn):
         """(inner, outer): the residual is within the noise at x + sgn inner, not at x + sgn outer (doubling)."""
         inner, outer = 0.0, d0
@@ -152,7 +154,7 @@ if AVAILABLE:
                     break
         return inner, outer
 
-    @njit(cache=True)
+    @internal
     def _flat_end(res, p, x, b, noise, inner, outer, limit, sgn, short):
         """(reach, the stretch ends openly) on one side, as in sweep._Search._center_flat."""
         at_limit = inner >= limit
@@ -168,7 +170,7 @@ if AVAILABLE:
         far = abs(res(p, x + 2.0 * sgn * outer, b))
         return inner, at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise
 
-    @njit(cache=True)
+    @internal
     def _multiplicity(res, p, x, b, noise, span):
         """As sweep._Search._multiplicity, for one root."""
         level = MULT_LEVEL * noise
@@ -190,7 +192,7 @@ if AVAILABLE:
         m = total / count if count > 0 else 1.0
         return int(min(max(round(m), 1), MULT_MAX))
 
-    @njit(cache=True)
+    @internal
     def _extend(res, p, b, inside, outside):
         for _ in range(FAMILY_BISECT):
             mid = 0.5 * (inside + outside)
@@ -201,14 +203,14 @@ if AVAILABLE:
                 outside = mid
         return inside
 
-    @njit(cache=True)
+    @internal
     def _push(out_t, out_b, cnt, x, b):
         if cnt[0] < out_t.shape[0]:
             out_t[cnt[0]] = x
             out_b[cnt[0]] = b
         cnt[0] += 1
 
-    @njit(cache=True)
+    @internal
     def _extremum(res, p, b, ta, tc, tb, fa, fc, fb, span, noise, xtol, out_t, out_b, cnt):
         xe = tc
         lo, hi = ta, tb
@@ -237,11 +239,11 @@ if AVAILABLE:
         elif abs(fx) <= FAR_NOISE * noise:
             _push(out_t, out_b, cnt, xe, b)
 
-    @njit(cache=True)
+    @internal
     def _g(res, p, x, b, h):
         return res(p, x + h, b) - res(p, x - h, b)
 
-    @njit(cache=True)
+    @internal
     def _root_diff(res, p, b, a, c, ga, gc, h):
         """Root of the central difference between a and c (Illinois-safeguarded bisection)."""
         xtol = 1e-3 * h
@@ -271,7 +273,7 @@ if AVAILABLE:
                 side = 1
         return x
 
-    @njit(cache=True)
+    @internal
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
         wv, wx, wdd, res_all, n_all, edge_f, edge_ok,
@@ -314,7 +316,8 @@ if AVAILABLE:
         for j in range(M):
             x[j] = th[j] if math.isnan(xe) else math.sqrt(abs(th[j] - xe))
         dd = wdd[:M]
-        dd[:] = np.nan
+        for j in range(M):
+            dd[j] = np.nan
         for j in range(1, M - 1):
             if valid[j - 1] and valid[j] and valid[j + 1]:
                 hl = x[j] - x[j - 1]
@@ -384,39 +387,94 @@ if AVAILABLE:
             elif prod < 0:
                 _push(out_t, out_b, cnt, _root(res, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
 
+    @internal
+    def _sort_pairs(keys, values, n):
+        """The first ``n`` pairs ``(keys[k], values[k])`` sorted in place, by key, then by value (insertion sort: a
+        pose has a few dozen candidates at most; ``values`` are never NaN)."""
+        for a in range(1, n):
+            kk, vv = keys[a], values[a]
+            m = a - 1
+            while m >= 0 and (keys[m] > kk or (keys[m] == kk and values[m] > vv)):
+                keys[m + 1] = keys[m]
+                values[m + 1] = values[m]
+                m -= 1
+            keys[m + 1] = kk
+            values[m + 1] = vv
+
     _U_UNIFORM_ARR = _U_UNIFORM.copy()
     _U_EDGE_ARR = _U_EDGE.copy()
 
-    @njit(cache=True)
-    def _search_pose(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i):
-        """Pose ``i``. ``res_all``: every branch's residual at once (``Reduction.kernel_residuals``), used for the
-        uniform samples when ``n_all`` (the number of branches it fills) is not 0."""
+    from numba import float64, int64, types
+
+    from .reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG
+
+    #: The engine's entry signature: the residual is a first-class function, so the engine is compiled once
+    #: (and cached) for every reduction.
+    _SEARCH_SIG = (
+        types.FunctionType(RESIDUAL_SIG),
+        types.FunctionType(RESIDUALS_SIG),
+        int64,
+        float64[:, ::1],
+        float64[:, ::1],
+        int64[::1],
+        float64[::1],
+        float64,
+        float64[:, ::1],
+        int64[:, ::1],
+        int64[:, ::1],
+        int64[::1],
+        float64[:, :, ::1],
+        int64[::1],
+        int64,
+        int64,
+    )
+
+    @lazy_njit(_SEARCH_SIG, cache=True, nogil=True)
+    def _search(
+        res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, start, stop
+    ):
+        """Poses ``start .. stop - 1`` (threads run parts of a batch side by side: :mod:`sweepik.parallel`).
+        ``res_all``: every branch's residual at once (``Reduction.kernel_residuals``), used for the uniform samples
+        when ``n_all`` (the number of branches it fills) is not 0.
+
+        One function, not a loop calling a function per pose: Numba re-optimises everything a compiled function calls
+        when it compiles the caller, and each level costs seconds on a fresh install."""
         M = grid.shape[1]
-        if True:
+        # work arrays, shared by the poses (each pose sets what it reads). Explicit loops rather than np.zeros,
+        # np.full, slice copies or np.argsort: each of those adds to the first compilation (docs/performance.md)
+        c = np.empty(1, dtype=np.int64)
+        stk_t = np.empty((STACK, SUB + 2))
+        stk_f = np.empty((STACK, SUB + 2))
+        stk_i = np.empty((STACK, 3), dtype=np.int64)
+        stk_c = np.empty((STACK, 5))
+        no_ctx = np.empty(4)
+        for k in range(4):
+            no_ctx[k] = np.nan
+        W = M if M > SUB + 2 else SUB + 2
+        wv = np.empty(W, dtype=np.bool_)
+        wx = np.empty(W)
+        wdd = np.empty(W)
+        buf_t = np.empty(SUB + 2)
+        buf_f = np.empty(SUB + 2)
+        buf_c = np.empty(4)
+        nb_all = n_all if n_all > 1 else 1
+        f_all = np.empty((M, nb_all))
+        edge_f = np.empty((M, SUB + 1, nb_all))  # all-branch sub-samples of edge intervals (level 0)
+        edge_ok = np.empty(M, dtype=np.bool_)
+        f = np.empty(M)
+        top = np.empty(1, dtype=np.int64)
+        for i in range(start, stop):
             p = params[i]
             th = grid[i]
             xtol = XTOL_REL * span[i]
-            c = np.zeros(1, dtype=np.int64)
-            stk_t = np.empty((STACK, SUB + 2))
-            stk_f = np.empty((STACK, SUB + 2))
-            stk_i = np.empty((STACK, 3), dtype=np.int64)
-            stk_c = np.empty((STACK, 5))
-            no_ctx = np.full(4, np.nan)
-            wv = np.empty(max(M, SUB + 2), dtype=np.bool_)
-            wx = np.empty(max(M, SUB + 2))
-            wdd = np.empty(max(M, SUB + 2))
-            buf_t = np.empty(SUB + 2)
-            buf_f = np.empty(SUB + 2)
-            buf_c = np.empty(4)
-            f_all = np.empty((M, max(n_all, 1)))
-            edge_f = np.empty((M, SUB + 1, max(n_all, 1)))  # all-branch sub-samples of edge intervals (level 0)
-            edge_ok = np.zeros(M, dtype=np.bool_)
+            c[0] = 0
+            for j in range(M):
+                edge_ok[j] = False
             if n_all > 0:
                 for j in range(M):
                     res_all(p, th[j], f_all[j])
             for bi in range(branches.shape[0]):
                 b = branches[bi]
-                f = np.empty(M)
                 if n_all > 0:
                     for j in range(M):
                         f[j] = f_all[j, b]
@@ -447,9 +505,13 @@ if AVAILABLE:
                         j = k + 1
                     else:
                         j += 1
-                top = np.zeros(1, dtype=np.int64)
+                top[0] = 0
                 # the sequence itself, then the resampled intervals it (and they) push on the stack
-                seq_t, seq_f, level, el, er, ctx, xe = th, f, 0, False, False, no_ctx, np.nan
+                # level 0, not open at either end: read from ``top`` rather than written as constants (Numba would
+                # compile _scan once more for the literal types of 0 and False)
+                level = top[0]
+                el = er = level > 0
+                seq_t, seq_f, ctx, xe = th, f, no_ctx, np.nan
                 while True:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
                           c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd, res_all, n_all, edge_f, edge_ok)  # fmt: skip
@@ -457,9 +519,11 @@ if AVAILABLE:
                         break
                     top[0] -= 1
                     k0 = top[0]
-                    buf_t[:] = stk_t[k0]  # copied: the scan pushes its own intervals from k0 on
-                    buf_f[:] = stk_f[k0]
-                    buf_c[:] = stk_c[k0, :4]
+                    for k in range(SUB + 2):  # copied: the scan pushes its own intervals from k0 on
+                        buf_t[k] = stk_t[k0, k]
+                        buf_f[k] = stk_f[k0, k]
+                    for k in range(4):
+                        buf_c[k] = stk_c[k0, k]
                     seq_t, seq_f, ctx, xe = buf_t, buf_f, buf_c, stk_c[k0, 4]
                     level, el, er = stk_i[k0, 0], stk_i[k0, 1] == 1, stk_i[k0, 2] == 1
             cnt[i] = c[0]
@@ -483,13 +547,10 @@ if AVAILABLE:
             # merge noise-level clusters per branch (candidates sorted by branch, then theta)
             n = min(c[0], out_t.shape[1])
             if n > 1:
-                order = np.argsort(out_t[i, :n])
-                ts = out_t[i, :n][order]
-                bs = out_b[i, :n][order]
-                order2 = np.argsort(bs, kind="mergesort")  # stable: by branch, then theta
-                ts = ts[order2]
-                bs = bs[order2]
-                w = 0
+                ts = out_t[i]
+                bs = out_b[i]
+                _sort_pairs(bs, ts, n)
+                w = 0  # (written in place: w <= s, and only entries from s on are read after a write)
                 s = 0
                 while s < n:
                     e = s
@@ -506,43 +567,6 @@ if AVAILABLE:
                 cnt[i] = w if c[0] <= out_t.shape[1] else c[0]
             for k in range(min(cnt[i], out_t.shape[1])):
                 out_m[i, k] = _multiplicity(res, p, out_t[i, k], out_b[i, k], noise, span[i])
-
-    from numba import float64, int64, types
-
-    from .reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG
-
-    #: The engine's entry signature: the residual is a first-class function, so the engine is compiled once
-    #: (and cached) for every reduction.
-    _SEARCH_SIG = (
-        types.FunctionType(RESIDUAL_SIG),
-        types.FunctionType(RESIDUALS_SIG),
-        int64,
-        float64[:, ::1],
-        float64[:, ::1],
-        int64[::1],
-        float64[::1],
-        float64,
-        float64[:, ::1],
-        int64[:, ::1],
-        int64[:, ::1],
-        int64[::1],
-        float64[:, :, ::1],
-        int64[::1],
-    )
-
-    @lazy_njit(_SEARCH_SIG, cache=True, parallel=True)
-    def _search_parallel(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
-        for i in prange(grid.shape[0]):
-            _search_pose(
-                res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i
-            )
-
-    @lazy_njit(_SEARCH_SIG, cache=True)
-    def _search_serial(res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt):
-        for i in range(grid.shape[0]):
-            _search_pose(
-                res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, i
-            )
 
     @lazy_njit(RESIDUALS_SIG, cache=True)
     def _no_residuals(params, theta, out):  # pragma: no cover - never called (n_all = 0)
@@ -571,10 +595,12 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
     fam = np.empty((N, MAX_FAM, 3))
     fcnt = np.zeros(N, dtype=np.int64)
     span = (hi - lo).astype(np.float64)
-    # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
-    run = _search_parallel if N >= PARALLEL_MIN else _search_serial
     res_all = _kernel_residuals(reduction)
-    run(
+    # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
+    parallel.run(
+        _search,
+        N,
+        PARALLEL_MIN,
         first_class(reduction.kernel[0]),
         first_class(_no_residuals if res_all is None else res_all),
         0 if res_all is None else reduction.n_branches,
@@ -620,39 +646,39 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
 
 if AVAILABLE:
 
-    @njit(cache=True)
-    def _fk_one(a, alpha, d, theta, rev, base, q, out, k):
-        """Flange pose of configuration ``q[k]`` of a modified-DH chain (world frame, tool not applied)."""
+    @njit(cache=True, nogil=True)
+    def _fk(a, alpha, d, theta, rev, base, q, out, start, stop):
+        """Flange poses ``out[k]`` of configurations ``q[k]``, k = ``start .. stop - 1``, of a modified-DH chain
+        (world frame, tool not applied). Element by element: slice assignments compile their shape checks and
+        error messages (seconds on a fresh install)."""
         n = a.shape[0]
-        T = base.copy()
+        T = np.empty((4, 4))
         R = np.empty((3, 4))
-        for i in range(n):
-            th = theta[i] + (q[k, i] if rev[i] else 0.0)
-            di = d[i] + (0.0 if rev[i] else q[k, i])
-            ct, st = math.cos(th), math.sin(th)
-            ca, sa = math.cos(alpha[i]), math.sin(alpha[i])
-            # link = [[ct, -st, 0, a], [st ca, ct ca, -sa, -sa d], [st sa, ct sa, ca, ca d], [0, 0, 0, 1]]
-            l00, l01, l02, l03 = ct, -st, 0.0, a[i]
-            l10, l11, l12, l13 = st * ca, ct * ca, -sa, -sa * di
-            l20, l21, l22, l23 = st * sa, ct * sa, ca, ca * di
-            for r in range(3):
-                t0, t1, t2 = T[r, 0], T[r, 1], T[r, 2]
-                R[r, 0] = t0 * l00 + t1 * l10 + t2 * l20
-                R[r, 1] = t0 * l01 + t1 * l11 + t2 * l21
-                R[r, 2] = t0 * l02 + t1 * l12 + t2 * l22
-                R[r, 3] = t0 * l03 + t1 * l13 + t2 * l23 + T[r, 3]
-            T[:3, :] = R
-        out[k] = T
-
-    @njit(cache=True, parallel=True)
-    def _fk_parallel(a, alpha, d, theta, rev, base, q, out):
-        for k in prange(q.shape[0]):
-            _fk_one(a, alpha, d, theta, rev, base, q, out, k)
-
-    @njit(cache=True)
-    def _fk_serial(a, alpha, d, theta, rev, base, q, out):
-        for k in range(q.shape[0]):
-            _fk_one(a, alpha, d, theta, rev, base, q, out, k)
+        for k in range(start, stop):
+            for r in range(4):
+                for c in range(4):
+                    T[r, c] = base[r, c]
+            for i in range(n):
+                th = theta[i] + (q[k, i] if rev[i] else 0.0)
+                di = d[i] + (0.0 if rev[i] else q[k, i])
+                ct, st = math.cos(th), math.sin(th)
+                ca, sa = math.cos(alpha[i]), math.sin(alpha[i])
+                # link = [[ct, -st, 0, a], [st ca, ct ca, -sa, -sa d], [st sa, ct sa, ca, ca d], [0, 0, 0, 1]]
+                l00, l01, l02, l03 = ct, -st, 0.0, a[i]
+                l10, l11, l12, l13 = st * ca, ct * ca, -sa, -sa * di
+                l20, l21, l22, l23 = st * sa, ct * sa, ca, ca * di
+                for r in range(3):
+                    t0, t1, t2 = T[r, 0], T[r, 1], T[r, 2]
+                    R[r, 0] = t0 * l00 + t1 * l10 + t2 * l20
+                    R[r, 1] = t0 * l01 + t1 * l11 + t2 * l21
+                    R[r, 2] = t0 * l02 + t1 * l12 + t2 * l22
+                    R[r, 3] = t0 * l03 + t1 * l13 + t2 * l23 + T[r, 3]
+                for r in range(3):
+                    for c in range(4):
+                        T[r, c] = R[r, c]
+            for r in range(4):
+                for c in range(4):
+                    out[k, r, c] = T[r, c]
 
 
 def flange_poses(robot: Robot, q: Array) -> Array:
@@ -663,8 +689,10 @@ def flange_poses(robot: Robot, q: Array) -> Array:
     if not AVAILABLE or robot.dh_convention != "modified" or q.ndim != 2:
         return kinematics.chain_frames(robot, q)[..., -1, :, :]
     out = np.empty((q.shape[0], 4, 4))
-    run = _fk_parallel if q.shape[0] >= PARALLEL_MIN * 16 else _fk_serial
-    run(
+    parallel.run(
+        _fk,
+        q.shape[0],
+        PARALLEL_MIN * 16,
         robot.dh_a,
         robot.dh_alpha,
         robot.dh_d,

@@ -134,14 +134,31 @@ class GeometricReduction(Reduction):
         # the wrist centre in the tool frame (the last joints do not move it)
         p_end = chain.P.sum(axis=0)
         self._w_tool = chain.R_end.T @ (np.asarray(plan.W) - p_end)
-        self._kernels = {
-            "pair": (geometric.pair_residual, geometric.pair_configuration),
-            "wrist": (geometric.wrist_residual, geometric.wrist_configuration),
-            "parallel": (geometric.wrist_residual, geometric.parallel_configuration),
-        }[plan.family]
+        # the pair and wrist families' kernels are made for the arm's position case (geometric.case_kernels)
+        self._case = None if plan.family == "parallel" else geometric.case_kernels(int(row[L["case"]]))
+        if plan.family == "parallel":
+            self._kernels = (geometric.wrist_residual, geometric.parallel_configuration)
+        elif plan.family == "pair":
+            self._kernels = (self._case_kernels.pair_residual, self._case_kernels.pair_configuration)
+        else:
+            assert plan.family == "wrist", plan.family
+            self._kernels = (geometric.wrist_residual, self._case_kernels.wrist_configuration)
         self.kernel = self._kernels
-        if not plan.closed_form:
-            self.twins = tuple(tuple(c) for c in _classes(self._probe(self._kernels[0], self.n_branches)) if len(c) > 1)
+
+    @cached_property
+    def twins(self) -> tuple[tuple[int, ...], ...]:  # type: ignore[override]
+        """Classes of branches with identical residuals (probed; none for a closed form). Found when first asked
+        for, not when the reduction is made: a closed form's fallback is made for every batch, and probing it
+        compiles the pair family's kernels (seconds on a fresh install) that only degenerate poses need."""
+        if self.plan.closed_form:
+            return ()
+        return tuple(tuple(c) for c in _classes(self._probe(self._kernels[0], self.n_branches)) if len(c) > 1)
+
+    @property
+    def _case_kernels(self) -> geometric.CaseKernels:
+        """The kernels of the arm's position case (the pair and wrist families)."""
+        assert self._case is not None, "the parallel family has no position case"
+        return self._case
 
     def _probe(self, fn: Any, count: int) -> Array:
         """``fn(params, theta*, k)`` for k < count at random poses and theta* values: ``(poses, samples, count)``."""
@@ -165,11 +182,12 @@ class GeometricReduction(Reduction):
 
     @cached_property
     def _steps(self) -> tuple[list[int], list[int]]:
-        """The margins and the amplitudes (``geometric.pair_margin``, ``_amplitude``: k = 0, 1, 2) worth sweeping:
+        """The margins and the amplitudes (``pair_margin``, ``amplitude`` of ``geometric.case_kernels``: k = 0, 1, 2)
+        worth sweeping:
         not constant (a step with one solution, or a circle that always meets its plane) and not the twin of an
         earlier one."""
-        m = self._probe(geometric.pair_margin, 3)
-        a = self._probe(geometric.amplitude, 3)
+        m = self._probe(self._case_kernels.pair_margin, 3)
+        a = self._probe(self._case_kernels.amplitude, 3)
         margins = [c[0] for c in _classes(m) if not np.all(m[..., c[0]] == 1.0)]
         amplitudes = [c[0] for c in _classes(a) if not np.all(np.isinf(a[..., c[0]]))]
         return margins, amplitudes
@@ -202,7 +220,7 @@ class GeometricReduction(Reduction):
         if not self.plan.closed_form or poses.shape[0] == 0:
             return None
         out = np.zeros(poses.shape[0], dtype=np.bool_)
-        singular = geometric.parallel_singular if self.plan.family == "parallel" else geometric.wrist_singular
+        singular = geometric.parallel_singular if self.plan.family == "parallel" else self._case_kernels.wrist_singular
         singular(self.kernel_params(poses), out)
         return out
 
@@ -235,9 +253,10 @@ class GeometricReduction(Reduction):
     def sample_hints(self, poses: Array) -> Array | None:
         """Samples where the residual can change faster than the grid resolves: windows where a step's angle
         swings (``geometric.swing_hints``), and the theta* values where a branch's domain begins or ends, the
-        zeros of the steps' margins ``1 - c^2`` (``geometric.pair_margin``), found by the same sweep as the
-        residual's zeros (with the swing windows as samples). A root at or next to a domain edge is bracketed only
-        if the edge is a sample; a domain narrower than the grid step is found as a pair of close margin zeros."""
+        zeros of the steps' margins ``1 - c^2`` (``pair_margin`` of ``geometric.case_kernels``), found by the same
+        sweep as the residual's zeros (with the swing windows as samples). A root at or next to a domain edge is
+        bracketed only if the edge is a sample; a domain narrower than the grid step is found as a pair of close
+        margin zeros."""
         if self.closed_form or poses.shape[0] == 0:
             return None
         from ..sweep import N_SAMPLES  # local: the engine imports the reductions
@@ -245,7 +264,9 @@ class GeometricReduction(Reduction):
         lo, hi = self._range(poses)
         swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
         ks = np.asarray(self._steps[1], dtype=np.int64)
-        geometric.swing_hints(self.kernel_params(poses), lo, hi, N_SAMPLES, self.periodic, ks, swings)
+        geometric.swing_hints(
+            self.kernel_params(poses), lo, hi, N_SAMPLES, self.periodic, ks, swings, self._case_kernels.amplitude
+        )
         keep = np.any(np.isfinite(swings), axis=0)
         swings = swings[:, keep]
         theta = np.concatenate([_Margins(self, swings).zeros(poses, lo, hi), swings], axis=1)
@@ -355,7 +376,7 @@ class _Margins(Reduction):
         super().__init__(red.robot, red.free_joint, 3)
         self.red = red
         self.swings = swings
-        self.kernel = (geometric.pair_margin, geometric.pair_configuration)
+        self.kernel = (red._case_kernels.pair_margin, red._case_kernels.pair_configuration)
 
     def sample_hints(self, poses: Array) -> Array | None:
         # where a step's angle swings, the next step's margin changes as fast: a domain there can be narrow
@@ -365,7 +386,7 @@ class _Margins(Reduction):
         return self.red.kernel_params(poses)
 
     def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
-        return self.red._evaluate(geometric.pair_margin, poses, theta, branch, self.n_branches)
+        return self.red._evaluate(self.red._case_kernels.pair_margin, poses, theta, branch, self.n_branches)
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         raise NotImplementedError("margins have no configurations")

@@ -32,11 +32,15 @@ the robot's order.
 from __future__ import annotations
 
 import math
+from typing import Any, NamedTuple
 
 import numpy as np
-from numba import float64, int64, njit, prange, types
+from numba import float64, int64, njit, types
+from numba.extending import register_jitable
 from numpy.typing import NDArray
 
+from .. import parallel
+from .._jit import internal
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
 from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, LazyKernel, first_class, lazy_njit
@@ -66,17 +70,19 @@ _T, _W, _O, _FREE = LAYOUT["t"], LAYOUT["W"], LAYOUT["O"], LAYOUT["free"]
 _CASE, _REVERSED, _POS_BRANCHES = LAYOUT["case"], LAYOUT["reversed"], LAYOUT["pos_branches"]
 
 
-@njit(cache=True)
+# Read with constant offsets all over the kernels: as jitable functions (typed for an int64 offset first), not
+# dispatchers, which Numba compiles once per literal offset (_h was compiled 7 times, _v 5 times).
+@register_jitable
 def _v(p, i):
     return (p[i], p[i + 1], p[i + 2])
 
 
-@njit(cache=True)
+@register_jitable
 def _h(p, i):
     return _v(p, _H + 3 * i)
 
 
-@njit(cache=True)
+@internal
 def _mat(p, v):
     """``M v`` for the target orientation ``M`` of the row."""
     m = _M
@@ -87,7 +93,7 @@ def _mat(p, v):
     )
 
 
-@njit(cache=True)
+@internal
 def _mat_t(p, v):
     """``M^T v``."""
     m = _M
@@ -98,10 +104,11 @@ def _mat_t(p, v):
     )
 
 
-@njit(cache=True)
-def _arm(p, x, branch):
+@internal
+def _arm(p, x, branch, case):
     """Motions ``(m0, m1, m2, m3)`` (``position.motion``) of the first four joints with joint ``free`` at ``x``,
-    and the cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the position case's steps (``position.place``)."""
+    and the cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the position case's steps (``position.place``).
+    ``case``: the position case, a constant of the kernel (see ``case_kernels``)."""
     h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
     r0, r1, r2, r3 = p[_REV] > 0.5, p[_REV + 1] > 0.5, p[_REV + 2] > 0.5, p[_REV + 3] > 0.5
     s0, s1, s2, s3 = _v(p, _P), _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
@@ -110,7 +117,6 @@ def _arm(p, x, branch):
     o3 = (o2[0] + s3[0], o2[1] + s3[1], o2[2] + s3[2])
     s4 = sub(_v(p, _W), o3)
     f = int(p[_FREE])
-    case = int(p[_CASE])
     rev = (r0, r1, r2, r3)
     mx = motion(rev[f], x)
     tp, ha, hb, hc, pab, pbc, pcw = reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, mx, _v(p, _T))
@@ -135,13 +141,13 @@ def _arm(p, x, branch):
     return ma, mb, mc, mx, c1, c2, a1, a2
 
 
-@njit(cache=True)
+@internal
 def _missing(m0, m1, m2, m3):
     """Some motion is NaN (an unknown case, dependent prismatic directions)."""
     return math.isnan(m0[0] + m0[2] + m1[0] + m1[2] + m2[0] + m2[2] + m3[0] + m3[2])
 
 
-@njit(cache=True)
+@internal
 def _back(p, m0, m1, m2, m3, v):
     """``R_04^T v = R_3^T R_2^T R_1^T R_0^T v``: ``v`` seen from frame 4 (joint 0's rotation undone first)."""
     ms = (m0, m1, m2, m3)
@@ -151,7 +157,7 @@ def _back(p, m0, m1, m2, m3, v):
     return v
 
 
-@njit(cache=True)
+@internal
 def _fore(p, m0, m1, m2, m3, v):
     """``R_04 v``."""
     ms = (m0, m1, m2, m3)
@@ -161,15 +167,7 @@ def _fore(p, m0, m1, m2, m3, v):
     return v
 
 
-def _pair_residual(p, x, branch):
-    m0, m1, m2, m3, c1, c2, _, _ = _arm(p, x, branch)
-    if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
-        return math.nan
-    h4, h5 = _h(p, 4), _h(p, 5)
-    return dot(_fore(p, m0, m1, m2, m3, h4), _mat(p, h5)) - dot(h4, h5)
-
-
-@njit(cache=True)
+@internal
 def _last_two(p, m0, m1, m2, m3, h4, h5):
     """Joints 5 and 6 (indices 4, 5) turning the tool onto the target, given the first four."""
     q4, _ = sp1(h5, _back(p, m0, m1, m2, m3, _mat(p, h5)), h4)
@@ -178,7 +176,7 @@ def _last_two(p, m0, m1, m2, m3, h4, h5):
     return q4, q5
 
 
-@njit(cache=True)
+@internal
 def _write(p, out, m0, m1, m2, m3, q4, q5):
     """The configuration in the robot's joint order (reversed for a reversed chain)."""
     qs = (
@@ -194,58 +192,13 @@ def _write(p, out, m0, m1, m2, m3, q4, q5):
         out[5 - i if rev else i] = qs[i]
 
 
-@njit(cache=True)
-def _step(p, x, k):
-    """Cosine and amplitude of the position case's first step (k = 0) or of its second step on the first step's
-    branch k - 1 (k = 1, 2)."""
-    if k == 0:
-        arm = _arm(p, x, 0)
-        return arm[4], arm[6]
-    arm = _arm(p, x, 2 * (k - 1))
-    return arm[5], arm[7]
+# Steps of the position case: k = 0 is its first step, k = 1, 2 its second step on the first step's branch k - 1.
+# ``_arm(p, x, b, case)`` with ``b = 0`` for k = 0, else ``2 (k - 1)``, holds step k's cosine at index 4 (k = 0) or 5
+# and its amplitude at 6 or 7. (The margin and amplitude kernels, ``case_kernels``, call _arm themselves rather than
+# through a helper: each compiled level re-optimises everything it calls.)
 
 
-def _pair_margin(p, x, k):
-    """``1 - c^2`` of step k (``_step``): positive inside the branch domains, zero at their edges (found by the
-    same sweep, and sampled as hints)."""
-    c = _step(p, x, k)[0]
-    return 1.0 - c * c
-
-
-def _pair_configuration(p, x, branch, out):
-    m0, m1, m2, m3, _, _, _, _ = _arm(p, x, branch)
-    if _missing(m0, m1, m2, m3):
-        for i in range(6):
-            out[i] = math.nan
-        return
-    q4, q5 = _last_two(p, m0, m1, m2, m3, _h(p, 4), _h(p, 5))
-    _write(p, out, m0, m1, m2, m3, q4, q5)
-
-
-def _wrist_configuration(p, x, branch, out):
-    nb = int(p[_POS_BRANCHES])
-    m0, m1, m2, m3, _, _, _, _ = _arm(p, 0.0, branch // 2)
-    if _missing(m0, m1, m2, m3) or branch >= 2 * nb:
-        for i in range(6):
-            out[i] = math.nan
-        return
-    h3, h4, h5 = _h(p, 3), _h(p, 4), _h(p, 5)
-    v = _back(p, m0, m1, m2, m3, _mat(p, h5))
-    t1a, t2a, t1b, t2b, c, _ = sp2(v, h5, h3, h4)
-    if math.isnan(c):  # joint 6's axis on joint 4's: a continuum (wrist singular); one member
-        q3 = 0.0
-        q4, _ = sp1(h5, v, h4)
-    elif branch % 2 == 0:
-        q3, q4 = -t1a, t2a
-    else:
-        q3, q4 = -t1b, t2b
-    e = orthogonal(h5)
-    w = rot(h4, -q4, rot(h3, -q3, _back(p, m0, m1, m2, m3, _mat(p, e))))
-    q5, _ = sp1(e, w, h5)
-    _write(p, out, m0, m1, m2, motion(True, q3), q4, q5)
-
-
-@njit(cache=True)
+@internal
 def _o3(p):
     """Joint 4's point (index 3) at the zero configuration."""
     o = _v(p, _P)
@@ -254,7 +207,7 @@ def _o3(p):
     return o
 
 
-@njit(cache=True)
+@internal
 def _parallel_g(p, m0, v):
     """``R_0^T M v``: the target orientation seen after joint 1."""
     w = _mat(p, v)
@@ -263,7 +216,7 @@ def _parallel_g(p, m0, v):
     return w
 
 
-@njit(cache=True)
+@internal
 def _parallel_first(p, branch):
     """The parallel family's first steps: motion of joint 1, ``(cos, sin)`` of joint 5, and cosines ``(c0, c4)``
     (``|c| <= 1`` inside the branch's domain; NaN: no such branch). Joint 5 moves ``W`` (joint 6's point) by
@@ -333,19 +286,6 @@ def _no_residual(p, x, branch):
     return 0.0
 
 
-pair_residual = LazyKernel(_pair_residual, RESIDUAL_SIG, cache=True)
-pair_configuration = LazyKernel(_pair_configuration, CONFIGURATION_SIG, cache=True)
-pair_margin = LazyKernel(_pair_margin, RESIDUAL_SIG, cache=True)
-
-
-@njit(cache=True)
-def _amplitude(p, x, k):
-    """Amplitude of step k (``_step``)."""
-    return _step(p, x, k)[1]
-
-
-amplitude = LazyKernel(_amplitude.py_func, RESIDUAL_SIG, cache=True)  # for the engine; compiled code calls _amplitude
-
 #: Swing hints: up to this many local minima of each step's amplitude per pose, ...
 SWING_MINIMA = 4
 #: ... each giving its centre and this many samples spread over the window where the angle swings
@@ -361,84 +301,74 @@ SWING_DEPTH = 2.0
 SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
-@njit(cache=True)
-def _swing_pose(params, lo, hi, n, periodic, ks, out, i):
-    """Swing hints of pose i (``swing_hints``)."""
-    g = (math.sqrt(5.0) - 1.0) / 2.0
-    p = params[i]
-    h = (hi[i] - lo[i]) / n
-    cnt = 0
-    for k in ks:
-        found = 0
-        xm, am = lo[i] - h, _amplitude(p, lo[i] - h, k)
-        x0, a0 = lo[i], _amplitude(p, lo[i], k)
-        for j in range(1, n + 2):
-            x1 = lo[i] + j * h
-            a1 = _amplitude(p, x1, k)
-            # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
-            # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
-            deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
-            if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
-                a, b = xm, x1
-                c, d = b - g * (b - a), a + g * (b - a)
-                fc, fd = _amplitude(p, c, k), _amplitude(p, d, k)
-                for _ in range(SWING_GOLDEN):
-                    # located well enough: the bracket is a small part of the window it centres
-                    fm = min(fc, fd)
-                    slope = max(abs(am - fm) / max(c - xm, 1e-300), abs(a1 - fm) / max(x1 - d, 1e-300))
-                    if b - a < SWING_LOCATE * fm / max(slope, 1e-300):
-                        break
-                    if fc < fd:
-                        b, d, fd = d, c, fc
-                        c = b - g * (b - a)
-                        fc = _amplitude(p, c, k)
-                    else:
-                        a, c, fc = c, d, fd
-                        d = a + g * (b - a)
-                        fd = _amplitude(p, d, k)
-                xs = 0.5 * (a + b)
-                rs = _amplitude(p, xs, k)
-                slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
-                if slope > 0.0 and rs < slope * h:
-                    w = rs / slope
-                    for m in range(SWING_SAMPLES + 1):
-                        t = xs
-                        if m > 0:
-                            t = xs + w * math.tan(math.pi * (m / (SWING_SAMPLES + 1.0) - 0.5))
-                        if periodic:
-                            t = lo[i] + (t - lo[i]) % (hi[i] - lo[i])
-                        if lo[i] <= t <= hi[i]:
-                            out[i, cnt] = t
-                            cnt += 1
-                    found += 1
-            xm, am, x0, a0 = x0, a0, x1, a1
+@njit(cache=True, nogil=True)
+def _swing(amp, params, lo, hi, n, periodic, ks, out, start, stop):
+    """Swing hints of poses ``start .. stop - 1`` (``swing_hints``). ``amp``: ``amplitude`` as a first-class
+    function (called, not linked in: Numba re-optimises everything a compiled function links, and the amplitude
+    links the whole position case); one function rather than a loop calling a per-pose one, for the same reason."""
+    for i in range(start, stop):
+        g = (math.sqrt(5.0) - 1.0) / 2.0
+        p = params[i]
+        h = (hi[i] - lo[i]) / n
+        cnt = 0
+        for k in ks:
+            found = 0
+            xm, am = lo[i] - h, amp(p, lo[i] - h, k)
+            x0, a0 = lo[i], amp(p, lo[i], k)
+            for j in range(1, n + 2):
+                x1 = lo[i] + j * h
+                a1 = amp(p, x1, k)
+                # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
+                # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
+                deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
+                if a0 <= am and a0 <= a1 and a0 < math.inf and deep and found < SWING_MINIMA:
+                    a, b = xm, x1
+                    c, d = b - g * (b - a), a + g * (b - a)
+                    fc, fd = amp(p, c, k), amp(p, d, k)
+                    for _ in range(SWING_GOLDEN):
+                        # located well enough: the bracket is a small part of the window it centres
+                        fm = min(fc, fd)
+                        slope = max(abs(am - fm) / max(c - xm, 1e-300), abs(a1 - fm) / max(x1 - d, 1e-300))
+                        if b - a < SWING_LOCATE * fm / max(slope, 1e-300):
+                            break
+                        if fc < fd:
+                            b, d, fd = d, c, fc
+                            c = b - g * (b - a)
+                            fc = amp(p, c, k)
+                        else:
+                            a, c, fc = c, d, fd
+                            d = a + g * (b - a)
+                            fd = amp(p, d, k)
+                    xs = 0.5 * (a + b)
+                    rs = amp(p, xs, k)
+                    slope = max(abs(am - rs) / max(xs - xm, 1e-300), abs(a1 - rs) / max(x1 - xs, 1e-300))
+                    if slope > 0.0 and rs < slope * h:
+                        w = rs / slope
+                        for m in range(SWING_SAMPLES + 1):
+                            t = xs
+                            if m > 0:
+                                t = xs + w * math.tan(math.pi * (m / (SWING_SAMPLES + 1.0) - 0.5))
+                            if periodic:
+                                t = lo[i] + (t - lo[i]) % (hi[i] - lo[i])
+                            if lo[i] <= t <= hi[i]:
+                                out[i, cnt] = t
+                                cnt += 1
+                        found += 1
+                xm, am, x0, a0 = x0, a0, x1, a1
 
 
-@njit(cache=True, parallel=True)
-def _swing_parallel(params, lo, hi, n, periodic, ks, out):
-    for i in prange(params.shape[0]):
-        _swing_pose(params, lo, hi, n, periodic, ks, out, i)
-
-
-@njit(cache=True)
-def _swing_serial(params, lo, hi, n, periodic, ks, out):
-    for i in range(params.shape[0]):
-        _swing_pose(params, lo, hi, n, periodic, ks, out, i)
-
-
-def swing_hints(params, lo, hi, n, periodic, ks, out):
+def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude):
     """Samples of theta* ``out (N, SWING_PER_POSE)`` (NaN-padded) where a step of the position case is nearly
     degenerate: around each local minimum ``r*`` of its amplitude ``r(theta*)`` narrower than the grid step
     ``h``, where its angles turn by up to pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
-    ``_amplitude``). Batches use both cores, as the engine's search."""
+    ``amplitude`` of ``case_kernels``: the arm's kernel, given as ``amplitude``). Batches use both cores, as
+    the engine's search."""
     from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
 
-    run = _swing_parallel if params.shape[0] >= PARALLEL_MIN else _swing_serial
-    run(params, lo, hi, n, periodic, ks, out)
+    parallel.run(_swing, params.shape[0], PARALLEL_MIN, first_class(amplitude), params, lo, hi, n, periodic, ks, out)
 
 
 wrist_residual = LazyKernel(_no_residual, RESIDUAL_SIG, cache=True)
-wrist_configuration = LazyKernel(_wrist_configuration, CONFIGURATION_SIG, cache=True)
 parallel_configuration = LazyKernel(_parallel_configuration, CONFIGURATION_SIG, cache=True)
 
 
@@ -492,22 +422,6 @@ WRIST_SINGULAR = 1e-6
 
 
 @njit(cache=True)
-def wrist_singular(params, out):
-    """``out[i]``: some exact position branch of the wrist family leaves pose i with a singular wrist."""
-    h3, h5 = _h(params[0], 3), _h(params[0], 5)
-    for i in range(params.shape[0]):
-        p = params[i]
-        out[i] = False
-        for b in range(int(p[_POS_BRANCHES])):
-            m0, m1, m2, m3, c1, c2, _, _ = _arm(p, 0.0, b)
-            if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
-                continue
-            v = _back(p, m0, m1, m2, m3, _mat(p, h5))
-            if norm(cross(v, h3)) < WRIST_SINGULAR:
-                out[i] = True
-
-
-@njit(cache=True)
 def parallel_singular(params, out):
     """``out[i]``: some exact branch of joint 1 leaves pose i with joint 6's axis along the parallel axes (joint 6
     and the sum of joints 2-4 then turn about one direction: a continuum)."""
@@ -523,3 +437,109 @@ def parallel_singular(params, out):
             # carries the square root of the rounding)
             if norm(cross(_parallel_g(p, m0, h5), h)) < WRIST_SINGULAR:
                 out[i] = True
+
+
+class CaseKernels(NamedTuple):
+    """The compiled kernels of the pair and wrist families for one position case (``position.CASES``): Python calls
+    ``wrist_singular(params, out)``; the others are :class:`~.kernels.LazyKernel` objects with the engine's
+    signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch)."""
+
+    pair_residual: Any
+    pair_configuration: Any
+    pair_margin: Any
+    amplitude: Any
+    wrist_configuration: Any
+    wrist_singular: Any
+
+
+_CASE_KERNELS: dict[int, CaseKernels] = {}
+
+
+def case_kernels(case: int) -> CaseKernels:
+    """The pair and wrist families' kernels for position case ``case`` (its index in ``position.CASES``; -1: none).
+
+    One set per case, each compiled on first use: the case is a constant of the kernels (a closure variable, which
+    Numba types as a literal), so an arm compiles the chain of subproblems of its own case only and not the
+    others' (``position.place``). Numba's disk cache keeps one entry per case (it keys a closure on its variables).
+    """
+    case = int(case)
+    ck = _CASE_KERNELS.get(case)
+    if ck is None:
+        # (the kernels' bodies are here, not in functions they call with the case: Numba re-optimises all that
+        # a compiled function calls, and a level more costs ~0.3 s per kernel on a fresh install)
+
+        def residual(p, x, branch):
+            m0, m1, m2, m3, c1, c2, _, _ = _arm(p, x, branch, case)
+            if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
+                return math.nan
+            h4, h5 = _h(p, 4), _h(p, 5)
+            return dot(_fore(p, m0, m1, m2, m3, h4), _mat(p, h5)) - dot(h4, h5)
+
+        def configuration(p, x, branch, out):
+            m0, m1, m2, m3, _, _, _, _ = _arm(p, x, branch, case)
+            if _missing(m0, m1, m2, m3):
+                for i in range(6):
+                    out[i] = math.nan
+                return
+            q4, q5 = _last_two(p, m0, m1, m2, m3, _h(p, 4), _h(p, 5))
+            _write(p, out, m0, m1, m2, m3, q4, q5)
+
+        def margin(p, x, k):
+            """``1 - c^2`` of step k's cosine c: positive inside the branch domains, zero at their edges (found by
+            the same sweep, and sampled as hints)."""
+            b = 0 if k == 0 else 2 * (k - 1)  # (one call: a constant branch would compile _arm and place once more)
+            arm = _arm(p, x, b, case)
+            c = arm[4] if k == 0 else arm[5]
+            return 1.0 - c * c
+
+        def amplitude(p, x, k):
+            """Amplitude of step k (see ``margin``)."""
+            b = 0 if k == 0 else 2 * (k - 1)
+            arm = _arm(p, x, b, case)
+            return arm[6] if k == 0 else arm[7]
+
+        def wrist(p, x, branch, out):
+            nb = int(p[_POS_BRANCHES])
+            m0, m1, m2, m3, _, _, _, _ = _arm(p, 0.0, branch // 2, case)
+            if _missing(m0, m1, m2, m3) or branch >= 2 * nb:
+                for i in range(6):
+                    out[i] = math.nan
+                return
+            h3, h4, h5 = _h(p, 3), _h(p, 4), _h(p, 5)
+            v = _back(p, m0, m1, m2, m3, _mat(p, h5))
+            t1a, t2a, t1b, t2b, c, _ = sp2(v, h5, h3, h4)
+            if math.isnan(c):  # joint 6's axis on joint 4's: a continuum (wrist singular); one member
+                q3 = 0.0
+                q4, _ = sp1(h5, v, h4)
+            elif branch % 2 == 0:
+                q3, q4 = -t1a, t2a
+            else:
+                q3, q4 = -t1b, t2b
+            e = orthogonal(h5)
+            w = rot(h4, -q4, rot(h3, -q3, _back(p, m0, m1, m2, m3, _mat(p, e))))
+            q5, _ = sp1(e, w, h5)
+            _write(p, out, m0, m1, m2, (math.cos(q3), math.sin(q3), 0.0), q4, q5)  # (motion(True, q3))
+
+        def singular(params, out):
+            """``out[i]``: some exact position branch of the wrist family leaves pose i with a singular wrist."""
+            h3, h5 = _h(params[0], 3), _h(params[0], 5)
+            for i in range(params.shape[0]):
+                p = params[i]
+                out[i] = False
+                for b in range(int(p[_POS_BRANCHES])):
+                    m0, m1, m2, m3, c1, c2, _, _ = _arm(p, 0.0, b, case)
+                    if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
+                        continue
+                    v = _back(p, m0, m1, m2, m3, _mat(p, h5))
+                    if norm(cross(v, h3)) < WRIST_SINGULAR:
+                        out[i] = True
+
+        ck = _CASE_KERNELS[case] = CaseKernels(
+            LazyKernel(residual, RESIDUAL_SIG, cache=True),
+            LazyKernel(configuration, CONFIGURATION_SIG, cache=True),
+            LazyKernel(margin, RESIDUAL_SIG, cache=True),
+            LazyKernel(amplitude, RESIDUAL_SIG, cache=True),
+            LazyKernel(wrist, CONFIGURATION_SIG, cache=True),
+            njit(cache=True)(singular),
+        )
+    return ck

@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from .._jit import internal
+
 _njit: Any
 try:
     from numba import njit as _njit
@@ -111,9 +113,9 @@ if _njit is not None:
     #: ``Reduction.kernel_residuals``).
     RESIDUALS_SIG = void(float64[::1], float64, float64[::1])
     CONFIGURATION_SIG = void(float64[::1], float64, int64, float64[::1])
-    _elbow = _njit(cache=True)(_elbow)
-    _d1_position = _njit(cache=True)(_d1_position)
-    _elbow_residual = _njit(cache=True)(_elbow_residual)
+    _elbow = internal(_elbow)
+    _d1_position = internal(_d1_position)
+    _elbow_residual = internal(_elbow_residual)
 
 
 class LazyKernel:
@@ -121,18 +123,34 @@ class LazyKernel:
     of at import: a process loads only the kernels its arms need (each takes 10-100 ms to load from the cache).
 
     Call it like the compiled function; :func:`first_class` takes it like a dispatcher. Only for functions called
-    from Python (compiled code needs the dispatcher itself).
+    from Python (compiled code needs the dispatcher itself). ``fn`` may be a dispatcher that compiled code calls too:
+    the kernel is then that dispatcher's overload for ``sig`` (compiled once, not a second time by a dispatcher of
+    its own), and ``options`` are that dispatcher's.
     """
 
     def __init__(self, fn: Any, sig: Any, **options: Any) -> None:
-        self.py_func, self._sig, self._options = fn, sig, options
+        self._shared = fn if hasattr(fn, "overloads") else None
+        self.py_func = fn if self._shared is None else fn.py_func
+        self._sig, self._options = sig, options
         self._dispatcher: Any = None
 
     @property
     def dispatcher(self) -> Any:
         if self._dispatcher is None:
-            self._dispatcher = _njit(self._sig, **self._options)(self.py_func)
+            if self._shared is not None:
+                self._shared.compile(self._sig)
+                self._dispatcher = self._shared
+            else:
+                self._dispatcher = _njit(self._sig, **self._options)(self.py_func)
         return self._dispatcher
+
+    @property
+    def signature(self) -> Any:
+        """The compiled signature (a Numba ``Signature``)."""
+        from numba.core import sigutils
+
+        args, _ = sigutils.normalize_signature(self._sig)
+        return self.dispatcher.overloads[tuple(args)].signature
 
     def __call__(self, *args: Any) -> Any:
         d = self._dispatcher
@@ -150,9 +168,9 @@ carm_d1_residuals: Any
 carm_d1_configuration: Any
 carm_theta2_configuration: Any
 if _njit is not None:
-    carm_d1_residual = LazyKernel(_carm_d1, RESIDUAL_SIG, cache=True)
-    carm_theta2_residual = LazyKernel(_carm_theta2, RESIDUAL_SIG, cache=True)
     _carm_d1 = _njit(cache=True)(_carm_d1)  # compiled code (_carm_d1_all) calls the dispatcher
+    carm_d1_residual = LazyKernel(_carm_d1, RESIDUAL_SIG)  # (its overload for the engine's signature)
+    carm_theta2_residual = LazyKernel(_carm_theta2, RESIDUAL_SIG, cache=True)
     carm_d1_residuals = LazyKernel(_carm_d1_all, RESIDUALS_SIG, cache=True)
 else:  # pragma: no cover
     carm_d1_residual, carm_theta2_residual = _carm_d1, _carm_theta2
@@ -172,8 +190,11 @@ def first_class(fn: Any) -> Any:
     if wap is None:
         from numba import types
 
-        disp = fn.dispatcher if isinstance(fn, LazyKernel) else fn
-        (sig,) = disp.nopython_signatures
+        if isinstance(fn, LazyKernel):
+            disp, sig = fn.dispatcher, fn.signature
+        else:
+            disp = fn
+            (sig,) = disp.nopython_signatures
         cres = disp.overloads[sig.args]
         address = cres.library.get_pointer_to_function(cres.fndesc.llvm_cfunc_wrapper_name)
 
@@ -240,7 +261,7 @@ def _carm_theta2_configuration(p, x: float, b: int, out) -> None:
 
 
 if _njit is not None:
-    _carm_configuration = _njit(cache=True)(_carm_configuration)
+    _carm_configuration = internal(_carm_configuration)
     carm_d1_configuration = LazyKernel(_carm_d1_configuration, CONFIGURATION_SIG, cache=True)
     carm_theta2_configuration = LazyKernel(_carm_theta2_configuration, CONFIGURATION_SIG, cache=True)
 else:  # pragma: no cover

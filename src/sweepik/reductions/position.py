@@ -37,8 +37,10 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
+from .._jit import internal
 from ..subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
 from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
@@ -67,7 +69,7 @@ def motion(rev, x):
     return 1.0, 0.0, x
 
 
-@njit(cache=True)
+@internal
 def angle(rev, m):
     """The joint value of motion ``m`` (radians or travel)."""
     if rev:
@@ -75,17 +77,17 @@ def angle(rev, m):
     return m[2]
 
 
-@njit(cache=True)
+@internal
 def _rev(c, s):
     return c, s, 0.0
 
 
-@njit(cache=True)
+@internal
 def _pris(t):
     return 1.0, 0.0, t
 
 
-@njit(cache=True)
+@internal
 def move(h, rev, m, v):
     """``T(v)``: ``v`` rotated about ``h`` (revolute) or translated along it (prismatic) by motion ``m``."""
     if rev:
@@ -93,7 +95,7 @@ def move(h, rev, m, v):
     return add(v, scale(m[2], h))
 
 
-@njit(cache=True)
+@internal
 def move_back(h, rev, m, v):
     """The inverse of ``move``."""
     if rev:
@@ -101,7 +103,7 @@ def move_back(h, rev, m, v):
     return sub(v, scale(m[2], h))
 
 
-@njit(cache=True)
+@internal
 def _turn(h, rev, m, v):
     """The rotation part of ``move`` (directions)."""
     if rev:
@@ -136,7 +138,7 @@ def reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, t):
     return tp, h0, h1, h2, s1, s2, add(s3, move(h3, r3, x, s4))
 
 
-@njit(cache=True)
+@internal
 def _line_cos(disc, d):
     """A line-sphere discriminant as the cosine of a circle subproblem (|c| <= 1 inside the domain)."""
     if d > 0.0:
@@ -144,7 +146,134 @@ def _line_cos(disc, d):
     return 0.0 if disc >= 0.0 else math.inf
 
 
-@njit(cache=True)
+@internal
+def _ab_par(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``ab_par`` of ``place``: the height along h_a does not depend on qa, qb."""
+    b1 = branch // 2
+    b2 = branch % 2
+    c1 = 0.0
+    r1 = math.inf
+    height = dot(ha, sub(sub(tp, pab), pbc))
+    if rc:
+        ua, va, ub, vb, c1, r1 = sp4_cs(ha, pcw, hc, height)
+        mc = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
+    else:
+        mc = _pris(lp4(ha, pcw, hc, height))
+        b2 = branch
+    w = add(pbc, move(hc, rc, mc, pcw))
+    ua, va, ub, vb, c2, r2 = sp3_cs(w, scale(-1.0, pab), hb, norm(tp))
+    mb = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
+    # (rot_cs for move(hb, True, ...): a constant True would have move compiled once more, for its literal type)
+    ca, sa = sp1_cs(add(pab, rot_cs(hb, mb[0], mb[1], w)), tp, ha)
+    return _rev(ca, sa), mb, mc, c1, c2, r1, r2
+
+
+@internal
+def _bc_par(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``bc_par`` of ``place``: the height along h_b does not depend on qb, qc."""
+    b1 = branch // 2
+    b2 = branch % 2
+    c1 = 0.0
+    r1 = math.inf
+    height = dot(hb, add(add(pab, pbc), pcw))
+    if ra:
+        ua, va, ub, vb, c1, r1 = sp4_cs(hb, tp, ha, height)
+        ma = _rev(ua, -va) if b1 == 0 else _rev(ub, -vb)
+    else:
+        ma = _pris(lp4(hb, tp, scale(-1.0, ha), height))
+        b2 = branch
+    target = sub(move_back(ha, ra, ma, tp), pab)
+    ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, pbc), hc, norm(target))
+    mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
+    cb, sb = sp1_cs(add(pbc, rot_cs(hc, mc[0], mc[1], pcw)), target, hb)
+    return ma, _rev(cb, sb), mc, c1, c2, r1, r2
+
+
+@internal
+def _ab_int(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``ab_int`` of ``place``: |W - O| depends on qc only."""
+    b1 = branch // 2
+    b2 = branch % 2
+    c1 = 0.0
+    r1 = math.inf
+    base = add(sub(pab, o), pbc)
+    d = norm(sub(tp, o))
+    if rc:
+        ua, va, ub, vb, c1, r1 = sp3_cs(pcw, scale(-1.0, base), hc, d)
+        mc = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
+    else:
+        u, v, disc = lp3(add(base, pcw), (0.0, 0.0, 0.0), hc, d)
+        c1 = _line_cos(disc, d)
+        mc = _pris(u if b1 == 0 else v)
+    w0 = add(base, move(hc, rc, mc, pcw))
+    c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c2, r2 = sp2_cs(sub(tp, o), w0, ha, hb)
+    if b2 == 0:
+        return _rev(c1a, -s1a), _rev(c2a, s2a), mc, c1, c2, r1, r2
+    return _rev(c1b, -s1b), _rev(c2b, s2b), mc, c1, c2, r1, r2
+
+
+@internal
+def _bc_int(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``bc_int`` of ``place``: |W - O| is fixed; O moves with joint a only."""
+    b1 = branch // 2
+    b2 = branch % 2
+    c1 = 0.0
+    r1 = math.inf
+    w1 = add(sub(pbc, o), pcw)
+    d = norm(w1)
+    centre = add(pab, o)
+    if ra:
+        ua, va, ub, vb, c1, r1 = sp3_cs(centre, tp, ha, d)
+        ma = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
+    else:
+        u, v, disc = lp3(centre, tp, ha, d)
+        c1 = _line_cos(disc, d)
+        ma = _pris(u if b1 == 0 else v)
+    target = sub(move_back(ha, ra, ma, tp), centre)
+    c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c2, r2 = sp2_cs(target, w1, hb, hc)
+    if b2 == 0:
+        return ma, _rev(c1a, -s1a), _rev(c2a, s2a), c1, c2, r1, r2
+    return ma, _rev(c1b, -s1b), _rev(c2b, s2b), c1, c2, r1, r2
+
+
+@internal
+def _ppp(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``ppp`` of ``place``."""
+    qa, qb, qc = lines3(ha, hb, hc, sub(sub(sub(tp, pab), pbc), pcw))
+    return _pris(qa), _pris(qb), _pris(qc), 0.0, 0.0, math.inf, math.inf
+
+
+@internal
+def _ppr(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``ppr`` of ``place``: the height along ha x hb does not depend on qa, qb."""
+    b2 = branch % 2
+    c1 = 0.0
+    r1 = math.inf
+    n = cross(ha, hb)
+    if norm(n) == 0.0:  # parallel slides (a blind spot of a plan whose slides turn with theta*)
+        nan = (math.nan, math.nan, math.nan)
+        return nan, nan, nan, math.nan, math.nan, math.nan, math.nan
+    n = unit(n)
+    ua, va, ub, vb, c2, r2 = sp4_cs(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
+    mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
+    qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), rot_cs(hc, mc[0], mc[1], pcw)))
+    return _pris(qa), _pris(qb), mc, c1, c2, r1, r2
+
+
+@internal
+def _ac_par(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``ac_par`` of ``place``: the height along ha fixes the prismatic b."""
+    b2 = branch % 2
+    c1 = 0.0
+    r1 = math.inf
+    qb = lp4(ha, add(add(pab, pbc), pcw), hb, dot(ha, tp))
+    w = add(add(pab, scale(qb, hb)), pbc)
+    ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, w), hc, norm(tp))
+    mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
+    ca, sa = sp1_cs(add(w, rot_cs(hc, mc[0], mc[1], pcw)), tp, ha)
+    return _rev(ca, sa), _pris(qb), mc, c1, c2, r1, r2
+
+
 def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Motions ``(ma, mb, mc)`` (see ``motion``) of ``branch`` putting ``W`` at ``tp``, the cosines ``(c1, c2)`` of
     its two-solution steps (0 for a one-solution step): ``|c| <= 1`` inside the branch's domain, and their
@@ -154,87 +283,52 @@ def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
 
     ``o``: for ``ab_int`` the meeting point of axes a and b relative to joint a's point; for ``bc_int`` that of b
     and c relative to joint b's point, in the reduced chain's frame.
+
+    For compiled code only (an ``overload``, ``_place``): with ``case`` a constant of the caller's (a literal type,
+    as a family kernel made for one arm's case passes it), only that case's chain of subproblems is compiled, not all
+    seven (about 2 s less on a fresh install); with a variable ``case``, every case.
     """
-    b1 = branch // 2
-    b2 = branch % 2
-    c1 = 0.0
-    r1 = math.inf
-    if case == 0:  # ab_par: the height along h_a does not depend on qa, qb
-        height = dot(ha, sub(sub(tp, pab), pbc))
-        if rc:
-            ua, va, ub, vb, c1, r1 = sp4_cs(ha, pcw, hc, height)
-            mc = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
-        else:
-            mc = _pris(lp4(ha, pcw, hc, height))
-            b2 = branch
-        w = add(pbc, move(hc, rc, mc, pcw))
-        ua, va, ub, vb, c2, r2 = sp3_cs(w, scale(-1.0, pab), hb, norm(tp))
-        mb = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-        ca, sa = sp1_cs(add(pab, move(hb, True, mb, w)), tp, ha)
-        return _rev(ca, sa), mb, mc, c1, c2, r1, r2
-    if case == 1:  # bc_par: the height along h_b does not depend on qb, qc
-        height = dot(hb, add(add(pab, pbc), pcw))
-        if ra:
-            ua, va, ub, vb, c1, r1 = sp4_cs(hb, tp, ha, height)
-            ma = _rev(ua, -va) if b1 == 0 else _rev(ub, -vb)
-        else:
-            ma = _pris(lp4(hb, tp, scale(-1.0, ha), height))
-            b2 = branch
-        target = sub(move_back(ha, ra, ma, tp), pab)
-        ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, pbc), hc, norm(target))
-        mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-        cb, sb = sp1_cs(add(pbc, move(hc, True, mc, pcw)), target, hb)
-        return ma, _rev(cb, sb), mc, c1, c2, r1, r2
-    if case == 2:  # ab_int: |W - O| depends on qc only
-        base = add(sub(pab, o), pbc)
-        d = norm(sub(tp, o))
-        if rc:
-            ua, va, ub, vb, c1, r1 = sp3_cs(pcw, scale(-1.0, base), hc, d)
-            mc = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
-        else:
-            u, v, disc = lp3(add(base, pcw), (0.0, 0.0, 0.0), hc, d)
-            c1 = _line_cos(disc, d)
-            mc = _pris(u if b1 == 0 else v)
-        w0 = add(base, move(hc, rc, mc, pcw))
-        c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c2, r2 = sp2_cs(sub(tp, o), w0, ha, hb)
-        if b2 == 0:
-            return _rev(c1a, -s1a), _rev(c2a, s2a), mc, c1, c2, r1, r2
-        return _rev(c1b, -s1b), _rev(c2b, s2b), mc, c1, c2, r1, r2
-    if case == 3:  # bc_int: |W - O| is fixed; O moves with joint a only
-        w1 = add(sub(pbc, o), pcw)
-        d = norm(w1)
-        centre = add(pab, o)
-        if ra:
-            ua, va, ub, vb, c1, r1 = sp3_cs(centre, tp, ha, d)
-            ma = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
-        else:
-            u, v, disc = lp3(centre, tp, ha, d)
-            c1 = _line_cos(disc, d)
-            ma = _pris(u if b1 == 0 else v)
-        target = sub(move_back(ha, ra, ma, tp), centre)
-        c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c2, r2 = sp2_cs(target, w1, hb, hc)
-        if b2 == 0:
-            return ma, _rev(c1a, -s1a), _rev(c2a, s2a), c1, c2, r1, r2
-        return ma, _rev(c1b, -s1b), _rev(c2b, s2b), c1, c2, r1, r2
-    if case == 4:  # ppp
-        qa, qb, qc = lines3(ha, hb, hc, sub(sub(sub(tp, pab), pbc), pcw))
-        return _pris(qa), _pris(qb), _pris(qc), 0.0, 0.0, math.inf, math.inf
-    if case == 5:  # ppr: the height along ha x hb does not depend on qa, qb
-        n = cross(ha, hb)
-        if norm(n) == 0.0:  # parallel slides (a blind spot of a plan whose slides turn with theta*)
-            nan = (math.nan, math.nan, math.nan)
-            return nan, nan, nan, math.nan, math.nan, math.nan, math.nan
-        n = unit(n)
-        ua, va, ub, vb, c2, r2 = sp4_cs(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
-        mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-        qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), move(hc, True, mc, pcw)))
-        return _pris(qa), _pris(qb), mc, c1, c2, r1, r2
-    if case == 6:  # ac_par: the height along ha fixes the prismatic b
-        qb = lp4(ha, add(add(pab, pbc), pcw), hb, dot(ha, tp))
-        w = add(add(pab, scale(qb, hb)), pbc)
-        ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, w), hc, norm(tp))
-        mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-        ca, sa = sp1_cs(add(w, move(hc, True, mc, pcw)), tp, ha)
-        return _rev(ca, sa), _pris(qb), mc, c1, c2, r1, r2
+    raise NotImplementedError("position.place is compiled code's")
+
+
+#: The cases' functions, in the order of ``CASES``.
+_CASE_FUNCTIONS = (_ab_par, _bc_par, _ab_int, _bc_int, _ppp, _ppr, _ac_par)
+
+
+@internal
+def _no_case(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """An unknown case: NaN motions."""
     nan = (math.nan, math.nan, math.nan)
     return nan, nan, nan, math.nan, math.nan, math.nan, math.nan
+
+
+@overload(place, prefer_literal=True)
+def _place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """``place`` in compiled code: the case's own function for a constant ``case``, else a dispatch over them all."""
+    if isinstance(case, types.IntegerLiteral):
+        k = case.literal_value
+        fn = _CASE_FUNCTIONS[k] if 0 <= k < len(_CASE_FUNCTIONS) else _no_case
+
+        def one(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+            return fn(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+
+        return one
+
+    def every(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+        if case == 0:
+            return place(0, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        if case == 1:
+            return place(1, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        if case == 2:
+            return place(2, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        if case == 3:
+            return place(3, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        if case == 4:
+            return place(4, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        if case == 5:
+            return place(5, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        if case == 6:
+            return place(6, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        return place(-1, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+
+    return every

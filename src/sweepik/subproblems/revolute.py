@@ -31,6 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .._jit import internal
 from .trig import trig2_roots
 from .vec import cross, dot, norm, perp, rot, rot_cs, sub
 
@@ -149,7 +150,7 @@ def sp2(p1, p2, k1, k2):
     return math.atan2(s1a, c1a), math.atan2(s2a, c2a), math.atan2(s1b, c1b), math.atan2(s2b, c2b), c, r
 
 
-@njit(cache=True)
+@internal
 def _trig_terms(h, k, p):
     """``(a_c, a_s, a_0)`` with ``h . R(k, t) p = a_c cos t + a_s sin t + a_0``."""
     return dot(h, perp(k, p)), dot(h, cross(k, p)), dot(h, k) * dot(k, p)
@@ -179,8 +180,10 @@ def sp6(h1, k1, p1, h2, k2, p2, h3, k3, p3, h4, k4, p4, d1, d2):
     a2c, a2s, a20 = _trig_terms(h3, k3, p3)
     b2c, b2s, b20 = _trig_terms(h4, k4, p4)
     e1, e2 = d1 - a10 - b10, d2 - a20 - b20
-    t1 = np.full(4, np.nan)
-    t2 = np.full(4, np.nan)
+    t1 = np.empty(4)
+    t2 = np.empty(4)
+    for i in range(4):
+        t1[i] = t2[i] = np.nan
     det_a = a1c * a2s - a1s * a2c
     det_b = b1c * b2s - b1s * b2c
     size = max(abs(a1c), abs(a1s), abs(a2c), abs(a2s), abs(b1c), abs(b1s), abs(b2c), abs(b2s))
@@ -227,7 +230,9 @@ def sp5(p0, p1, p2, p3, k1, k2, k3):
     d1 = dot(k2, p2) - dot(k2, p0)
     d2 = 0.5 * (dot(p2, p2) + dot(p3, p3) - dot(p0, p0) - dot(p1, p1))
     t1, t3, n = sp6(k2, k1, p1, nk2, k3, p3, p0, k1, p1, np2, k3, p3, d1, d2)
-    t2 = np.full(4, np.nan)
+    t2 = np.empty(4)
+    for i in range(4):
+        t2[i] = np.nan
     for i in range(max(n, 0)):
         a = rot(k3, t3[i], p3)
         a = (a[0] + p2[0], a[1] + p2[1], a[2] + p2[2])

@@ -5,6 +5,11 @@ circle. With ``z = exp(i theta)``, ``z^2 f`` is a polynomial of degree 4 in ``z`
 the roots of ``f``: its companion matrix's eigenvalues (``numpy.roots``), those within ``UNIT_TOL`` of the circle
 kept, each polished by Newton's method on ``f`` itself and accepted only where ``|f|`` is then at rounding level.
 No tangent-half-angle substitution, so no angle is special (theta = pi included).
+
+The eigenvalues come from LAPACK's ``zgeev`` through the binding Numba's ``np.roots`` uses, called directly
+(``_companion_roots``: the same matrix and call, so the same roots to the bit): Numba's ``np.roots`` and
+``np.linalg.eigvals`` carry general-purpose checks and conversions that took about 8 s to compile on a fresh
+install.
 """
 
 from __future__ import annotations
@@ -12,9 +17,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.np.linalg import _LAPACK, _dummy_liveness_func, ensure_lapack
+
+from .._jit import internal
 
 __all__ = ["trig2_roots", "trig2"]
+
+ensure_lapack()  # (SciPy's LAPACK, as for np.roots in compiled code)
+#: ``info = zgeev(kind, jobvl, jobvr, n, a, lda, w, vl, ldvl, vr, ldvr)`` (Numba's helper; a private name of
+#: ``numba.np.linalg``, the one its ``np.linalg.eigvals`` calls for complex matrices).
+_ZGEEV = _LAPACK().numba_ez_cgeev(types.complex128)
 
 #: Roots of ``z^2 f`` this far from the unit circle (in ``| |z| - 1 |``) are candidates: a double root (f tangent
 #: to zero) splits into two roots ~sqrt(rounding) off the circle.
@@ -42,11 +55,39 @@ def trig2(a0, a1, b1, a2, b2, theta):
     return f, df
 
 
+@internal
+def _companion_roots(c, m):
+    """The ``m - 1`` roots of the polynomial ``c[0] z^(m-1) + ... + c[m-1]`` (``c[0]`` and ``c[m-1]`` not 0), as
+    Numba's ``np.roots(c[:m])``: the eigenvalues of the same companion matrix (first row ``-c[1:] / c[0]``, ones
+    below the diagonal, Fortran order) by the same LAPACK call, with the same errors."""
+    n = m - 1
+    a = np.empty((n, n), dtype=np.complex128).T  # (Fortran order, as LAPACK takes it)
+    for j in range(n):
+        for i in range(n):
+            a[i, j] = 0.0
+    for k in range(n):
+        a[0, k] = -c[k + 1] / c[0]
+        if not (math.isfinite(a[0, k].real) and math.isfinite(a[0, k].imag)):
+            raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
+    for k in range(n - 1):
+        a[k + 1, k] = 1.0
+    w = np.empty(n, dtype=np.complex128)
+    vl = np.empty(1, dtype=np.complex128)  # (not referenced: no eigenvectors)
+    vr = np.empty(1, dtype=np.complex128)
+    info = _ZGEEV(122, 78, 78, n, a.ctypes, n, w.ctypes, vl.ctypes, 1, vr.ctypes, 1)  # kind 'z', jobvl = jobvr = 'N'
+    if info != 0:
+        raise ValueError("Internal algorithm failed to converge.")
+    _dummy_liveness_func([a.size, vl.size, vr.size, w.size])  # (.ctypes does not keep the arrays alive)
+    return w
+
+
 @njit(cache=True)
 def trig2_roots(a0, a1, b1, a2, b2):
     """Roots ``(4,)`` (NaN-padded, ascending) of ``a0 + a1 cos t + b1 sin t + a2 cos 2t + b2 sin 2t`` in (-pi, pi],
     and their count. An identically zero ``f`` (every angle a root) gives count -1."""
-    out = np.full(4, np.nan)
+    out = np.empty(4)
+    for k in range(4):
+        out[k] = np.nan
     scale = max(abs(a0), abs(a1), abs(b1), abs(a2), abs(b2))
     if scale == 0.0:
         return out, -1
@@ -57,12 +98,16 @@ def trig2_roots(a0, a1, b1, a2, b2):
     c1 = complex(0.5 * a1, 0.5 * b1)
     c0 = complex(0.5 * a2, 0.5 * b2)
     small = 1e-13 * scale
+    coef = np.empty(5, dtype=np.complex128)
     if abs(c4) > small:
-        z = np.roots(np.array([c4, c3, c2, c1, c0]))
+        coef[0], coef[1], coef[2], coef[3], coef[4] = c4, c3, c2, c1, c0
+        m = 5
     elif abs(c3) > small:  # degree 1 in the angle: z f = c3 z^2 + c2 z + c1
-        z = np.roots(np.array([c3, c2, c1]))
+        coef[0], coef[1], coef[2] = c3, c2, c1
+        m = 3
     else:  # constant and nonzero
         return out, 0
+    z = _companion_roots(coef, m)  # (one call: with a constant m Numba would compile it once per value)
     n = 0
     for zi in z:
         if abs(abs(zi) - 1.0) > UNIT_TOL:
@@ -91,5 +136,11 @@ def trig2_roots(a0, a1, b1, a2, b2):
         if not dup and n < 4:
             out[n] = t
             n += 1
-    out[:n] = np.sort(out[:n])
+    for a in range(1, n):  # ascending (insertion sort of at most 4 finite angles)
+        t = out[a]
+        j = a - 1
+        while j >= 0 and out[j] > t:
+            out[j + 1] = out[j]
+            j -= 1
+        out[j + 1] = t
     return out, n

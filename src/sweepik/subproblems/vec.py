@@ -1,60 +1,62 @@
 """Small 3-vector algebra on tuples ``(x, y, z)`` for compiled scalar code (no array allocation).
 
-Every function is compiled with ``numba.njit`` and callable from Python with tuples of floats.
+Compiled code calls these only: they are compiled without the wrappers that would let Python call them
+(:func:`sweepik._jit.internal`; ~0.05 s less each on a fresh install). The subproblems built on them are callable
+from Python.
 """
 
 from __future__ import annotations
 
 import math
 
-from numba import njit
+from .._jit import internal
 
 __all__ = ["add", "sub", "scale", "dot", "cross", "norm", "unit", "rot", "rot_cs", "perp", "along", "orthogonal"]
 
 
-@njit(cache=True)
+@internal
 def add(a, b):
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
-@njit(cache=True)
+@internal
 def sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-@njit(cache=True)
+@internal
 def scale(s, a):
     return (s * a[0], s * a[1], s * a[2])
 
 
-@njit(cache=True)
+@internal
 def dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True)
+@internal
 def cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@njit(cache=True)
+@internal
 def norm(a):
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
-@njit(cache=True)
+@internal
 def unit(a):
     n = norm(a)
     return (a[0] / n, a[1] / n, a[2] / n)
 
 
-@njit(cache=True)
+@internal
 def rot(k, theta, v):
     """``v`` rotated by ``theta`` (radians) about the unit axis ``k`` (Rodrigues)."""
     return rot_cs(k, math.cos(theta), math.sin(theta), v)
 
 
-@njit(cache=True)
+@internal
 def rot_cs(k, c, s, v):
     """``v`` rotated about the unit axis ``k`` by the angle whose cosine and sine are ``c``, ``s``."""
     kv = dot(k, v)
@@ -66,19 +68,19 @@ def rot_cs(k, c, s, v):
     )
 
 
-@njit(cache=True)
+@internal
 def along(k, v):
     """The component of ``v`` along the unit vector ``k``."""
     return scale(dot(k, v), k)
 
 
-@njit(cache=True)
+@internal
 def perp(k, v):
     """The component of ``v`` perpendicular to the unit vector ``k``."""
     return sub(v, along(k, v))
 
 
-@njit(cache=True)
+@internal
 def orthogonal(k):
     """A unit vector perpendicular to the unit vector ``k``."""
     ax, ay, az = abs(k[0]), abs(k[1]), abs(k[2])

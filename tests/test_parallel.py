@@ -1,0 +1,53 @@
+"""Batch kernels on threads (sweepik.parallel): every item once, in parts, serial for small batches or one thread."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from sweepik import fastsweep, parallel
+
+
+def _record(out, seen, start, stop):
+    seen.append((start, stop, threading.get_ident()))
+    out[start:stop] += 1
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 7, 63, 64, 65, 1000])
+def test_every_item_once(n):
+    out = np.zeros(n, dtype=np.int64)
+    seen: list[tuple[int, int, int]] = []
+    parallel.run(_record, n, 64, out, seen)
+    assert np.all(out == 1)
+    if n < 64 or parallel.threads() == 1:
+        assert seen == [(0, n, threading.get_ident())]  # in the calling thread, one part
+    else:
+        assert len(seen) == min(n, parallel.threads() * parallel.PARTS_PER_THREAD)
+        assert all(t != threading.get_ident() for _, _, t in seen)
+
+
+def test_kernel_error_is_raised():
+    def fail(start, stop):
+        if stop == 1000:  # (the last part, on a thread or, with one thread allowed, the whole batch)
+            raise ValueError("boom")
+
+    with pytest.raises(ValueError, match="boom"):
+        parallel.run(fail, 1000, 1)
+
+
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="Numba's thread setting")
+def test_numba_thread_setting_is_honoured():
+    import numba
+
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        assert parallel.threads() == 1
+        out = np.zeros(500, dtype=np.int64)
+        seen: list[tuple[int, int, int]] = []
+        parallel.run(_record, 500, 1, out, seen)
+        assert seen == [(0, 500, threading.get_ident())] and np.all(out == 1)
+    finally:
+        numba.set_num_threads(before)
