@@ -118,7 +118,7 @@ def _robot_corpus() -> dict[str, tuple[bytes, bool]]:
         "joints_ints": b"joints = [1, 2]\n",
         "joints_empty": b"joints = []\n",
         "joint_no_type": CARM_TOML.replace('type = "prismatic"\n', "").encode(),
-        "joint_unknown_key": CARM_TOML.replace('type = "prismatic"', 'type = "prismatic"\nmass = 3.0').encode(),
+        "joint_unknown_key": CARM_TOML.replace('type = "prismatic"', 'type = "prismatic"\nstiffness = 3.0').encode(),
         "top_unknown_key": ("speed = 3\n" + CARM_TOML).encode(),
         "type_bad": CARM_TOML.replace('type = "prismatic"', 'type = "spherical"').encode(),
         "type_list": CARM_TOML.replace('type = "prismatic"', 'type = ["prismatic"]').encode(),
