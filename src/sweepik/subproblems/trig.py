@@ -18,16 +18,11 @@ import math
 
 import numpy as np
 from numba import njit, types
-from numba.np.linalg import _LAPACK, _dummy_liveness_func, ensure_lapack
+from numba.extending import overload
 
 from .._jit import internal
 
 __all__ = ["trig2_roots", "trig2"]
-
-ensure_lapack()  # (SciPy's LAPACK, as for np.roots in compiled code)
-#: ``info = zgeev(kind, jobvl, jobvr, n, a, lda, w, vl, ldvl, vr, ldvr)`` (Numba's helper; a private name of
-#: ``numba.np.linalg``, the one its ``np.linalg.eigvals`` calls for complex matrices).
-_ZGEEV = _LAPACK().numba_ez_cgeev(types.complex128)
 
 #: Roots of ``z^2 f`` this far from the unit circle (in ``| |z| - 1 |``) are candidates: a double root (f tangent
 #: to zero) splits into two roots ~sqrt(rounding) off the circle.
@@ -55,6 +50,30 @@ def trig2(a0, a1, b1, a2, b2, theta):
     return f, df
 
 
+def _zgeev(a, w, vl, vr):
+    """``info`` of LAPACK's ``zgeev`` (no eigenvectors) on ``a (n, n)`` (Fortran order), eigenvalues into ``w (n,)``
+    (``vl``, ``vr``: one-element placeholders). Compiled code only (an overload)."""
+    raise NotImplementedError("trig._zgeev is compiled code's")
+
+
+@overload(_zgeev)
+def _zgeev_compiled(a, w, vl, vr):
+    # Numba's binding, the one its np.linalg.eigvals calls for complex matrices (a private name of numba.np.linalg),
+    # looked up when a kernel using it is compiled: SciPy's LAPACK is then required, as for np.roots, and neither
+    # numba.np.linalg nor SciPy is imported with sweepik (a cached kernel loads LAPACK when first called)
+    from numba.np.linalg import _LAPACK, ensure_lapack
+
+    ensure_lapack()
+    zgeev = _LAPACK().numba_ez_cgeev(types.complex128)
+
+    def impl(a, w, vl, vr):
+        n = a.shape[0]
+        # kind 'z', jobvl = jobvr = 'N' (the arrays stay alive: the caller holds them through this call)
+        return zgeev(122, 78, 78, n, a.ctypes, n, w.ctypes, vl.ctypes, 1, vr.ctypes, 1)
+
+    return impl
+
+
 @internal
 def _companion_roots(c, m):
     """The ``m - 1`` roots of the polynomial ``c[0] z^(m-1) + ... + c[m-1]`` (``c[0]`` and ``c[m-1]`` not 0), as
@@ -74,10 +93,8 @@ def _companion_roots(c, m):
     w = np.empty(n, dtype=np.complex128)
     vl = np.empty(1, dtype=np.complex128)  # (not referenced: no eigenvectors)
     vr = np.empty(1, dtype=np.complex128)
-    info = _ZGEEV(122, 78, 78, n, a.ctypes, n, w.ctypes, vl.ctypes, 1, vr.ctypes, 1)  # kind 'z', jobvl = jobvr = 'N'
-    if info != 0:
+    if _zgeev(a, w, vl, vr) != 0:
         raise ValueError("Internal algorithm failed to converge.")
-    _dummy_liveness_func([a.size, vl.size, vr.size, w.size])  # (.ctypes does not keep the arrays alive)
     return w
 
 
