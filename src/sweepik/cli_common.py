@@ -323,6 +323,23 @@ def _check_output_path(path: str, directory: bool = False, suffixes: Sequence[st
         raise CliInputError(f"{path}: file exists and is not writable")
 
 
+def _emit_results(
+    args: argparse.Namespace, result: dict[str, Any], text: str, write_report: Callable[[str], Path]
+) -> None:
+    """``--json -``: ``result`` alone on stdout; else ``text``, and ``--json FILE`` written. Then ``--report DIR``
+    by ``write_report(DIR)`` (its status line on stderr when stdout holds the JSON)."""
+    if args.json == "-":
+        _print_json(result)
+    else:
+        print(text)
+        if args.json:
+            Path(args.json).write_text(json.dumps(result, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+            print(f"results written to {args.json}")
+    if args.report:
+        path = write_report(args.report)
+        print(f"report written to {path}", file=sys.stderr if args.json == "-" else sys.stdout)
+
+
 def _check_report_and_json(args: argparse.Namespace) -> None:
     """Before any work: ``--report DIR`` must be writable and matplotlib installed (the directory is created now,
     so that ``--json DIR/file.json`` may go into it); ``--json FILE`` writable."""

@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
-import sys
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -15,10 +12,10 @@ from .cli_common import (
     _add_robot_options,
     _check_report_and_json,
     _count,
+    _emit_results,
     _load_robot,
     _nonnegative_int,
     _parse_numbers,
-    _print_json,
     _Progress,
     _subparser,
     _SubParsers,
@@ -109,19 +106,7 @@ def cmd_design(args: argparse.Namespace) -> int:
         )
     finally:
         progress.close()
-    result = cmp.to_dict()
-    if args.json == "-":
-        _print_json(result)
-    else:
-        print(format_table(cmp))
-        print()
-        for v in cmp.verdicts:
-            winner = v["winner"] or "no clear winner"
-            print(f"{v['criterion']}: {winner}")
-        if args.json:
-            Path(args.json).write_text(json.dumps(result, indent=2, allow_nan=False) + "\n", encoding="utf-8")
-            print(f"results written to {args.json}")
-    if args.report:
-        path = write_design_report(cmp, args.report)
-        print(f"report written to {path}", file=sys.stderr if args.json == "-" else sys.stdout)
+    verdicts = [f"{v['criterion']}: {v['winner'] or 'no clear winner'}" for v in cmp.verdicts]
+    text = "\n".join([format_table(cmp), "", *verdicts])
+    _emit_results(args, cmp.to_dict(), text, lambda d: write_design_report(cmp, d))
     return 0

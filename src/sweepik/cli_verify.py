@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
-import sys
-from pathlib import Path
 from typing import Any
 
 from .cli_common import (
@@ -14,6 +11,7 @@ from .cli_common import (
     _add_robot_options,
     _check_report_and_json,
     _count,
+    _emit_results,
     _load_robot,
     _nonnegative_int,
     _print_json,
@@ -67,16 +65,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
         result = run_verify(robot, args.strategy, offgrid=args.offgrid, seed=args.seed, progress=progress)
     finally:
         progress.close()
-    if args.json == "-":
-        _print_json(result)
-    else:
-        print(format_table(result))
-        if args.json:
-            Path(args.json).write_text(json.dumps(result, indent=2, allow_nan=False) + "\n")
-            print(f"results written to {args.json}")
-    if args.report:
-        path = write_report(result, args.report)
-        print(f"report written to {path}", file=sys.stderr if args.json == "-" else sys.stdout)
+    _emit_results(args, result, format_table(result), lambda d: write_report(result, d))
     return 0
 
 

@@ -66,18 +66,21 @@ def _check_payload(robot: Robot, payload: float, payload_com: ArrayLike) -> tupl
 
 
 def _mass_points(
-    robot: Robot, q: Array, payload: float, payload_com: Array, links: bool
+    robot: Robot, q: ArrayLike, payload: float, payload_com: ArrayLike, links: bool
 ) -> tuple[Array, Array, Array, Array]:
-    """``(masses (n + 1,), points (..., n + 1, 3), axes (..., n, 3), axis points (..., n, 3))``: point k < n is
-    link k + 1's centre of mass, point n the payload (rides on the last link); world frame, length unit."""
-    frames = kinematics.chain_frames(robot, q)
+    """The arguments checked, then ``(masses (n + 1,), points (..., n + 1, 3), axes (..., n, 3), axis points
+    (..., n, 3))``: point k < n is link k + 1's centre of mass, point n the payload (rides on the last link); world
+    frame, length unit."""
+    qa = check_configuration(q, robot.n_joints)
+    mass, com = _check_payload(robot, payload, payload_com)
+    frames = kinematics.chain_frames(robot, qa)
     tool = frames[..., -1, :, :] @ robot.T_flange_tool
     n = robot.n_joints
     masses = np.zeros(n + 1)
     if links:
         masses[:n] = [j.mass for j in robot.joints]
-    masses[n] = payload
-    coms = np.array([j.com for j in robot.joints] + [list(payload_com)], dtype=np.float64)
+    masses[n] = mass
+    coms = np.array([j.com for j in robot.joints] + [list(com)], dtype=np.float64)
     poses = np.concatenate([frames[..., 1:, :, :], tool[..., None, :, :]], axis=-3)
     points = np.einsum("...kij,kj->...ki", poses[..., :3, :3], coms) + poses[..., :3, 3]
     z, o = kinematics.joint_axes(robot, frames)
@@ -94,9 +97,7 @@ def gravity_torques(
 ) -> Array:
     """Holding efforts ``(..., n)`` against gravity at configurations ``q (..., n)``: N·m for revolute joints, N
     for prismatic ones (see the module docstring for the sign and the masses counted)."""
-    qa = check_configuration(q, robot.n_joints)
-    m, c = _check_payload(robot, payload, payload_com)
-    masses, points, z, o = _mass_points(robot, qa, m, c, bool(links))
+    masses, points, z, o = _mass_points(robot, q, payload, payload_com, bool(links))
     n = robot.n_joints
     # masses beyond joint i: links i..n-1 (link k is moved by joint k) and the payload
     beyond = np.cumsum(masses[::-1])[::-1][:n]  # (n,)
@@ -120,9 +121,7 @@ def potential_energy(
 ) -> Array:
     """Gravitational potential energy ``(...)`` in J (zero at the world origin's height) of the masses that
     :func:`gravity_torques` counts; its derivative along q is those torques."""
-    qa = check_configuration(q, robot.n_joints)
-    m, c = _check_payload(robot, payload, payload_com)
-    masses, points, _, _ = _mass_points(robot, qa, m, c, bool(links))
+    masses, points, _, _ = _mass_points(robot, q, payload, payload_com, bool(links))
     metres = mm_per_unit(robot.length_unit) / 1000.0
     height = -np.einsum("...ki,i->...k", points, np.array(robot.gravity)) * metres
     return np.asarray(STANDARD_GRAVITY * height @ masses, dtype=np.float64)
