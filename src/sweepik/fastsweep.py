@@ -573,19 +573,84 @@ if AVAILABLE:
         pass
 
 
+if AVAILABLE:
+
+    @njit(cache=True, nogil=True)
+    def _merge_grid(lo, hi, s, hints, out, start, stop):
+        """``sweep.merge_grid`` for poses ``start .. stop - 1`` into ``out (N, n + H)``, element by element (the same
+        arithmetic, so the same samples): the hints (``H`` columns) are few, so an insertion sort of each row, whose
+        uniform part is sorted already, costs little."""
+        n, H = s.shape[0], hints.shape[1]
+        M = n + H
+        for i in range(start, stop):
+            g = out[i]
+            a, w = lo[i], hi[i] - lo[i]
+            for k in range(n):
+                g[k] = a + w * s[k]
+            for k in range(H):
+                h = hints[i, k]
+                g[n + k] = h if (math.isfinite(h) and h >= a and h <= hi[i]) else a + w * ((k + 0.5) / (n - 1))
+            for m in range(n, M):
+                v = g[m]
+                j = m - 1
+                while j >= 0 and g[j] > v:
+                    g[j + 1] = g[j]
+                    j -= 1
+                g[j + 1] = v
+            # runs of equal samples spread towards the next distinct one
+            m = 1
+            while m < M:
+                if g[m] > g[m - 1]:
+                    m += 1
+                    continue
+                s0 = m - 1
+                e0 = m
+                while e0 < M and not g[e0] > g[e0 - 1]:
+                    e0 += 1
+                if e0 < M:
+                    base = g[s0]
+                    for j in range(m, e0):
+                        g[j] = base + (g[e0] - base) * (j - s0) / (e0 - s0)
+                m = e0 + 1
+
+
+def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
+    """:func:`sweepik.sweep.sample_grid`, the merge compiled (for a single pose its NumPy steps cost ~80 us)."""
+    hints = _ref.grid_hints(reduction, poses)
+    N = poses.shape[0]
+    if hints is None:
+        hints = np.empty((N, 0))
+    out = np.empty((N, n_samples + hints.shape[1]))
+    parallel.run(
+        _merge_grid,
+        N,
+        PARALLEL_MIN * 16,
+        np.ascontiguousarray(lo, dtype=np.float64),
+        np.ascontiguousarray(hi, dtype=np.float64),
+        _ref._unit_grid(n_samples),
+        np.ascontiguousarray(hints, dtype=np.float64),
+        out,
+    )
+    return out
+
+
 def _kernel_residuals(reduction):
-    """``reduction.kernel_residuals`` if the class that sets ``kernel`` sets it too (else None: a subclass with
-    its own ``kernel`` must not get its parent's all-branch kernel)."""
+    """``reduction.kernel_residuals`` if the class that sets ``kernel`` sets it too (as a class attribute, or
+    declares it for its instances to set), else None: a subclass with its own ``kernel`` must not get its parent's
+    all-branch kernel."""
     mro = type(reduction).__mro__
     owner = next((c for c in mro if "kernel" in vars(c)), None)
-    # read from the class: a compiled function stored as a class attribute would bind to the instance
-    return None if owner is None else vars(owner).get("kernel_residuals")
+    if owner is None or "kernel_residuals" not in vars(owner):
+        return None
+    # read from the class (a compiled function stored as a class attribute would bind to the instance), unless
+    # the instance set its own
+    return vars(reduction).get("kernel_residuals", vars(owner)["kernel_residuals"])
 
 
 def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
     """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
     Poses whose candidate or family buffers overflow are redone by the NumPy engine."""
-    theta = _ref.sample_grid(reduction, poses, lo, hi, n_samples)
+    theta = sample_grid(reduction, poses, lo, hi, n_samples)
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
@@ -616,6 +681,15 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         fam,
         fcnt,
     )
+    if N == 1 and cnt[0] <= MAX_CAND and fcnt[0] == 0:  # (a single pose: the general bookkeeping costs ~40 us)
+        k0 = int(cnt[0])
+        single = _ref.Candidates(
+            pose=np.zeros(k0, dtype=np.intp),
+            branch=out_b[0, :k0].astype(np.intp),
+            theta=out_t[0, :k0].copy(),
+            mult=out_m[0, :k0].astype(np.intp),
+        )
+        return single, []
     over = (cnt > MAX_CAND) | (fcnt > MAX_FAM)
     counts = np.where(over, 0, cnt)
     pose_idx = np.repeat(np.arange(N), counts)

@@ -234,6 +234,11 @@ class Robot:
         return self is other or self._content() == other._content()
 
     def __hash__(self) -> int:
+        return self._hash
+
+    @cached_property
+    def _hash(self) -> int:
+        # (solve looks its reduction up by robot on every call: hashing the content each time cost ~40 us)
         return hash(self._content())
 
     def __reduce__(self) -> tuple[object, ...]:

@@ -79,7 +79,9 @@ def _theta_range(robot: Robot, red: Reduction, chain: Array, paper_limits: bool 
         lo, hi = rng[:, 0], rng[:, 1]
     else:
         lo, hi = np.full(n, robot.lower[j]), np.full(n, robot.upper[j])
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi - lo < np.inf)):
+    with np.errstate(invalid="ignore", over="ignore"):
+        finite = np.isfinite(hi - lo).all()  # (lo and hi finite, and their difference too)
+    if not finite:
         raise ShapeError(f"joint {robot.joint_names[j]} (theta*) needs finite limits to be swept")
     return lo, hi
 
@@ -93,6 +95,8 @@ CLIP_REACH_REL = 1e-4
 def _limit_copies(robot: Robot, red: Reduction, cand: Candidates, span: Array) -> Candidates:
     """``cand`` plus, for each multiple root within ``CLIP_REACH_REL`` of the range outside theta*'s limits, a copy
     at the limit (same branch). Added with and without ``limits``: both see the same candidates."""
+    if not (cand.mult >= 2).any():
+        return cand
     j = red.free_joint
     lo, hi = robot.lower[j], robot.upper[j]
     reach = CLIP_REACH_REL * span[cand.pose]

@@ -132,18 +132,32 @@ def _unit_grid(n: int) -> Array:
     return np.linspace(0.0, 1.0, n)
 
 
+def grid_hints(reduction: Reduction, poses: Array) -> Array | None:
+    """The samples ``(N, H)`` that ``sample_grid`` adds to the uniform grid (NaN: none): the reduction's hints and,
+    for a non-periodic theta*, its limits (a solution exactly at a limit, a rail end, is then a sample); for a
+    periodic theta* wrapped into [-pi, pi]."""
+    hints = reduction.sample_hints(poses)
+    if not reduction.periodic:
+        j = reduction.free_joint
+        ends = np.empty((poses.shape[0], 2))
+        ends[:, 0], ends[:, 1] = reduction.robot.lower[j], reduction.robot.upper[j]
+        hints = ends if hints is None else np.concatenate([hints, ends], axis=1)
+    if hints is not None and hints.size and reduction.periodic:
+        hints = np.pi - np.mod(np.pi - hints, 2.0 * np.pi)
+    return hints
+
+
 def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
-    """Sorted theta* samples ``(N, M)``: a uniform grid on [lo, hi] plus the reduction's hints inside it."""
+    """Sorted theta* samples ``(N, M)``: a uniform grid on [lo, hi] plus the reduction's hints inside it
+    (``grid_hints``; :func:`sweepik.fastsweep.sample_grid` is the compiled version)."""
+    return merge_grid(lo, hi, n_samples, grid_hints(reduction, poses))
+
+
+def merge_grid(lo: Array, hi: Array, n_samples: int, hints: Array | None) -> Array:
+    """``sample_grid`` from the hints: the uniform grid, the hints inside [lo, hi], sorted, repeats spread."""
     s = _unit_grid(n_samples)
     grid = lo[:, None] + (hi - lo)[:, None] * s[None, :]
-    hints = reduction.sample_hints(poses)
-    if not reduction.periodic:  # theta*'s limits: a solution exactly at a limit (a rail end) is a sample
-        j = reduction.free_joint
-        ends = np.broadcast_to([reduction.robot.lower[j], reduction.robot.upper[j]], (poses.shape[0], 2))
-        hints = ends if hints is None else np.concatenate([hints, ends], axis=1)
     if hints is not None and hints.size:
-        if reduction.periodic:
-            hints = np.pi - np.mod(np.pi - hints, 2.0 * np.pi)
         inside = np.isfinite(hints) & (hints >= lo[:, None]) & (hints <= hi[:, None])
         # a hint outside the range becomes a midpoint of the uniform grid (a distinct, harmless extra sample)
         spare = lo[:, None] + (hi - lo)[:, None] * ((np.arange(hints.shape[1]) + 0.5) / (n_samples - 1))[None, :]

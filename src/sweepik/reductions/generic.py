@@ -111,8 +111,10 @@ def _chain_rows(chain: Chain) -> Array:
 class GeometricReduction(Reduction):
     """A reduction from a :class:`Plan`: the family's compiled kernels over the generic parameter row."""
 
-    #: Set per instance (the family's pair); declared here so that ``uses_kernel`` sees this class as its owner.
+    #: Set per instance (the family's pair, and its all-branch residual); declared here so that ``uses_kernel`` and
+    #: the engine see this class as their owner.
     kernel: tuple[Any, Any] | None = None
+    kernel_residuals: Any = None
 
     def __init__(self, robot: Robot, plan: Plan) -> None:
         super().__init__(robot, plan.free_joint, plan.branches)
@@ -129,17 +131,26 @@ class GeometricReduction(Reduction):
         row[L["case"]] = CASES.index(plan.case) if plan.case in CASES else -1
         row[L["reversed"]] = float(plan.reversed)
         row[L["pos_branches"]] = plan.branches // 2 if plan.closed_form else plan.branches
+        row[L["need"]] = 3.0  # (both first-step branches, every step: see _params)
+        row[L["need_margin"]] = 7.0
+        row[L["need_amplitude"]] = 7.0
         self._row = row
         self._last_params: tuple[Array, Array] | None = None
+        self._last_range: tuple[Array, Array] | None = None
         # the wrist centre in the tool frame (the last joints do not move it)
         p_end = chain.P.sum(axis=0)
         self._w_tool = chain.R_end.T @ (np.asarray(plan.W) - p_end)
         # the pair and wrist families' kernels are made for the arm's position case (geometric.case_kernels)
-        self._case = None if plan.family == "parallel" else geometric.case_kernels(int(row[L["case"]]))
+        self._case = (
+            None
+            if plan.family == "parallel"
+            else geometric.case_kernels(int(row[L["case"]]), plan.free, tuple(bool(r) for r in chain.revolute[:4]))
+        )
         if plan.family == "parallel":
             self._kernels = (geometric.wrist_residual, geometric.parallel_configuration)
         elif plan.family == "pair":
             self._kernels = (self._case_kernels.pair_residual, self._case_kernels.pair_configuration)
+            self.kernel_residuals = self._case_kernels.pair_residuals
         else:
             assert plan.family == "wrist", plan.family
             self._kernels = (geometric.wrist_residual, self._case_kernels.wrist_configuration)
@@ -167,7 +178,7 @@ class GeometricReduction(Reduction):
         lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
         hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
         q = rng.uniform(lo, hi, size=(TWIN_POSES, robot.n_joints))
-        params = self.kernel_params(robot.T_base_world @ robot.fk(q) @ robot.T_tool_flange)
+        params = self._params(robot.T_base_world @ robot.fk(q) @ robot.T_tool_flange, probing=True)
         j = self.free_joint
         a, b = (-np.pi, np.pi) if self.periodic else (float(robot.lower[j]), float(robot.upper[j]))
         if not b - a < 1e6 * robot.length_scale:  # no practical end: around the arm
@@ -233,6 +244,17 @@ class GeometricReduction(Reduction):
         limits, so that ``limits=False`` keeps (and flags) solutions beyond the limits."""
         if self.periodic or self.closed_form:
             return None
+        last = self._last_range
+        if last is not None and last[0] is poses:  # (asked for by the solver and again by the hints)
+            return last[1]
+        out = self._search_range(poses)
+        out.setflags(write=False)
+        self._last_range = (poses, out)
+        return out
+
+    @cached_property
+    def _reach(self) -> float:
+        """R of ``search_range``."""
         chain, f = self._chain, self.plan.free
         o3 = chain.P[:4].sum(axis=0)
         R = float(np.linalg.norm(chain.P[1:4], axis=1).sum() + np.linalg.norm(np.asarray(self.plan.W) - o3))
@@ -242,13 +264,20 @@ class GeometricReduction(Reduction):
             k = n - 1 - j if self.plan.reversed else j
             if j != f and not chain.revolute[j]:
                 R += max(abs(float(self.robot.lower[k])), abs(float(self.robot.upper[k])))
+        return R
+
+    def _search_range(self, poses: Array) -> Array:
+        chain, R = self._chain, self._reach
         L = geometric.LAYOUT
         t = self.kernel_params(poses)[:, L["t"] : L["t"] + 3] - chain.P[0]
-        if f == 0:
+        out = np.empty((poses.shape[0], 2))
+        if self.plan.free == 0:
             mid = t @ chain.H[0]
-            return np.stack([mid - R, mid + R], axis=1)
-        reach = np.linalg.norm(t, axis=1) + R
-        return np.stack([-reach, reach], axis=1)
+            out[:, 0], out[:, 1] = mid - R, mid + R
+        else:
+            reach = np.sqrt(np.einsum("ij,ij->i", t, t)) + R
+            out[:, 0], out[:, 1] = -reach, reach
+        return out
 
     def sample_hints(self, poses: Array) -> Array | None:
         """Samples where the residual can change faster than the grid resolves: windows where a step's angle
@@ -265,7 +294,15 @@ class GeometricReduction(Reduction):
         swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
         ks = np.asarray(self._steps[1], dtype=np.int64)
         geometric.swing_hints(
-            self.kernel_params(poses), lo, hi, N_SAMPLES, self.periodic, ks, swings, self._case_kernels.amplitude
+            self.kernel_params(poses),
+            lo,
+            hi,
+            N_SAMPLES,
+            self.periodic,
+            ks,
+            swings,
+            self._case_kernels.amplitude,
+            self._case_kernels.amplitudes,
         )
         keep = np.any(np.isfinite(swings), axis=0)
         swings = swings[:, keep]
@@ -292,7 +329,9 @@ class GeometricReduction(Reduction):
         self._last_params = (poses, out)
         return out
 
-    def _params(self, poses: Array) -> Array:
+    def _params(self, poses: Array, probing: bool = False) -> Array:
+        """The rows; ``probing``: for ``_probe``, which finds the twins and steps that the rows' ``need`` fields
+        name (all of them there)."""
         robot = self.robot
         world = poses
         if not robot.base_is_identity:
@@ -305,10 +344,22 @@ class GeometricReduction(Reduction):
         else:
             R, p = world[:, :3, :3], world[:, :3, 3]
         L = geometric.LAYOUT
-        out = np.broadcast_to(self._row, (poses.shape[0], geometric.N_PARAMS)).copy()
+        out = np.empty((poses.shape[0], geometric.N_PARAMS))
+        out[:] = self._row if probing else self._solving_row
         out[:, L["M"] : L["M"] + 9] = (R @ self._chain.R_end.T).reshape(-1, 9)
         out[:, L["t"] : L["t"] + 3] = p + R @ self._w_tool
         return out
+
+    @cached_property
+    def _solving_row(self) -> Array:
+        """The row's pose-independent part, with the ``need`` fields of the twins and steps (once probed)."""
+        row = self._row.copy()
+        if self.plan.family == "pair":
+            L = geometric.LAYOUT
+            row[L["need"]] = sum(1 << b1 for b1 in {b // 2 for b in self.search_branches})
+            row[L["need_margin"]] = sum(1 << k for k in self._steps[0])
+            row[L["need_amplitude"]] = sum(1 << k for k in self._steps[1])
+        return row
 
     def _flat(
         self, poses: Array, theta: Array, branch: IntArray | None, n_branches: int | None = None
@@ -367,6 +418,7 @@ class _Margins(Reduction):
 
     name = "margins"
     kernel: tuple[Any, Any] | None = None
+    kernel_residuals: Any = None
 
     @property
     def search_branches(self) -> list[int]:
@@ -377,6 +429,7 @@ class _Margins(Reduction):
         self.red = red
         self.swings = swings
         self.kernel = (red._case_kernels.pair_margin, red._case_kernels.pair_configuration)
+        self.kernel_residuals = red._case_kernels.pair_margins
 
     def sample_hints(self, poses: Array) -> Array | None:
         # where a step's angle swings, the next step's margin changes as fast: a domain there can be narrow
@@ -400,6 +453,8 @@ class _Margins(Reduction):
             cand, _ = fastsweep.search(self, poses, lo, hi, sweep.N_SAMPLES)
         else:
             cand, _ = sweep.find_candidates(self, poses, lo, hi, sweep.N_SAMPLES)
+        if N == 1:
+            return cand.theta[None, :]
         counts = np.bincount(cand.pose, minlength=N)
         out = np.full((N, int(counts.max(initial=0))), np.nan)
         order = np.argsort(cand.pose, kind="stable")

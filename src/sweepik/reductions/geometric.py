@@ -43,8 +43,8 @@ from .. import parallel
 from .._jit import internal
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
-from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, LazyKernel, first_class, lazy_njit
-from .position import angle, motion, place, reduce_chain
+from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, RESIDUALS_SIG, LazyKernel, first_class, lazy_njit
+from .position import BOTH, NEITHER, angle, motion, place, reduce_chain
 
 Array = NDArray[np.float64]
 
@@ -61,13 +61,17 @@ LAYOUT = {
     "case": 64,  # position case (index into position.CASES)
     "reversed": 65,  # 1: the chain is reversed, joints are written back in reverse order
     "pos_branches": 66,  # branches of the position case (the wrist family multiplies them by 2)
+    "need": 67,  # first-step branches whose residuals the all-branch kernel computes: bit b1 (twins skip some)
+    "need_margin": 68,  # steps whose margins the all-branch margin kernel computes: bit k
+    "need_amplitude": 69,  # the same for the amplitudes (swing hints)
 }
-N_PARAMS = 67
+N_PARAMS = 70
 # The offsets as module constants (Numba freezes globals into the compiled kernels: a change of LAYOUT needs the
 # on-disk cache cleared, see docs/decomposition.md).
 _H, _P, _REV, _M = LAYOUT["H"], LAYOUT["P"], LAYOUT["rev"], LAYOUT["M"]
 _T, _W, _O, _FREE = LAYOUT["t"], LAYOUT["W"], LAYOUT["O"], LAYOUT["free"]
 _CASE, _REVERSED, _POS_BRANCHES = LAYOUT["case"], LAYOUT["reversed"], LAYOUT["pos_branches"]
+_NEED, _NEED_MARGIN, _NEED_AMPLITUDE = LAYOUT["need"], LAYOUT["need_margin"], LAYOUT["need_amplitude"]
 
 
 # Read with constant offsets all over the kernels: as jitable functions (typed for an int64 offset first), not
@@ -105,10 +109,13 @@ def _mat_t(p, v):
 
 
 @internal
-def _arm(p, x, branch, case):
-    """Motions ``(m0, m1, m2, m3)`` (``position.motion``) of the first four joints with joint ``free`` at ``x``,
-    and the cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the position case's steps (``position.place``).
-    ``case``: the position case, a constant of the kernel (see ``case_kernels``)."""
+def _arm(p, x, b1, b2, case, f, rev):
+    """The first four joints with joint ``free`` at ``x``, on branch ``b1`` of the position case's first step and
+    ``b2`` of its second (``position.place``: 0, 1, both or neither): ``(A, B, c1, c2, a1, a2)`` with ``A`` the
+    motions ``(m0, m1, m2, m3)`` (``position.motion``) of branch ``2 b1``, ``B`` those of branch ``2 b1 + 1``, the
+    cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the case's steps. ``case`` (the position case), ``f``
+    (theta*'s index among the first four joints) and ``rev`` (their types, True: revolute): constants of the kernel
+    (see ``case_kernels``)."""
     h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
     r0, r1, r2, r3 = p[_REV] > 0.5, p[_REV + 1] > 0.5, p[_REV + 2] > 0.5, p[_REV + 3] > 0.5
     s0, s1, s2, s3 = _v(p, _P), _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
@@ -116,8 +123,6 @@ def _arm(p, x, branch, case):
     o2 = (o1[0] + s2[0], o1[1] + s2[1], o1[2] + s2[2])
     o3 = (o2[0] + s3[0], o2[1] + s3[1], o2[2] + s3[2])
     s4 = sub(_v(p, _W), o3)
-    f = int(p[_FREE])
-    rev = (r0, r1, r2, r3)
     mx = motion(rev[f], x)
     tp, ha, hb, hc, pab, pbc, pcw = reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, mx, _v(p, _T))
     meet = _v(p, _O)
@@ -131,20 +136,32 @@ def _arm(p, x, branch, case):
         o = sub(meet, pts[b])
         if f == 1 and r1:
             o = rot_cs(h1, mx[0], mx[1], o)
-    ma, mb, mc, c1, c2, a1, a2 = place(case, branch, tp, ha, hb, hc, rev[a], rev[b], rev[c], pab, pbc, pcw, o)
+    ra, rb, rc = rev[a], rev[b], rev[c]
+    ma, mb, mc, na, nb, nc, c1, c2, a1, a2 = place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
     if f == 0:
-        return mx, ma, mb, mc, c1, c2, a1, a2
+        return (mx, ma, mb, mc), (mx, na, nb, nc), c1, c2, a1, a2
     if f == 1:
-        return ma, mx, mb, mc, c1, c2, a1, a2
+        return (ma, mx, mb, mc), (na, mx, nb, nc), c1, c2, a1, a2
     if f == 2:
-        return ma, mb, mx, mc, c1, c2, a1, a2
-    return ma, mb, mc, mx, c1, c2, a1, a2
+        return (ma, mb, mx, mc), (na, nb, mx, nc), c1, c2, a1, a2
+    return (ma, mb, mc, mx), (na, nb, nc, mx), c1, c2, a1, a2
 
 
 @internal
 def _missing(m0, m1, m2, m3):
     """Some motion is NaN (an unknown case, dependent prismatic directions)."""
     return math.isnan(m0[0] + m0[2] + m1[0] + m1[2] + m2[0] + m2[2] + m3[0] + m3[2])
+
+
+@internal
+def _orientation(p, m, c1, c2):
+    """The pair family's residual for the motions ``m`` of the first four joints and the cosines of the position
+    case's steps: NaN outside the branch's domain."""
+    m0, m1, m2, m3 = m
+    if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
+        return math.nan
+    h4, h5 = _h(p, 4), _h(p, 5)
+    return dot(_fore(p, m0, m1, m2, m3, h4), _mat(p, h5)) - dot(h4, h5)
 
 
 @internal
@@ -193,9 +210,9 @@ def _write(p, out, m0, m1, m2, m3, q4, q5):
 
 
 # Steps of the position case: k = 0 is its first step, k = 1, 2 its second step on the first step's branch k - 1.
-# ``_arm(p, x, b, case)`` with ``b = 0`` for k = 0, else ``2 (k - 1)``, holds step k's cosine at index 4 (k = 0) or 5
-# and its amplitude at 6 or 7. (The margin and amplitude kernels, ``case_kernels``, call _arm themselves rather than
-# through a helper: each compiled level re-optimises everything it calls.)
+# ``_arm(p, x, b1, NEITHER, case, free, rev)`` with ``b1 = 0`` for k = 0, else ``k - 1``, holds step k's cosine at
+# index 2 (k = 0) or 3 and its amplitude at 4 or 5. (The margin and amplitude kernels, ``case_kernels``, call _arm
+# themselves rather than through a helper: each compiled level re-optimises everything it calls.)
 
 
 @internal
@@ -302,22 +319,29 @@ SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
 @njit(cache=True, nogil=True)
-def _swing(amp, params, lo, hi, n, periodic, ks, out, start, stop):
+def _swing(amp, amps, params, lo, hi, n, periodic, ks, out, start, stop):
     """Swing hints of poses ``start .. stop - 1`` (``swing_hints``). ``amp``: ``amplitude`` as a first-class
     function (called, not linked in: Numba re-optimises everything a compiled function links, and the amplitude
-    links the whole position case); one function rather than a loop calling a per-pose one, for the same reason."""
+    links the whole position case), ``amps`` every step's at once (``amplitudes``, for the scan's samples); one
+    function rather than a loop calling a per-pose one, for the same reason."""
+    scan = np.empty((n + 3, 3))  # the amplitudes at lo - h, lo, lo + h, ..., lo + (n + 1) h
+    vals = np.empty(3)
     for i in range(start, stop):
         g = (math.sqrt(5.0) - 1.0) / 2.0
         p = params[i]
         h = (hi[i] - lo[i]) / n
         cnt = 0
+        for j in range(n + 3 if ks.shape[0] > 0 else 0):
+            amps(p, lo[i] - h if j == 0 else (lo[i] if j == 1 else lo[i] + (j - 1) * h), vals)
+            for m in range(3):
+                scan[j, m] = vals[m]
         for k in ks:
             found = 0
-            xm, am = lo[i] - h, amp(p, lo[i] - h, k)
-            x0, a0 = lo[i], amp(p, lo[i], k)
+            xm, am = lo[i] - h, scan[0, k]
+            x0, a0 = lo[i], scan[1, k]
             for j in range(1, n + 2):
                 x1 = lo[i] + j * h
-                a1 = amp(p, x1, k)
+                a1 = scan[j + 1, k]
                 # a minimum can hide a window narrower than the grid only if it is deep compared with the rise
                 # to its neighbours (V-shaped: r = sqrt(r*^2 + r'^2 (x - x*)^2) with r* < |r'| h)
                 deep = a0 < SWING_DEPTH * max(am - a0, a1 - a0)
@@ -357,15 +381,28 @@ def _swing(amp, params, lo, hi, n, periodic, ks, out, start, stop):
                 xm, am, x0, a0 = x0, a0, x1, a1
 
 
-def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude):
+def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
     """Samples of theta* ``out (N, SWING_PER_POSE)`` (NaN-padded) where a step of the position case is nearly
     degenerate: around each local minimum ``r*`` of its amplitude ``r(theta*)`` narrower than the grid step
     ``h``, where its angles turn by up to pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
-    ``amplitude`` of ``case_kernels``: the arm's kernel, given as ``amplitude``). Batches use both cores, as
-    the engine's search."""
+    ``amplitude`` of ``case_kernels``: the arm's kernel, given as ``amplitude``, with ``amplitudes`` its all-step
+    kernel, which must compute at least the steps ``ks``). Batches use both cores, as the engine's search."""
     from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
 
-    parallel.run(_swing, params.shape[0], PARALLEL_MIN, first_class(amplitude), params, lo, hi, n, periodic, ks, out)
+    parallel.run(
+        _swing,
+        params.shape[0],
+        PARALLEL_MIN,
+        first_class(amplitude),
+        first_class(amplitudes),
+        params,
+        lo,
+        hi,
+        n,
+        periodic,
+        ks,
+        out,
+    )
 
 
 wrist_residual = LazyKernel(_no_residual, RESIDUAL_SIG, cache=True)
@@ -442,41 +479,64 @@ def parallel_singular(params, out):
 class CaseKernels(NamedTuple):
     """The compiled kernels of the pair and wrist families for one position case (``position.CASES``): Python calls
     ``wrist_singular(params, out)``; the others are :class:`~.kernels.LazyKernel` objects with the engine's
-    signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch)."""
+    signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch;
+    ``pair_residuals`` and ``pair_margins`` are their all-branch kernels, ``Reduction.kernel_residuals``)."""
 
     pair_residual: Any
+    pair_residuals: Any
     pair_configuration: Any
     pair_margin: Any
+    pair_margins: Any
     amplitude: Any
+    amplitudes: Any
     wrist_configuration: Any
     wrist_singular: Any
 
 
-_CASE_KERNELS: dict[int, CaseKernels] = {}
+_CASE_KERNELS: dict[tuple[int, int, tuple[bool, ...]], CaseKernels] = {}
 
 
-def case_kernels(case: int) -> CaseKernels:
-    """The pair and wrist families' kernels for position case ``case`` (its index in ``position.CASES``; -1: none).
+def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernels:
+    """The pair and wrist families' kernels for position case ``case`` (its index in ``position.CASES``; -1: none),
+    theta* the joint ``free`` (0-3) of the solved chain's first four, whose types are ``revolute`` (4 booleans).
 
-    One set per case, each compiled on first use: the case is a constant of the kernels (a closure variable, which
-    Numba types as a literal), so an arm compiles the chain of subproblems of its own case only and not the
-    others' (``position.place``). Numba's disk cache keeps one entry per case (it keys a closure on its variables).
+    One set per arm structure, each compiled on first use: these are constants of the kernels (closure variables,
+    which Numba types as literals), so an arm compiles the chain of subproblems of its own case only and not the
+    others' (``position.place``), and the compiler drops the branches for other theta* and joint types (about 15 %
+    of a residual's time). Numba's disk cache keeps one entry per set (it keys a closure on its variables).
     """
-    case = int(case)
-    ck = _CASE_KERNELS.get(case)
+    case, free = int(case), int(free)
+    rev = tuple(bool(r) for r in revolute)
+    if len(rev) != 4 or not 0 <= free <= 3:
+        raise ValueError(f"case_kernels: free={free} must be 0-3 and revolute 4 booleans, not {revolute!r}")
+    key = (case, free, rev)
+    ck = _CASE_KERNELS.get(key)
     if ck is None:
         # (the kernels' bodies are here, not in functions they call with the case: Numba re-optimises all that
         # a compiled function calls, and a level more costs ~0.3 s per kernel on a fresh install)
 
         def residual(p, x, branch):
-            m0, m1, m2, m3, c1, c2, _, _ = _arm(p, x, branch, case)
-            if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
-                return math.nan
-            h4, h5 = _h(p, 4), _h(p, 5)
-            return dot(_fore(p, m0, m1, m2, m3, h4), _mat(p, h5)) - dot(h4, h5)
+            arm = _arm(p, x, branch // 2, branch % 2, case, free, rev)
+            m = arm[0] if branch % 2 == 0 else arm[1]
+            return _orientation(p, m, arm[2], arm[3])
+
+        def residuals(p, x, out):
+            """Every branch's ``residual`` at once (``Reduction.kernel_residuals``): the two branches of each first
+            step share its work, and a first step whose branches the search skips (twins, ``LAYOUT['need']``) is
+            not computed (its entries are left as they are)."""
+            nb = int(p[_POS_BRANCHES])
+            need = int(p[_NEED])
+            both = BOTH + 0 * nb  # (a run-time value: see position.place)
+            for b1 in range((nb + 1) // 2):
+                if need & (1 << b1):
+                    arm = _arm(p, x, b1, both, case, free, rev)
+                    out[2 * b1] = _orientation(p, arm[0], arm[2], arm[3])
+                    if 2 * b1 + 1 < nb:
+                        out[2 * b1 + 1] = _orientation(p, arm[1], arm[2], arm[3])
 
         def configuration(p, x, branch, out):
-            m0, m1, m2, m3, _, _, _, _ = _arm(p, x, branch, case)
+            arm = _arm(p, x, branch // 2, branch % 2, case, free, rev)
+            m0, m1, m2, m3 = arm[0] if branch % 2 == 0 else arm[1]
             if _missing(m0, m1, m2, m3):
                 for i in range(6):
                     out[i] = math.nan
@@ -487,20 +547,45 @@ def case_kernels(case: int) -> CaseKernels:
         def margin(p, x, k):
             """``1 - c^2`` of step k's cosine c: positive inside the branch domains, zero at their edges (found by
             the same sweep, and sampled as hints)."""
-            b = 0 if k == 0 else 2 * (k - 1)  # (one call: a constant branch would compile _arm and place once more)
-            arm = _arm(p, x, b, case)
-            c = arm[4] if k == 0 else arm[5]
+            arm = _arm(p, x, 0 if k == 0 else k - 1, NEITHER + 0 * k, case, free, rev)
+            c = arm[2] if k == 0 else arm[3]
             return 1.0 - c * c
+
+        def margins(p, x, out):
+            """``margin`` of steps 0 and 1 (one first-step branch) and of step 2 (the other) at once, as they are
+            wanted (``LAYOUT['need_margin']``: bit k for step k)."""
+            need = int(p[_NEED_MARGIN])
+            neither = NEITHER + 0 * need
+            if need & 3:
+                arm = _arm(p, x, 0 * need, neither, case, free, rev)
+                out[0] = 1.0 - arm[2] * arm[2]
+                out[1] = 1.0 - arm[3] * arm[3]
+            if need & 4:
+                arm = _arm(p, x, 1 + 0 * need, neither, case, free, rev)
+                out[2] = 1.0 - arm[3] * arm[3]
 
         def amplitude(p, x, k):
             """Amplitude of step k (see ``margin``)."""
-            b = 0 if k == 0 else 2 * (k - 1)
-            arm = _arm(p, x, b, case)
-            return arm[6] if k == 0 else arm[7]
+            arm = _arm(p, x, 0 if k == 0 else k - 1, NEITHER + 0 * k, case, free, rev)
+            return arm[4] if k == 0 else arm[5]
+
+        def amplitudes(p, x, out):
+            """``amplitude`` of the steps wanted (``LAYOUT['need_amplitude']``: bit k for step k) at once."""
+            need = int(p[_NEED_AMPLITUDE])
+            neither = NEITHER + 0 * need
+            if need & 3:
+                arm = _arm(p, x, 0 * need, neither, case, free, rev)
+                out[0] = arm[4]
+                out[1] = arm[5]
+            if need & 4:
+                arm = _arm(p, x, 1 + 0 * need, neither, case, free, rev)
+                out[2] = arm[5]
 
         def wrist(p, x, branch, out):
             nb = int(p[_POS_BRANCHES])
-            m0, m1, m2, m3, _, _, _, _ = _arm(p, 0.0, branch // 2, case)
+            pb = branch // 2  # the position branch
+            arm = _arm(p, 0.0, pb // 2, pb % 2, case, free, rev)
+            m0, m1, m2, m3 = arm[0] if pb % 2 == 0 else arm[1]
             if _missing(m0, m1, m2, m3) or branch >= 2 * nb:
                 for i in range(6):
                     out[i] = math.nan
@@ -527,18 +612,22 @@ def case_kernels(case: int) -> CaseKernels:
                 p = params[i]
                 out[i] = False
                 for b in range(int(p[_POS_BRANCHES])):
-                    m0, m1, m2, m3, c1, c2, _, _ = _arm(p, 0.0, b, case)
-                    if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
+                    arm = _arm(p, 0.0, b // 2, b % 2, case, free, rev)
+                    m0, m1, m2, m3 = arm[0] if b % 2 == 0 else arm[1]
+                    if _missing(m0, m1, m2, m3) or not (in_domain(arm[2]) and in_domain(arm[3])):
                         continue
                     v = _back(p, m0, m1, m2, m3, _mat(p, h5))
                     if norm(cross(v, h3)) < WRIST_SINGULAR:
                         out[i] = True
 
-        ck = _CASE_KERNELS[case] = CaseKernels(
+        ck = _CASE_KERNELS[key] = CaseKernels(
             LazyKernel(residual, RESIDUAL_SIG, cache=True),
+            LazyKernel(residuals, RESIDUALS_SIG, cache=True),
             LazyKernel(configuration, CONFIGURATION_SIG, cache=True),
             LazyKernel(margin, RESIDUAL_SIG, cache=True),
+            LazyKernel(margins, RESIDUALS_SIG, cache=True),
             LazyKernel(amplitude, RESIDUAL_SIG, cache=True),
+            LazyKernel(amplitudes, RESIDUALS_SIG, cache=True),
             LazyKernel(wrist, CONFIGURATION_SIG, cache=True),
             njit(cache=True)(singular),
         )

@@ -44,7 +44,7 @@ from .._jit import internal
 from ..subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
 from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
-__all__ = ["CASES", "BRANCHES", "reduce_chain", "place", "motion", "angle", "move", "move_back"]
+__all__ = ["CASES", "BRANCHES", "BOTH", "NEITHER", "reduce_chain", "place", "motion", "angle", "move", "move_back"]
 
 #: Case names, in the order of their integer codes in a family's parameter row.
 CASES = ("ab_par", "bc_par", "ab_int", "bc_int", "ppp", "ppr", "ac_par")
@@ -138,6 +138,22 @@ def reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, t):
     return tp, h0, h1, h2, s1, s2, add(s3, move(h3, r3, x, s4))
 
 
+#: ``b2`` of ``place``: both second-step branches, or neither (only the cosines and amplitudes are wanted).
+BOTH = -1
+NEITHER = 2
+_NO_ANGLE = (math.nan, math.nan)
+
+
+@internal
+def _first(b2):
+    return b2 == 0 or b2 == BOTH
+
+
+@internal
+def _second(b2):
+    return b2 == 1 or b2 == BOTH
+
+
 @internal
 def _line_cos(disc, d):
     """A line-sphere discriminant as the cosine of a circle subproblem (|c| <= 1 inside the domain)."""
@@ -147,10 +163,8 @@ def _line_cos(disc, d):
 
 
 @internal
-def _ab_par(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+def _ab_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ab_par`` of ``place``: the height along h_a does not depend on qa, qb."""
-    b1 = branch // 2
-    b2 = branch % 2
     c1 = 0.0
     r1 = math.inf
     height = dot(ha, sub(sub(tp, pab), pbc))
@@ -159,20 +173,17 @@ def _ab_par(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         mc = _rev(ua, va) if b1 == 0 else _rev(ub, vb)
     else:
         mc = _pris(lp4(ha, pcw, hc, height))
-        b2 = branch
     w = add(pbc, move(hc, rc, mc, pcw))
     ua, va, ub, vb, c2, r2 = sp3_cs(w, scale(-1.0, pab), hb, norm(tp))
-    mb = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
     # (rot_cs for move(hb, True, ...): a constant True would have move compiled once more, for its literal type)
-    ca, sa = sp1_cs(add(pab, rot_cs(hb, mb[0], mb[1], w)), tp, ha)
-    return _rev(ca, sa), mb, mc, c1, c2, r1, r2
+    ca, sa = sp1_cs(add(pab, rot_cs(hb, ua, va, w)), tp, ha) if _first(b2) else _NO_ANGLE
+    cb, sb = sp1_cs(add(pab, rot_cs(hb, ub, vb, w)), tp, ha) if _second(b2) else _NO_ANGLE
+    return _rev(ca, sa), _rev(ua, va), mc, _rev(cb, sb), _rev(ub, vb), mc, c1, c2, r1, r2
 
 
 @internal
-def _bc_par(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+def _bc_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``bc_par`` of ``place``: the height along h_b does not depend on qb, qc."""
-    b1 = branch // 2
-    b2 = branch % 2
     c1 = 0.0
     r1 = math.inf
     height = dot(hb, add(add(pab, pbc), pcw))
@@ -181,19 +192,16 @@ def _bc_par(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         ma = _rev(ua, -va) if b1 == 0 else _rev(ub, -vb)
     else:
         ma = _pris(lp4(hb, tp, scale(-1.0, ha), height))
-        b2 = branch
     target = sub(move_back(ha, ra, ma, tp), pab)
     ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, pbc), hc, norm(target))
-    mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-    cb, sb = sp1_cs(add(pbc, rot_cs(hc, mc[0], mc[1], pcw)), target, hb)
-    return ma, _rev(cb, sb), mc, c1, c2, r1, r2
+    ca, sa = sp1_cs(add(pbc, rot_cs(hc, ua, va, pcw)), target, hb) if _first(b2) else _NO_ANGLE
+    cb, sb = sp1_cs(add(pbc, rot_cs(hc, ub, vb, pcw)), target, hb) if _second(b2) else _NO_ANGLE
+    return ma, _rev(ca, sa), _rev(ua, va), ma, _rev(cb, sb), _rev(ub, vb), c1, c2, r1, r2
 
 
 @internal
-def _ab_int(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+def _ab_int(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ab_int`` of ``place``: |W - O| depends on qc only."""
-    b1 = branch // 2
-    b2 = branch % 2
     c1 = 0.0
     r1 = math.inf
     base = add(sub(pab, o), pbc)
@@ -207,16 +215,12 @@ def _ab_int(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         mc = _pris(u if b1 == 0 else v)
     w0 = add(base, move(hc, rc, mc, pcw))
     c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c2, r2 = sp2_cs(sub(tp, o), w0, ha, hb)
-    if b2 == 0:
-        return _rev(c1a, -s1a), _rev(c2a, s2a), mc, c1, c2, r1, r2
-    return _rev(c1b, -s1b), _rev(c2b, s2b), mc, c1, c2, r1, r2
+    return _rev(c1a, -s1a), _rev(c2a, s2a), mc, _rev(c1b, -s1b), _rev(c2b, s2b), mc, c1, c2, r1, r2
 
 
 @internal
-def _bc_int(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+def _bc_int(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``bc_int`` of ``place``: |W - O| is fixed; O moves with joint a only."""
-    b1 = branch // 2
-    b2 = branch % 2
     c1 = 0.0
     r1 = math.inf
     w1 = add(sub(pbc, o), pcw)
@@ -231,55 +235,56 @@ def _bc_int(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         ma = _pris(u if b1 == 0 else v)
     target = sub(move_back(ha, ra, ma, tp), centre)
     c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c2, r2 = sp2_cs(target, w1, hb, hc)
-    if b2 == 0:
-        return ma, _rev(c1a, -s1a), _rev(c2a, s2a), c1, c2, r1, r2
-    return ma, _rev(c1b, -s1b), _rev(c2b, s2b), c1, c2, r1, r2
+    return ma, _rev(c1a, -s1a), _rev(c2a, s2a), ma, _rev(c1b, -s1b), _rev(c2b, s2b), c1, c2, r1, r2
 
 
 @internal
-def _ppp(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
-    """Case ``ppp`` of ``place``."""
+def _ppp(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``ppp`` of ``place`` (one branch: the second outcome repeats the first)."""
     qa, qb, qc = lines3(ha, hb, hc, sub(sub(sub(tp, pab), pbc), pcw))
-    return _pris(qa), _pris(qb), _pris(qc), 0.0, 0.0, math.inf, math.inf
+    ma, mb, mc = _pris(qa), _pris(qb), _pris(qc)
+    return ma, mb, mc, ma, mb, mc, 0.0, 0.0, math.inf, math.inf
 
 
 @internal
-def _ppr(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+def _ppr(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ppr`` of ``place``: the height along ha x hb does not depend on qa, qb."""
-    b2 = branch % 2
-    c1 = 0.0
-    r1 = math.inf
     n = cross(ha, hb)
     if norm(n) == 0.0:  # parallel slides (a blind spot of a plan whose slides turn with theta*)
-        nan = (math.nan, math.nan, math.nan)
-        return nan, nan, nan, math.nan, math.nan, math.nan, math.nan
+        return _no_case(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
     n = unit(n)
     ua, va, ub, vb, c2, r2 = sp4_cs(n, pcw, hc, dot(n, sub(sub(tp, pab), pbc)))
-    mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-    qa, qb = lines2(ha, hb, sub(sub(sub(tp, pab), pbc), rot_cs(hc, mc[0], mc[1], pcw)))
-    return _pris(qa), _pris(qb), mc, c1, c2, r1, r2
+    rest = sub(sub(tp, pab), pbc)
+    qa, qb = lines2(ha, hb, sub(rest, rot_cs(hc, ua, va, pcw))) if _first(b2) else _NO_ANGLE
+    qa2, qb2 = lines2(ha, hb, sub(rest, rot_cs(hc, ub, vb, pcw))) if _second(b2) else _NO_ANGLE
+    return _pris(qa), _pris(qb), _rev(ua, va), _pris(qa2), _pris(qb2), _rev(ub, vb), 0.0, c2, math.inf, r2
 
 
 @internal
-def _ac_par(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+def _ac_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ac_par`` of ``place``: the height along ha fixes the prismatic b."""
-    b2 = branch % 2
-    c1 = 0.0
-    r1 = math.inf
     qb = lp4(ha, add(add(pab, pbc), pcw), hb, dot(ha, tp))
     w = add(add(pab, scale(qb, hb)), pbc)
     ua, va, ub, vb, c2, r2 = sp3_cs(pcw, scale(-1.0, w), hc, norm(tp))
-    mc = _rev(ua, va) if b2 == 0 else _rev(ub, vb)
-    ca, sa = sp1_cs(add(w, rot_cs(hc, mc[0], mc[1], pcw)), tp, ha)
-    return _rev(ca, sa), _pris(qb), mc, c1, c2, r1, r2
+    ca, sa = sp1_cs(add(w, rot_cs(hc, ua, va, pcw)), tp, ha) if _first(b2) else _NO_ANGLE
+    cb, sb = sp1_cs(add(w, rot_cs(hc, ub, vb, pcw)), tp, ha) if _second(b2) else _NO_ANGLE
+    return _rev(ca, sa), _pris(qb), _rev(ua, va), _rev(cb, sb), _pris(qb), _rev(ub, vb), 0.0, c2, math.inf, r2
 
 
-def place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
-    """Motions ``(ma, mb, mc)`` (see ``motion``) of ``branch`` putting ``W`` at ``tp``, the cosines ``(c1, c2)`` of
-    its two-solution steps (0 for a one-solution step): ``|c| <= 1`` inside the branch's domain, and their
-    amplitudes ``(r1, r2)`` (inf for a one-solution step): where one nears 0 the step's angle swings fast. Outside
-    the domain the steps continue with least squares (NaN only for an unknown case or dependent prismatic
-    directions).
+def place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Motions putting ``W`` at ``tp`` on branch ``b1`` of the first step and branch ``b2`` of the second (0, 1,
+    ``BOTH`` or ``NEITHER``): ``(ma, mb, mc)`` (see ``motion``) of branch ``2 b1``, those of branch ``2 b1 + 1``
+    (NaN where not asked for, except in a case that gets them at no cost), the cosines ``(c1, c2)`` of
+    the two steps (0 for a one-solution step): ``|c| <= 1`` inside the branch's domain, and their amplitudes
+    ``(r1, r2)`` (inf for a one-solution step): where one nears 0 the step's angle swings fast. Outside the domain
+    the steps continue with least squares (NaN only for an unknown case or dependent prismatic directions). A case
+    whose first step has one solution ignores ``b1`` (its branches are 0 and 1); one with a single branch gives it
+    twice.
+
+    Both second-step branches at once (``BOTH``): they share the first step and the second step's subproblem, so
+    that a kernel wanting every branch (``geometric.case_kernels``, ``residuals``) does that work once per ``b1``.
+    ``b2`` should be a run-time value in the caller (a constant would have Numba compile this once more for its
+    literal type); the compiler still drops the unused final steps when the caller's value is known.
 
     ``o``: for ``ab_int`` the meeting point of axes a and b relative to joint a's point; for ``bc_int`` that of b
     and c relative to joint b's point, in the reduced chain's frame.
@@ -296,39 +301,39 @@ _CASE_FUNCTIONS = (_ab_par, _bc_par, _ab_int, _bc_int, _ppp, _ppr, _ac_par)
 
 
 @internal
-def _no_case(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+def _no_case(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """An unknown case: NaN motions."""
     nan = (math.nan, math.nan, math.nan)
-    return nan, nan, nan, math.nan, math.nan, math.nan, math.nan
+    return nan, nan, nan, nan, nan, nan, math.nan, math.nan, math.nan, math.nan
 
 
 @overload(place, prefer_literal=True)
-def _place(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+def _place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """``place`` in compiled code: the case's own function for a constant ``case``, else a dispatch over them all."""
     if isinstance(case, types.IntegerLiteral):
         k = case.literal_value
         fn = _CASE_FUNCTIONS[k] if 0 <= k < len(_CASE_FUNCTIONS) else _no_case
 
-        def one(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
-            return fn(branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        def one(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+            return fn(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
 
         return one
 
-    def every(case, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    def every(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
         if case == 0:
-            return place(0, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+            return place(0, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         if case == 1:
-            return place(1, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+            return place(1, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         if case == 2:
-            return place(2, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+            return place(2, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         if case == 3:
-            return place(3, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+            return place(3, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         if case == 4:
-            return place(4, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+            return place(4, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         if case == 5:
-            return place(5, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+            return place(5, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         if case == 6:
-            return place(6, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
-        return place(-1, branch, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+            return place(6, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        return place(-1, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
 
     return every
