@@ -1,8 +1,8 @@
 """Benchmark script: the same code as ``sweepik bench`` (see sweepik.bench); run from the repository root.
 
-    python benchmarks/bench.py            # full run (a)-(d), table
-    python benchmarks/bench.py --json     # machine-readable
-    python benchmarks/bench.py --numpy    # the NumPy engine only (as without the 'fast' extra)
+python benchmarks/bench.py            # full run (a)-(d), table
+python benchmarks/bench.py --json     # machine-readable
+python benchmarks/bench.py --numpy    # the NumPy engine only (as without the 'fast' extra)
 """
 
 from __future__ import annotations

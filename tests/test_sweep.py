@@ -118,3 +118,83 @@ def test_all_branch_kernel_is_bitwise_the_branch_kernel() -> None:
         kernel = (kernels.carm_theta2_residual, kernels.carm_theta2_configuration)
 
     assert fastsweep._kernel_residuals(OwnKernel(CARM)) is None
+
+
+def _pair_reductions() -> list[sweepik.GeometricReduction]:
+    """Every pair plan (swept theta*) of the bundled swept arms and of the C-Arm (its four plans: three position
+    cases, a prismatic and two revolute theta*)."""
+    from sweepik.reductions.decompose import plans
+
+    out = []
+    for name in ("carm", "kinova_jaco2", "xarm6", "fanuc_crx10ia", "yaskawa_hc10"):
+        robot = load_robot(name)
+        for plan in plans(robot):
+            if plan.family == "pair":
+                out.append(sweepik.GeometricReduction(robot, plan))
+    return out
+
+
+@pytest.mark.parametrize("red", _pair_reductions(), ids=lambda r: f"{r.robot.name}-{r.name}-{r.plan.case}")
+def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(red: sweepik.GeometricReduction) -> None:
+    """The generic pair family's all-branch residual, margin and amplitude kernels (the position case's branches
+    share their first steps) give exactly, bit for bit, what the one-branch kernels give, on the branches and steps
+    the search asks for (twins and constant steps are skipped: their entries are never read)."""
+    from sweepik import solver
+
+    robot = red.robot
+    rng = np.random.default_rng(3)
+    q = rng.uniform(robot.lower, robot.upper, size=(60, robot.n_joints))
+    q[:10, 4] = 0.0  # a straight wrist
+    chain = solver._chain_poses(robot, robot.fk(q))
+    params = red.kernel_params(chain)
+    lo, hi = solver._theta_range(robot, red, chain)
+    ck = red._case_kernels
+    branches, margins, amplitudes = red.search_branches, red._steps[0], red._steps[1]
+    assert branches and fastsweep._kernel_residuals(red) is ck.pair_residuals
+    out = np.full(max(3, red.n_branches), np.nan)
+
+    def same(a: float, b: float) -> bool:
+        return a == b or (np.isnan(a) and np.isnan(b))
+
+    for i in range(len(q)):
+        for th in np.concatenate([rng.uniform(lo[i], hi[i], 30), [lo[i], hi[i]]]):
+            ck.pair_residuals(params[i], float(th), out)
+            for b in branches:
+                assert same(out[b], ck.pair_residual(params[i], float(th), b))
+            ck.pair_margins(params[i], float(th), out)
+            for k in margins:
+                assert same(out[k], ck.pair_margin(params[i], float(th), k))
+            ck.amplitudes(params[i], float(th), out)
+            for k in amplitudes:
+                assert same(out[k], ck.amplitude(params[i], float(th), k))
+
+
+def test_compiled_sample_grid_is_the_numpy_one() -> None:
+    """``fastsweep.sample_grid`` (compiled merge) gives the reference's samples exactly: hints inside and outside
+    the range, NaN hints, hints on the uniform grid and repeated (runs of equal samples spread), real reductions."""
+    from sweepik import solver, sweep
+
+    rng = np.random.default_rng(4)
+    for name, reduction in (("carm", "carm-d1"), ("carm", "carm-theta2"), ("carm", "auto"), ("xarm6", "auto")):
+        robot = load_robot(name)
+        red = sweepik.get_reduction(robot, reduction)
+        chain = solver._chain_poses(robot, robot.fk(rng.uniform(robot.lower, robot.upper, (200, robot.n_joints))))
+        lo, hi = solver._theta_range(robot, red, chain)
+        ref = sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
+        np.testing.assert_array_equal(fastsweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES), ref)
+
+    class Hinted(sweepik.CArmD1):
+        def sample_hints(self, poses: np.ndarray) -> np.ndarray:
+            return hints
+
+    N, n = 300, 11
+    lo = rng.uniform(-900.0, 0.0, N)
+    hi = lo + rng.uniform(1.0, 3000.0, N)
+    on_grid = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, n)[rng.integers(0, n, (N, 8))]
+    hints = np.where(rng.random((N, 8)) < 0.5, on_grid, rng.uniform(-2000.0, 4000.0, (N, 8)))
+    hints[rng.random((N, 8)) < 0.2] = np.nan
+    hints[:, 3] = hints[:, 2]
+    red = Hinted(CARM)
+    poses = np.broadcast_to(np.eye(4), (N, 4, 4))
+    ref = sweep.sample_grid(red, poses, lo, hi, n)
+    np.testing.assert_array_equal(fastsweep.sample_grid(red, poses, lo, hi, n), ref)
