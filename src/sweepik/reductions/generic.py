@@ -275,7 +275,7 @@ class GeometricReduction(Reduction):
             mid = t @ chain.H[0]
             out[:, 0], out[:, 1] = mid - R, mid + R
         else:
-            reach = np.sqrt(np.einsum("ij,ij->i", t, t)) + R
+            reach = np.linalg.norm(t, axis=1) + R
             out[:, 0], out[:, 1] = -reach, reach
         return out
 

@@ -117,7 +117,7 @@ def _arm(p, x, b1, b2, case, f, rev):
     (theta*'s index among the first four joints) and ``rev`` (their types, True: revolute): constants of the kernel
     (see ``case_kernels``)."""
     h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
-    r0, r1, r2, r3 = p[_REV] > 0.5, p[_REV + 1] > 0.5, p[_REV + 2] > 0.5, p[_REV + 3] > 0.5
+    r0, r1, r2, r3 = rev
     s0, s1, s2, s3 = _v(p, _P), _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
     o1 = (s0[0] + s1[0], s0[1] + s1[1], s0[2] + s1[2])
     o2 = (o1[0] + s2[0], o1[1] + s2[1], o1[2] + s2[2])
