@@ -617,6 +617,8 @@ if AVAILABLE:
 def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
     """:func:`sweepik.sweep.sample_grid`, the merge compiled (for a single pose its NumPy steps cost ~80 us)."""
     hints = _ref.grid_hints(reduction, poses)
+    if not AVAILABLE:
+        return _ref.merge_grid(lo, hi, n_samples, hints)
     N = poses.shape[0]
     if hints is None:
         hints = np.empty((N, 0))
