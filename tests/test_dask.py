@@ -105,6 +105,30 @@ def test_resume_solves_only_missing_chunks(client: Client, carm_poses: tuple[np.
         solve_dask(CARM, other, client, out=path, resume=True)
 
 
+def test_store_that_cannot_be_resumed_is_refused_before_a_local_cluster_starts(
+    carm_poses: tuple[np.ndarray, Any], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import distributed
+
+    def no_cluster(*args: Any, **kwargs: Any) -> None:
+        raise AssertionError("a local cluster was started")
+
+    monkeypatch.setattr(distributed, "LocalCluster", no_cluster)
+    P, _ = carm_poses
+    path = tmp_path / "s.zarr"
+    write_store(path, CARM, P, 25, chunks=[0, 3])
+    other = P.copy()
+    other[80] = P[81]  # chunk 3 holds poses 75:100
+    with pytest.raises(StoreError, match=r"poses \[75:100\] differ"):
+        solve_dask(CARM, other, out=path, resume=True)
+    with pytest.raises(StoreError, match="solver options"):
+        solve_dask(CARM, P, out=path, resume=True, limits=False)
+    with pytest.raises(StoreError, match="number of poses"):
+        solve_dask(CARM, P[:-1], out=path, resume=True)
+    with pytest.raises(StoreError, match="chunk_size 30"):
+        solve_dask(CARM, P, out=path, resume=True, chunk_size=30)
+
+
 def test_killed_worker_chunks_rerun(client: Client, carm_poses: tuple[np.ndarray, Any], tmp_path: Path) -> None:
     P, ref = carm_poses
     P, ref_list = np.concatenate([P] * 3), list(ref) * 3

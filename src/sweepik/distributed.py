@@ -250,10 +250,18 @@ def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
     if client is not None and n_workers is not None:
         raise UnknownOptionError("n_workers sizes the local cluster started when client is None; give one of them")
     if client is None:
-        n = (os.cpu_count() or 1) if n_workers is None else check_int(n_workers, "n_workers", 1, 4096)
-        cluster = distributed.LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL
-        )
+        import dask
+
+        n = _local_threads(None, n_workers)
+        # Dask's nannies set MALLOC_TRIM_THRESHOLD_ in the workers' environment (to hand freed memory back to the
+        # system). Setting it turns off glibc's adaptive mmap threshold: every large temporary array of the solver
+        # is then mapped, zero-filled and unmapped again, ~10 % of a chunk's time. A worker here holds a bounded
+        # number of chunks, so glibc's own policy is kept (a variable set in this process's environment still
+        # passes through, as Dask does).
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+            cluster = distributed.LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL
+            )
         try:
             with distributed.Client(cluster) as c:
                 yield c
@@ -336,13 +344,19 @@ def run(
                 )
         elif not path.parent.is_dir():
             raise StoreError(f"{path}: cannot create the store: directory {str(path.parent)!r} is missing")
+    # the store is created (or opened and checked, with resume) before a local cluster starts whenever the chunk
+    # size is known by then: a store that cannot be written or resumed costs no cluster start
+    local = _local_threads(client, n_workers)
+    cs = stored_chunk or chunk_size or (None if local is None else auto_chunk_size(src.n, local))
+    writer = None if out is None or cs is None else _open_writer(out, robot, options, src, cs, resume)
     with _connected(client, n_workers) as c:
         threads = max(1, sum(c.nthreads().values()))
-        cs = stored_chunk or chunk_size or auto_chunk_size(src.n, threads)
+        if cs is None:
+            cs = auto_chunk_size(src.n, threads)
+            writer = None if out is None else _open_writer(out, robot, options, src, cs, resume, c)
         n_chunks = -(-src.n // cs)
-        writer = None if out is None else StoreWriter(out, robot, options, src.n, cs, resume=resume)
         done: dict[int, dict[str, Any]] = {} if writer is None else writer.done()
-        if writer is not None and done:
+        if writer is not None and done and src.dask is not None:
             _check_resumed(c, src, writer, done, cs)
         stats = [done[k]["stats"] for k in sorted(done)]
         resumed_poses = sum(int(s["poses"]) for s in stats)
@@ -364,6 +378,33 @@ def run(
         totals = writer.finish() if writer is not None else _totals(stats)
     summary = RunSummary(totals, n_chunks, cs, len(done), resumed_poses, time.perf_counter() - t0, threads)
     return summary, blocks
+
+
+def _local_threads(client: Any, n_workers: int | None) -> int | None:
+    """Worker threads of the local cluster ``_connected`` starts for ``client`` None (one per process), else None
+    (an existing cluster's are known once connected)."""
+    if client is not None:
+        return None
+    return (os.cpu_count() or 1) if n_workers is None else check_int(n_workers, "n_workers", 1, 4096)
+
+
+def _open_writer(
+    out: str | os.PathLike[str],
+    robot: Robot,
+    options: Mapping[str, Any],
+    src: _Source,
+    cs: int,
+    resume: bool,
+    c: Any = None,
+) -> StoreWriter:
+    """The store's writer (created, or opened and checked with ``resume``: robot, options, sizes and, for poses
+    the client holds, each stored chunk's poses; a Dask array's are checked on the cluster, by the caller)."""
+    writer = StoreWriter(out, robot, options, src.n, cs, resume=resume)
+    if resume and src.dask is None:
+        done = writer.done()
+        if done:
+            _check_resumed(c, src, writer, done, cs)
+    return writer
 
 
 def _totals(stats: list[dict[str, int]]) -> dict[str, int]:

@@ -87,6 +87,16 @@ def _zarr() -> Any:
     return zarr
 
 
+def _codec() -> Any:
+    """The columns' compressor: Blosc (LZ4, byte shuffle). Solutions are mostly mantissa bits and compress little
+    whatever the codec (x1.2 here, x1.45 with Zarr's default Zstandard); LZ4 costs almost nothing next to writing
+    the bytes, where Zstandard doubled the client's time per chunk (~80 against ~40 ms for 16,384 C-Arm poses),
+    time taken from the workers on a machine whose cores they use. Any Zarr reader decodes Blosc."""
+    from zarr.codecs import BloscCodec
+
+    return BloscCodec(cname="lz4", clevel=5, shuffle="shuffle")
+
+
 # --------------------------------------------------------------------------------------------------
 # Robot and options as exact JSON
 # --------------------------------------------------------------------------------------------------
@@ -367,12 +377,13 @@ class StoreWriter:
             "multiplicity": np.asarray(block.multiplicity, dtype=np.int64),
             "n_reachable": np.asarray(block.n_reachable, dtype=np.int64),
         }
+        codec = _codec()
         for name, data in columns.items():
             chunks = tuple(max(s, 1) for s in data.shape)  # one Zarr chunk per column (a zero-size one too)
-            g.create_array(name, data=data, chunks=chunks)
+            g.create_array(name, data=data, chunks=chunks, compressors=codec)
         families = [_family_record(i, f) for i, fams in sorted(block.families.items()) for f in fams]
         stats = chunk_stats(block)
-        g.attrs.update(
+        g.update_attributes(  # one write of the group's metadata, ``done`` with the rest
             {
                 "start": start,
                 "n": stop - start,
@@ -392,7 +403,7 @@ class StoreWriter:
         if missing:
             raise StoreError(f"{self.path}: {len(missing)} of {self.n_chunks} chunks are missing (first: {missing[0]})")
         summary = _sum_stats(done[k]["stats"] for k in range(self.n_chunks))
-        self.root.attrs.update({"summary": summary, "complete": True})
+        self.root.update_attributes({"summary": summary, "complete": True})
         with contextlib.suppress(OSError):
             (self.path / LOCK_FILE).unlink()
         return summary
