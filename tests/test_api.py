@@ -31,6 +31,17 @@ def test_contract_names_are_public() -> None:
         assert name in sweepik.__all__
 
 
+def test_import_leaves_the_tools_a_solve_does_not_need_unloaded() -> None:
+    import subprocess
+    import sys
+
+    lazy = ("sweepik.design", "sweepik.distributed", "sweepik.urdf", "sweepik.workspace")
+    code = f"import sys, sweepik; print([m for m in {lazy!r} if m in sys.modules])"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+    assert sweepik.solve_dask.__module__ == "sweepik.distributed"  # and they load on first use
+
+
 def test_version_matches_metadata() -> None:
     assert sweepik.__version__ == version("sweepik")
 

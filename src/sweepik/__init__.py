@@ -8,12 +8,10 @@ cluster, optionally into an on-disk store) and ``load_solutions``; design tools:
 docs/conventions.md for units and conventions.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from typing import TYPE_CHECKING, Any
 
 from .analysis import analyze
 from .batch import SolutionBatch
-from .design import DesignComparison, compare_designs
-from .distributed import solve_dask
 from .errors import (
     InvalidPoseError,
     LockedJointError,
@@ -45,13 +43,49 @@ from .solutions import Family, Solutions
 from .solver import STRATEGIES, iter_solve, solve, solve_many
 from .statics import gravity_torques
 from .store import StoreError, load_solutions
-from .urdf import read_urdf, urdf_text
-from .workspace import WorkspaceVolume, workspace_volume
 
-try:
-    __version__ = version("sweepik")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
-    __version__ = "0.0.0"
+if TYPE_CHECKING:
+    from .design import DesignComparison, compare_designs
+    from .distributed import solve_dask
+    from .urdf import read_urdf, urdf_text
+    from .workspace import WorkspaceVolume, workspace_volume
+
+    __version__: str
+
+#: Names imported on first use (PEP 562): a solve should not pay for the design tools, Dask's entry point, the URDF
+#: reader or the package metadata (~100 ms of ``import sweepik`` together).
+_LAZY = {
+    "compare_designs": "design",
+    "DesignComparison": "design",
+    "solve_dask": "distributed",
+    "read_urdf": "urdf",
+    "urdf_text": "urdf",
+    "workspace_volume": "workspace",
+    "WorkspaceVolume": "workspace",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            value = version("sweepik")
+        except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
+            value = "0.0.0"
+    elif name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY) | {"__version__"})
+
 
 __all__ = [
     "__version__",
