@@ -57,11 +57,16 @@ def wrap_inside(robot: Robot, q: Array) -> tuple[Array, NDArray[np.bool_]]:
 
 
 def finish(
-    robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array
+    robot: Robot,
+    pose_idx: NDArray[np.intp],
+    q: Array,
+    err: Array,
+    wrapped: tuple[Array, NDArray[np.bool_]] | None = None,
 ) -> tuple[Array, NDArray[np.bool_], NDArray[np.bool_]]:
     """``(wrapped q, inside, keep)`` for candidates ``q (K, n)`` of poses ``pose_idx (K,)`` with errors ``err (K,)``
-    (see the module docstring); ``keep`` marks the candidates that are not a duplicate of a better one."""
-    w, inside = wrap_inside(robot, q)
+    (see the module docstring); ``keep`` marks the candidates that are not a duplicate of a better one.
+    ``wrapped``: ``wrap_inside(robot, q)`` when the caller has it already."""
+    w, inside = wrap_inside(robot, q) if wrapped is None else wrapped
     score = np.where(inside, err, err + robot.length_scale)
     if not (AVAILABLE and q.shape[0]):
         return w, inside, _dedupe(robot, pose_idx, w, score)

@@ -121,26 +121,34 @@ SNAP_REACH = 1e-4
 SNAP_ITERATIONS = 4
 
 
-def _snap_to_limits(robot: Robot, q: Array, err_geo: Array, err_paper: Array, target: Array, weight: float) -> None:
-    """In place: certified configurations ``q (K, n)`` just outside the limits are clamped to them and polished
-    with the clamped joints held; where that still certifies, it replaces them (with their errors)."""
-    w, inside = wrap_inside(robot, q)
+def _snap_to_limits(
+    robot: Robot, q: Array, err_geo: Array, err_paper: Array, poses: Array, pose_idx: NDArray[np.intp], weight: float
+) -> tuple[Array, NDArray[np.bool_]]:
+    """In place: certified configurations ``q (K, n)`` of poses ``poses[pose_idx]`` just outside the limits are
+    clamped to them and polished with the clamped joints held; where that still certifies, it replaces them (with
+    their errors). Returns ``wrap_inside(robot, q)`` of the result (what the deduplication starts from)."""
+    w_all, inside = wrap_inside(robot, q)
     out = np.nonzero(~inside)[0]
     if out.size == 0:
-        return
-    w = w[out]
+        return w_all, inside
+    w = w_all[out]
     reach = np.where(robot.is_revolute, SNAP_REACH, SNAP_REACH * robot.length_scale)
     over = np.maximum(robot.lower - robot.limit_tol - w, w - robot.upper - robot.limit_tol)
     near = np.all(over <= reach, axis=-1)
     k, w, over = out[near], w[near], over[near]
     if k.size == 0:
-        return
+        return w_all, inside
     held = over > 0
     start = np.clip(w, robot.lower, robot.upper)
-    moved = polish(robot, start, target[k], weight, SNAP_ITERATIONS, fixed=held)
-    eg, ep = _errors(robot, moved, target[k], weight)
+    target = poses[pose_idx[k]]
+    moved = polish(robot, start, target, weight, SNAP_ITERATIONS, fixed=held)
+    eg, ep = _errors(robot, moved, target, weight)
     ok = (eg <= ACCEPT_TOL_REL * robot.length_scale) & robot.within_limits(moved)
-    q[k[ok]], err_geo[k[ok]], err_paper[k[ok]] = moved[ok], eg[ok], ep[ok]
+    k = k[ok]
+    q[k], err_geo[k], err_paper[k] = moved[ok], eg[ok], ep[ok]
+    if k.size:
+        w_all[k], inside[k] = wrap_inside(robot, q[k])
+    return w_all, inside
 
 
 def _twin_copies(red: Reduction, cand: Candidates, spans: list[FamilySpan]) -> tuple[Candidates, list[FamilySpan]]:
@@ -249,9 +257,8 @@ def _solve_chunk(
         fams = {}
     finite = np.all(np.isfinite(q), axis=-1)
     pose_idx, q, mult = pose_idx[finite], q[finite], mult[finite]
-    target = poses[pose_idx]
     if err_geo is None or err_paper is None:
-        err_geo, err_paper = _errors(robot, q, target, weight)
+        err_geo, err_paper = _errors(robot, q, poses[pose_idx], weight)
     else:
         err_geo, err_paper = err_geo[finite], err_paper[finite]
     if strategy == "precise":
@@ -261,8 +268,9 @@ def _solve_chunk(
             & ((err_geo > POLISH_ABOVE_REL * scale) | (err_paper > POLISH_PAPER_ABOVE_REL * scale))
         )[0]
         if near.size:
-            polished = polish(robot, q[near], target[near], weight, floor=POLISH_ABOVE_REL * scale)
-            eg, ep = _errors(robot, polished, target[near], weight)
+            target = poses[pose_idx[near]]
+            polished = polish(robot, q[near], target, weight, floor=POLISH_ABOVE_REL * scale)
+            eg, ep = _errors(robot, polished, target, weight)
             # at a singular configuration the step can drift along the near-null space: never out of the limits
             # for a configuration that was inside them and already certified
             drift = (
@@ -284,9 +292,11 @@ def _solve_chunk(
         rescue = np.unique(pose_idx[miss])
     pose_idx, q, err_paper, err_geo = pose_idx[certified], q[certified], err_paper[certified], err_geo[certified]
     mult = mult[certified]
+    wrapped = None
     if strategy == "precise":
-        _snap_to_limits(robot, q, err_geo, err_paper, poses[pose_idx], weight)
+        wrapped = _snap_to_limits(robot, q, err_geo, err_paper, poses, pose_idx, weight)
     if rescue.size:
+        wrapped = None
         rescued = _solve_chunk(
             robot, get_reduction(robot, red.fallback), poses[rescue], strategy, limits, n_samples, False
         )
@@ -299,7 +309,7 @@ def _solve_chunk(
                 mult = np.concatenate([mult, r_sol.multiplicity])
     # duplicates first (of twins, the one inside the limits is kept), so that limits=True is exactly
     # limits=False filtered by the limits
-    q, inside, keep = finish(robot, pose_idx, q, err_geo)
+    q, inside, keep = finish(robot, pose_idx, q, err_geo, wrapped)
     if strategy == "precise":  # a numerical continuum of certified solutions is reported once
         keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
     n_reachable = np.bincount(pose_idx[keep], minlength=len(poses))
@@ -348,7 +358,8 @@ def _solve_chunk(
         m_parts.append(other.multiplicity[k])
     pose_idx, q, err_paper = np.concatenate(p_parts), np.concatenate(q_parts), np.concatenate(e_parts)
     err_geo, inside, mult = np.concatenate(g_parts), np.concatenate(in_parts), np.concatenate(m_parts)
-    order = np.argsort(pose_idx, kind="stable")
+    # (already in pose order, as a closed form's candidates and most sweeps' are: no reordering copies)
+    order = slice(None) if np.all(pose_idx[1:] >= pose_idx[:-1]) else np.argsort(pose_idx, kind="stable")
     empty_reason = None
     if strategy == "paper" and not red.closed_form:  # its final resolution decides nothing about reachability
         step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"
