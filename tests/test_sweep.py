@@ -169,6 +169,60 @@ def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(red: 
                 assert same(out[k], ck.amplitude(params[i], float(th), k))
 
 
+def _wrist_reductions() -> list[sweepik.GeometricReduction]:
+    """Every wrist-family plan (closed form, spherical wrist) of the bundled arms that have one and of random arms
+    of the three wrist structures (2 || 3 shoulder, Stanford-like RRP, Cartesian PPP; base and tool transforms)."""
+    from test_any_arm import FAMILIES, _arm
+
+    from sweepik.reductions.decompose import plans
+
+    robots = [load_robot(n) for n in ("puma560", "puma560_std", "kuka_kr6_r900", "abb_irb140", "stanford")]
+    robots.append(load_robot("carm_swapped"))
+    rng = np.random.default_rng(8)
+    robots += [_arm(FAMILIES[f](rng), rng) for f in ("wrist_parallel", "wrist_rrp", "wrist_ppp")]
+    return [sweepik.GeometricReduction(r, p) for r in robots for p in plans(r) if p.family == "wrist"]
+
+
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.parametrize("red", _wrist_reductions(), ids=lambda r: f"{r.robot.name}-{r.plan.case}")
+def test_wrist_family_all_branch_configurations_are_bitwise_the_one_branch_ones(
+    red: sweepik.GeometricReduction,
+) -> None:
+    """A closed form's all-branch configuration kernel (the branches share their first steps and each position
+    branch its wrist's sp2) gives bit for bit the one-branch kernel's configurations, NaN rows included, also at and
+    next to a singular wrist; the solver's every-branch certification equals the branch-by-branch one."""
+    from sweepik import fastcertify, solver
+    from sweepik.reductions.kernels import owned_kernel
+
+    robot = red.robot
+    ck = red._case_kernels
+    assert owned_kernel(red, "kernel_configurations") is ck.wrist_configurations
+    rng = np.random.default_rng(5)
+    q = rng.uniform(robot.lower, robot.upper, size=(80, robot.n_joints))
+    q[:10, 4] = 0.0  # joint 5 straight: joint 6's axis on joint 4's, a continuum
+    q[10:20, 4] = rng.choice([-1.0, 1.0], 10) * 1e-7
+    world = robot.fk(q)
+    chain = solver._chain_poses(robot, world)
+    params = red.kernel_params(chain)
+    out = np.full((red.n_branches, robot.n_joints), 7.0)
+    one = np.empty(robot.n_joints)
+    for i in range(len(q)):
+        ck.wrist_configurations(params[i], 0.0, out)
+        for b in range(red.n_branches):
+            ck.wrist_configuration(params[i], 0.0, b, one)
+            np.testing.assert_array_equal(out[b], one)
+    cand = solver._every_branch(len(q), red.n_branches)
+    every = fastcertify.certify_every_branch(robot, red, chain, world, params)
+    each = fastcertify.certify(robot, red, chain, world, cand.pose, cand.theta, cand.branch, params)
+    for a, b in zip(every, each, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+    class OwnKernel(sweepik.GeometricReduction):
+        kernel = (red.kernel[0], red.kernel[1])
+
+    assert owned_kernel(OwnKernel(robot, red.plan), "kernel_configurations") is None
+
+
 def test_compiled_sample_grid_is_the_numpy_one() -> None:
     """``fastsweep.sample_grid`` (compiled merge) gives the reference's samples exactly: hints inside and outside
     the range, NaN hints, hints on the uniform grid and repeated (runs of equal samples spread), real reductions."""

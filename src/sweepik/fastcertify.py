@@ -18,7 +18,7 @@ from . import parallel
 from ._jit import internal
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
-from .reductions.kernels import first_class, lazy_njit
+from .reductions.kernels import first_class, lazy_njit, owned_kernel
 from .units import orientation_weight
 
 if TYPE_CHECKING:
@@ -34,9 +34,10 @@ J_CUTOFF_FACTOR = 1e-4
 if AVAILABLE:
     from numba import float64, int64, types
 
-    from .reductions.kernels import CONFIGURATION_SIG
+    from .reductions.kernels import CONFIGURATION_SIG, CONFIGURATIONS_SIG
 
     _CFG = types.FunctionType(CONFIGURATION_SIG)
+    _CFGS = types.FunctionType(CONFIGURATIONS_SIG)
 
     @internal
     def _poe_fk(H, P, rev, R_end, q):
@@ -169,35 +170,66 @@ if AVAILABLE:
         for k in range(start, stop):
             i = pose[k]
             cfg(params[i], theta[k], branch[k], q[k])
-            finite = True
-            for j in range(q.shape[1]):
-                if not math.isfinite(q[k, j]):
-                    finite = False
-                    break
-            if finite:
-                err_geo[k], err_paper[k] = _errors(_poe_fk(H, P, rev, R_end, q[k]), world[i], weight)
-            else:
+            _certify_row(H, P, rev, R_end, weight, q, world[i], k, err_geo, err_paper)
+
+    @internal
+    def _certify_row(H, P, rev, R_end, weight, q, Td, k, err_geo, err_paper):
+        """Errors of candidate ``k`` (configuration ``q[k]``, target ``Td``): inf where the branch does not exist."""
+        for j in range(q.shape[1]):
+            if not math.isfinite(q[k, j]):
                 err_geo[k], err_paper[k] = np.inf, np.inf
+                return
+        err_geo[k], err_paper[k] = _errors(_poe_fk(H, P, rev, R_end, q[k]), Td, weight)
+
+    @lazy_njit(
+        (_CFGS, float64[:, ::1], float64[:, :, ::1], int64)
+        + (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64)
+        + (float64[:, ::1], float64[::1], float64[::1], int64, int64),
+        cache=True,
+        nogil=True,
+    )
+    def _certify_every_branch(cfgs, params, world, nb, H, P, rev, R_end, weight, q, err_geo, err_paper, start, stop):
+        """Poses ``start .. stop - 1``: every branch's configuration at once (rows ``i nb .. i nb + nb - 1`` of
+        ``q`` for pose i) and their errors."""
+        for i in range(start, stop):
+            cfgs(params[i], 0.0, q[i * nb : (i + 1) * nb])
+            for k in range(i * nb, (i + 1) * nb):
+                _certify_row(H, P, rev, R_end, weight, q, world[i], k, err_geo, err_paper)
+
+
+def certify_every_branch(robot, red, chain: Array, world: Array, params: Array | None = None):
+    """A closed form's candidates, every branch of every pose (pose-major, as ``solver._every_branch``), certified
+    with its all-branch configuration kernel (``owned_kernel(red, "kernel_configurations")``, which must exist):
+    ``(q (N n_branches, n), geodesic errors, paper errors)``, as :func:`certify` gives them branch by branch."""
+    N, nb = chain.shape[0], red.n_branches
+    cfgs = first_class(owned_kernel(red, "kernel_configurations"))
+    return _run(_certify_every_branch, N, 2 * PARALLEL_MIN, N * nb, robot, red, chain, world, params, cfgs, int(nb))
 
 
 def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, params: Array | None = None):
     """Configurations ``(K, n)``, geodesic errors and paper errors ``(K,)`` of the candidates
     (inf errors where the branch does not exist)."""
     K = pose.shape[0]
+    cfg = first_class(red.kernel[1])
+    ids = (pose.astype(np.int64), theta.astype(np.float64), branch.astype(np.int64))
+    return _run(_certify, K, 16 * PARALLEL_MIN, K, robot, red, chain, world, params, cfg, *ids)
+
+
+def _run(kernel, n, min_parallel, K, robot, red, chain, world, params, cfg, *middle):
+    """``kernel(cfg, params, world, *middle, chain geometry, weight, q, err_geo, err_paper)`` over ``n`` items with
+    ``K`` candidates: ``(q, err_geo, err_paper)``."""
     q = np.empty((K, robot.n_joints))
     eg = np.empty(K)
     ep = np.empty(K)
     ch = robot.chain
     parallel.run(
-        _certify,
-        K,
-        16 * PARALLEL_MIN,
-        first_class(red.kernel[1]),
+        kernel,
+        n,
+        min_parallel,
+        cfg,
         np.ascontiguousarray(red.kernel_params(chain) if params is None else params, dtype=np.float64),
         np.array(world, dtype=np.float64, order="C", copy=not world.flags.writeable or None),  # compiled: writable
-        pose.astype(np.int64),
-        theta.astype(np.float64),
-        branch.astype(np.int64),
+        *middle,
         np.array(ch.H),  # writable copies: the compiled signature takes writable arrays
         np.array(ch.P),
         np.array(ch.revolute),

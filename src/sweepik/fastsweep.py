@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from . import parallel
 from . import sweep as _ref
 from ._jit import internal
-from .reductions.kernels import first_class, lazy_njit
+from .reductions.kernels import first_class, lazy_njit, owned_kernel
 from .robot import Robot
 
 try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
@@ -637,16 +637,8 @@ def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -
 
 
 def _kernel_residuals(reduction):
-    """``reduction.kernel_residuals`` if the class that sets ``kernel`` sets it too (as a class attribute, or
-    declares it for its instances to set), else None: a subclass with its own ``kernel`` must not get its parent's
-    all-branch kernel."""
-    mro = type(reduction).__mro__
-    owner = next((c for c in mro if "kernel" in vars(c)), None)
-    if owner is None or "kernel_residuals" not in vars(owner):
-        return None
-    # read from the class (a compiled function stored as a class attribute would bind to the instance), unless
-    # the instance set its own
-    return vars(reduction).get("kernel_residuals", vars(owner)["kernel_residuals"])
+    """``reduction.kernel_residuals`` where it belongs to the reduction's ``kernel`` (``kernels.owned_kernel``)."""
+    return owned_kernel(reduction, "kernel_residuals")
 
 
 def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):

@@ -24,6 +24,7 @@ from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
 from .polish import polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, get_reduction
+from .reductions.kernels import owned_kernel
 from .robot import Robot
 from .solutions import Family, Solutions
 from .sweep import N_SAMPLES, Candidates, FamilySpan, find_candidates
@@ -206,7 +207,9 @@ def _solve_chunk(
         if closed:  # no sweep: every branch of the closed form is a candidate
             params = red.kernel_params(chain) if compiled else None
             cand = _every_branch(chain.shape[0], red.n_branches)
-            if compiled:
+            if compiled and owned_kernel(red, "kernel_configurations") is not None:
+                q, err_geo, err_paper = fastcertify.certify_every_branch(robot, red, chain, poses, params)
+            elif compiled:
                 q, err_geo, err_paper = fastcertify.certify(
                     robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
                 )

@@ -62,6 +62,11 @@ class Reduction(ABC):
     #: branch by branch, at less than ``n_branches`` times its cost (the branches share most of the work). The
     #: engine uses it for the uniform samples; it is ignored unless set by the class that sets ``kernel``.
     kernel_residuals: Any = None
+    #: Optional compiled kernel ``configurations(params, theta, out)`` (signature ``reductions.kernels.
+    #: CONFIGURATIONS_SIG``) writing every branch's configuration at theta* into ``out (n_branches, n_joints)``, bit
+    #: for bit what ``kernel[1]`` gives branch by branch (NaN rows where a branch does not exist). A closed form's
+    #: certification uses it (every branch is a candidate); ignored unless set by the class that sets ``kernel``.
+    kernel_configurations: Any = None
     #: No sweep: every branch of ``solve_rest`` (at any theta*) is a candidate (a closed-form decomposition).
     closed_form: bool = False
     #: Classes of branches whose residuals are identical (they differ in the configuration only, e.g. by a

@@ -111,10 +111,11 @@ def _chain_rows(chain: Chain) -> Array:
 class GeometricReduction(Reduction):
     """A reduction from a :class:`Plan`: the family's compiled kernels over the generic parameter row."""
 
-    #: Set per instance (the family's pair, and its all-branch residual); declared here so that ``uses_kernel`` and
-    #: the engine see this class as their owner.
+    #: Set per instance (the family's pair, its all-branch residual or configurations); declared here so that
+    #: ``uses_kernel`` and the engine see this class as their owner.
     kernel: tuple[Any, Any] | None = None
     kernel_residuals: Any = None
+    kernel_configurations: Any = None
 
     def __init__(self, robot: Robot, plan: Plan) -> None:
         super().__init__(robot, plan.free_joint, plan.branches)
@@ -154,6 +155,7 @@ class GeometricReduction(Reduction):
         else:
             assert plan.family == "wrist", plan.family
             self._kernels = (geometric.wrist_residual, self._case_kernels.wrist_configuration)
+            self.kernel_configurations = self._case_kernels.wrist_configurations
         self.kernel = self._kernels
 
     @cached_property

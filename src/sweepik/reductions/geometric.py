@@ -43,7 +43,15 @@ from .. import parallel
 from .._jit import internal
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
-from .kernels import CONFIGURATION_SIG, RESIDUAL_SIG, RESIDUALS_SIG, LazyKernel, first_class, lazy_njit
+from .kernels import (
+    CONFIGURATION_SIG,
+    CONFIGURATIONS_SIG,
+    RESIDUAL_SIG,
+    RESIDUALS_SIG,
+    LazyKernel,
+    first_class,
+    lazy_njit,
+)
 from .position import BOTH, NEITHER, angle, motion, place, reduce_chain
 
 Array = NDArray[np.float64]
@@ -207,6 +215,36 @@ def _write(p, out, m0, m1, m2, m3, q4, q5):
     rev = p[_REVERSED] > 0.5
     for i in range(6):
         out[5 - i if rev else i] = qs[i]
+
+
+@internal
+def _wrist_first(p, m):
+    """The wrist family's work shared by a position branch's two wrist branches (motions ``m`` of the first four
+    joints): joint 6's target axis seen from frame 4 ``v``, a unit vector normal to joint 6's axis seen from there
+    ``be``, and ``sp2`` turning joint 6's axis onto ``v`` with joints 4 and 5."""
+    m0, m1, m2, m3 = m
+    h3, h4, h5 = _h(p, 3), _h(p, 4), _h(p, 5)
+    v = _back(p, m0, m1, m2, m3, _mat(p, h5))
+    be = _back(p, m0, m1, m2, m3, _mat(p, orthogonal(h5)))
+    return v, be, sp2(v, h5, h3, h4)
+
+
+@internal
+def _wrist_joints(p, m, v, be, s, wb, out):
+    """The configuration of wrist branch ``wb`` (0, 1) given ``_wrist_first``'s ``v, be, s``, into ``out``."""
+    m0, m1, m2, _ = m
+    h3, h4, h5 = _h(p, 3), _h(p, 4), _h(p, 5)
+    t1a, t2a, t1b, t2b, c, _ = s
+    if math.isnan(c):  # joint 6's axis on joint 4's: a continuum (wrist singular); one member
+        q3 = 0.0
+        q4, _ = sp1(h5, v, h4)
+    elif wb == 0:
+        q3, q4 = -t1a, t2a
+    else:
+        q3, q4 = -t1b, t2b
+    e = orthogonal(h5)
+    q5, _ = sp1(e, rot(h4, -q4, rot(h3, -q3, be)), h5)
+    _write(p, out, m0, m1, m2, (math.cos(q3), math.sin(q3), 0.0), q4, q5)  # (motion(True, q3))
 
 
 # Steps of the position case: k = 0 is its first step, k = 1, 2 its second step on the first step's branch k - 1.
@@ -490,6 +528,7 @@ class CaseKernels(NamedTuple):
     amplitude: Any
     amplitudes: Any
     wrist_configuration: Any
+    wrist_configurations: Any
     wrist_singular: Any
 
 
@@ -585,25 +624,38 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
             nb = int(p[_POS_BRANCHES])
             pb = branch // 2  # the position branch
             arm = _arm(p, 0.0, pb // 2, pb % 2, case, free, rev)
-            m0, m1, m2, m3 = arm[0] if pb % 2 == 0 else arm[1]
-            if _missing(m0, m1, m2, m3) or branch >= 2 * nb:
+            m = arm[0] if pb % 2 == 0 else arm[1]
+            if _missing(m[0], m[1], m[2], m[3]) or branch >= 2 * nb:
                 for i in range(6):
                     out[i] = math.nan
                 return
-            h3, h4, h5 = _h(p, 3), _h(p, 4), _h(p, 5)
-            v = _back(p, m0, m1, m2, m3, _mat(p, h5))
-            t1a, t2a, t1b, t2b, c, _ = sp2(v, h5, h3, h4)
-            if math.isnan(c):  # joint 6's axis on joint 4's: a continuum (wrist singular); one member
-                q3 = 0.0
-                q4, _ = sp1(h5, v, h4)
-            elif branch % 2 == 0:
-                q3, q4 = -t1a, t2a
-            else:
-                q3, q4 = -t1b, t2b
-            e = orthogonal(h5)
-            w = rot(h4, -q4, rot(h3, -q3, _back(p, m0, m1, m2, m3, _mat(p, e))))
-            q5, _ = sp1(e, w, h5)
-            _write(p, out, m0, m1, m2, (math.cos(q3), math.sin(q3), 0.0), q4, q5)  # (motion(True, q3))
+            v, be, s = _wrist_first(p, m)
+            _wrist_joints(p, m, v, be, s, branch % 2, out)
+
+        def wrists(p, x, out):
+            """Every branch's ``wrist`` configuration at once, ``out (n_branches, 6)`` (``Reduction.
+            kernel_configurations``): the two branches of a first position step share its work (``_arm`` with
+            ``BOTH``), the two wrist branches of a position branch share their ``sp2``."""
+            nb = int(p[_POS_BRANCHES])
+            both = BOTH + 0 * nb  # (a run-time value: see position.place)
+            for b1 in range((nb + 1) // 2):
+                arm = _arm(p, 0.0, b1, both, case, free, rev)
+                for j in range(2):
+                    pb = 2 * b1 + j
+                    if pb >= nb:
+                        break
+                    m = arm[0] if j == 0 else arm[1]
+                    if _missing(m[0], m[1], m[2], m[3]):
+                        for i in range(6):
+                            out[2 * pb, i] = math.nan
+                            out[2 * pb + 1, i] = math.nan
+                        continue
+                    v, be, s = _wrist_first(p, m)
+                    _wrist_joints(p, m, v, be, s, 0, out[2 * pb])
+                    _wrist_joints(p, m, v, be, s, 1, out[2 * pb + 1])
+            for r in range(2 * nb, out.shape[0]):
+                for i in range(6):
+                    out[r, i] = math.nan
 
         def singular(params, out):
             """``out[i]``: some exact position branch of the wrist family leaves pose i with a singular wrist."""
@@ -629,6 +681,7 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
             LazyKernel(amplitude, RESIDUAL_SIG, cache=True),
             LazyKernel(amplitudes, RESIDUALS_SIG, cache=True),
             LazyKernel(wrist, CONFIGURATION_SIG, cache=True),
+            LazyKernel(wrists, CONFIGURATIONS_SIG, cache=True),
             njit(cache=True)(singular),
         )
     return ck

@@ -113,6 +113,9 @@ if _njit is not None:
     #: ``Reduction.kernel_residuals``).
     RESIDUALS_SIG = void(float64[::1], float64, float64[::1])
     CONFIGURATION_SIG = void(float64[::1], float64, int64, float64[::1])
+    #: ``configurations(params, theta, out)``: every branch's configuration at theta* into ``out (n_branches, n)``
+    #: (optional, see ``Reduction.kernel_configurations``).
+    CONFIGURATIONS_SIG = void(float64[::1], float64, float64[:, ::1])
     _elbow = internal(_elbow)
     _d1_position = internal(_d1_position)
     _elbow_residual = internal(_elbow_residual)
@@ -175,6 +178,19 @@ if _njit is not None:
 else:  # pragma: no cover
     carm_d1_residual, carm_theta2_residual = _carm_d1, _carm_theta2
     carm_d1_residuals = _carm_d1_all
+
+
+def owned_kernel(reduction: Any, name: str) -> Any:
+    """``reduction.<name>`` (an optional kernel: ``kernel_residuals``, ``kernel_configurations``) if the class that
+    sets ``kernel`` sets it too (as a class attribute, or declares it for its instances to set), else None: a
+    subclass with its own ``kernel`` must not get its parent's all-branch kernels."""
+    mro = type(reduction).__mro__
+    owner = next((c for c in mro if "kernel" in vars(c)), None)
+    if owner is None or name not in vars(owner):
+        return None
+    # read from the class (a compiled function stored as a class attribute would bind to the instance), unless
+    # the instance set its own
+    return vars(reduction).get(name, vars(owner)[name])
 
 
 _FIRST_CLASS: dict[Any, Any] = {}
