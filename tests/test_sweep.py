@@ -169,34 +169,43 @@ def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(red: 
                 assert same(out[k], ck.amplitude(params[i], float(th), k))
 
 
-def _wrist_reductions() -> list[sweepik.GeometricReduction]:
-    """Every wrist-family plan (closed form, spherical wrist) of the bundled arms that have one and of random arms
-    of the three wrist structures (2 || 3 shoulder, Stanford-like RRP, Cartesian PPP; base and tool transforms)."""
+def _closed_form_reductions() -> list[sweepik.GeometricReduction]:
+    """Every closed-form plan of the wrist family (spherical wrist) and the parallel family (UR-like) of bundled
+    arms and of random arms of those structures (2 || 3 shoulder, Stanford-like RRP, Cartesian PPP; three parallel
+    axes with and without a wrist offset, after a revolute joint or an oblique slide; base and tool transforms)."""
     from test_any_arm import FAMILIES, _arm
 
     from sweepik.reductions.decompose import plans
 
     robots = [load_robot(n) for n in ("puma560", "puma560_std", "kuka_kr6_r900", "abb_irb140", "stanford")]
-    robots.append(load_robot("carm_swapped"))
+    robots += [load_robot(n) for n in ("carm_swapped", "ur5", "ur10")]
     rng = np.random.default_rng(8)
-    robots += [_arm(FAMILIES[f](rng), rng) for f in ("wrist_parallel", "wrist_rrp", "wrist_ppp")]
-    return [sweepik.GeometricReduction(r, p) for r in robots for p in plans(r) if p.family == "wrist"]
+    families = ("wrist_parallel", "wrist_rrp", "wrist_ppp", "three_parallel", "three_parallel_offset")
+    robots += [_arm(FAMILIES[f](rng), rng) for f in (*families, "slide_parallel", "slide_parallel_offset")]
+    return [sweepik.GeometricReduction(r, p) for r in robots for p in plans(r) if p.family in ("wrist", "parallel")]
 
 
 @pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
-@pytest.mark.parametrize("red", _wrist_reductions(), ids=lambda r: f"{r.robot.name}-{r.plan.case}")
-def test_wrist_family_all_branch_configurations_are_bitwise_the_one_branch_ones(
+@pytest.mark.parametrize(
+    "red", _closed_form_reductions(), ids=lambda r: f"{r.robot.name}-{r.plan.family}-{r.plan.case}"
+)
+def test_closed_form_all_branch_configurations_are_bitwise_the_one_branch_ones(
     red: sweepik.GeometricReduction,
 ) -> None:
-    """A closed form's all-branch configuration kernel (the branches share their first steps and each position
-    branch its wrist's sp2) gives bit for bit the one-branch kernel's configurations, NaN rows included, also at and
-    next to a singular wrist; the solver's every-branch certification equals the branch-by-branch one."""
+    """A closed form's all-branch configuration kernel (branches share their first steps: position branches, a
+    wrist's sp2, the planar arm's elbows) gives bit for bit the one-branch kernel's configurations, NaN rows
+    included, also at and next to a singular wrist; the solver's every-branch certification equals the
+    branch-by-branch one."""
     from sweepik import fastcertify, solver
+    from sweepik.reductions import geometric
     from sweepik.reductions.kernels import owned_kernel
 
     robot = red.robot
-    ck = red._case_kernels
-    assert owned_kernel(red, "kernel_configurations") is ck.wrist_configurations
+    every_kernel, one_kernel = owned_kernel(red, "kernel_configurations"), red.kernel[1]
+    if red.plan.family == "wrist":
+        assert every_kernel is red._case_kernels.wrist_configurations
+    else:
+        assert every_kernel is geometric.parallel_configurations
     rng = np.random.default_rng(5)
     q = rng.uniform(robot.lower, robot.upper, size=(80, robot.n_joints))
     q[:10, 4] = 0.0  # joint 5 straight: joint 6's axis on joint 4's, a continuum
@@ -207,9 +216,9 @@ def test_wrist_family_all_branch_configurations_are_bitwise_the_one_branch_ones(
     out = np.full((red.n_branches, robot.n_joints), 7.0)
     one = np.empty(robot.n_joints)
     for i in range(len(q)):
-        ck.wrist_configurations(params[i], 0.0, out)
+        every_kernel(params[i], 0.0, out)
         for b in range(red.n_branches):
-            ck.wrist_configuration(params[i], 0.0, b, one)
+            one_kernel(params[i], 0.0, b, one)
             np.testing.assert_array_equal(out[b], one)
     cand = solver._every_branch(len(q), red.n_branches)
     every = fastcertify.certify_every_branch(robot, red, chain, world, params)

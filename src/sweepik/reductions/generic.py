@@ -149,6 +149,7 @@ class GeometricReduction(Reduction):
         )
         if plan.family == "parallel":
             self._kernels = (geometric.wrist_residual, geometric.parallel_configuration)
+            self.kernel_configurations = geometric.parallel_configurations
         elif plan.family == "pair":
             self._kernels = (self._case_kernels.pair_residual, self._case_kernels.pair_configuration)
             self.kernel_residuals = self._case_kernels.pair_residuals

@@ -304,13 +304,16 @@ def _parallel_first(p, branch):
     return m0, m4, c0, c4
 
 
-def _parallel_configuration(p, x, branch, out):
+@internal
+def _parallel_shared(p, branch):
+    """The parallel family's work shared by branches ``branch`` and ``branch ^ 1`` (they differ in the planar
+    arm's elbow only): ``(ok, m0, m4, c5, s5, cf, sf, d, sp3 of the planar arm)``; ``ok`` False: no such branch."""
     h0, h, h4, h5 = _h(p, 0), _h(p, 1), _h(p, 4), _h(p, 5)
     m0, m4, _, _ = _parallel_first(p, branch)
+    s2, s3 = _v(p, _P + 6), _v(p, _P + 9)
     if math.isnan(m0[0] + m0[2]) or branch >= (8 if p[_REV] > 0.5 else 4):
-        for i in range(6):
-            out[i] = math.nan
-        return
+        nan = math.nan
+        return False, m0, m4, nan, nan, nan, nan, s2, (nan, nan, nan, nan, nan, nan)
     # joint 6: h^T R_0^T M = h^T R_4 R_5, i.e. R_5^T (R_4^T h) = M^T R_0 h
     r0h = rot_cs(h0, m0[0], m0[1], h) if p[_REV] > 0.5 else h
     c5, s5 = sp1_cs(rot_cs(h4, m4[0], -m4[1], h), _mat_t(p, r0h), h5)
@@ -319,7 +322,7 @@ def _parallel_configuration(p, x, branch, out):
     e = orthogonal(h)
     cf, sf = sp1_cs(e, _parallel_g(p, m0, rot_cs(h5, c5, -s5, rot_cs(h4, m4[0], -m4[1], e))), h)
     # the planar arm: R_1 (s2 + R_2 s3) = R_0^T (t - s0) - s1 - R(h, phi) (s4 + R_4 s5)
-    s1, s2, s3 = _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
+    s1 = _v(p, _P + 3)
     o4 = _v(p, _O)
     s4 = add(sub(o4, _o3(p)), rot_cs(h4, m4[0], m4[1], sub(_v(p, _W), o4)))
     t0 = sub(_v(p, _T), _v(p, _P))
@@ -328,13 +331,41 @@ def _parallel_configuration(p, x, branch, out):
     else:
         t0 = sub(t0, scale(m0[2], h0))
     d = sub(sub(t0, s1), rot_cs(h, cf, sf, s4))
-    ua, va, ub, vb, _, _ = sp3_cs(s3, scale(-1.0, s2), h, norm(d))
-    c2, s2_ = (ua, va) if branch % 2 == 0 else (ub, vb)
+    return True, m0, m4, c5, s5, cf, sf, d, sp3_cs(s3, scale(-1.0, s2), h, norm(d))
+
+
+@internal
+def _parallel_finish(p, shared, elbow, out):
+    """The configuration of the branch with planar-arm elbow ``elbow`` (``branch % 2``) from ``_parallel_shared``."""
+    ok, m0, m4, c5, s5, cf, sf, d, planar = shared
+    if not ok:
+        for i in range(6):
+            out[i] = math.nan
+        return
+    h = _h(p, 1)
+    s2, s3 = _v(p, _P + 6), _v(p, _P + 9)
+    ua, va, ub, vb, _, _ = planar
+    c2, s2_ = (ua, va) if elbow == 0 else (ub, vb)
     c1, s1_ = sp1_cs(add(s2, rot_cs(h, c2, s2_, s3)), d, h)
     # joint 4 = phi - joint 2 - joint 3 (angles as unit complex numbers)
     c12, s12 = c1 * c2 - s1_ * s2_, s1_ * c2 + c1 * s2_
     c3, s3_ = cf * c12 + sf * s12, sf * c12 - cf * s12
     _write(p, out, m0, (c1, s1_, 0.0), (c2, s2_, 0.0), (c3, s3_, 0.0), math.atan2(m4[1], m4[0]), math.atan2(s5, c5))
+
+
+def _parallel_configuration(p, x, branch, out):
+    _parallel_finish(p, _parallel_shared(p, branch), branch % 2, out)
+
+
+def _parallel_configurations(p, x, out):
+    """Every branch's ``_parallel_configuration`` at once, ``out (n_branches, 6)`` (``Reduction.
+    kernel_configurations``): the two elbows of the planar arm share the rest."""
+    n = out.shape[0]
+    for pair in range((n + 1) // 2):
+        shared = _parallel_shared(p, 2 * pair)
+        _parallel_finish(p, shared, 0, out[2 * pair])
+        if 2 * pair + 1 < n:
+            _parallel_finish(p, shared, 1, out[2 * pair + 1])
 
 
 def _no_residual(p, x, branch):
@@ -445,6 +476,7 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
 
 wrist_residual = LazyKernel(_no_residual, RESIDUAL_SIG, cache=True)
 parallel_configuration = LazyKernel(_parallel_configuration, CONFIGURATION_SIG, cache=True)
+parallel_configurations = LazyKernel(_parallel_configurations, CONFIGURATIONS_SIG, cache=True)
 
 
 # Kernels enter as first-class functions (``kernels.first_class``) through an explicit signature: compiled once
