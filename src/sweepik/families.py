@@ -292,19 +292,36 @@ def _repeated_pieces(
     return dup
 
 
-def off_families(robot: Robot, q: Array, families: tuple[Family, ...]) -> NDArray[np.bool_]:
-    """``(k,)`` mask of the configurations ``q (k, n)`` that are not members of any of ``families``."""
-    on = np.zeros(q.shape[0], dtype=bool)
-    if not families or q.shape[0] == 0:
-        return ~on
-    for f in families:
-        th = q[:, f.free_joint]
-        lo, hi = f.interval
-        slack = _MEMBER_TOL * np.maximum(1.0, np.abs(th))  # a configuration at an end of the interval is on it
-        inn = (th >= lo - slack) & (th <= hi + slack)
-        if inn.any():
-            on |= inn & _same_configuration(robot, f.at(np.clip(th, *f.interval)), q)
-    return ~on
+def off_families(robot: Robot, checks: list[tuple[Array, tuple[Family, ...]]]) -> list[NDArray[np.bool_]]:
+    """For each ``(q (k, n), families)`` of ``checks``, the ``(k,)`` mask of the configurations that are not members
+    of any of the families. The members (at the configurations within a family's interval) are evaluated in one
+    batch per reduction, bit for bit what ``Family.at`` gives."""
+    on = [np.zeros(q.shape[0], dtype=bool) for q, _ in checks]
+    batches: dict[int, list[tuple[int, Family, NDArray[np.intp], Array]]] = {}
+    for g, (q, families) in enumerate(checks):
+        for f in families:
+            th = q[:, f.free_joint]
+            lo, hi = f.interval
+            slack = _MEMBER_TOL * np.maximum(1.0, np.abs(th))  # a configuration at an end of the interval is on it
+            rows = np.nonzero((th >= lo - slack) & (th <= hi + slack))[0]
+            if rows.size == 0:
+                continue
+            if f.held is not None:  # (members of the full arm: as Family.at expands them)
+                on[g][rows] |= _same_configuration(robot, f.at(np.clip(th[rows], lo, hi)), q[rows])
+            else:
+                batches.setdefault(id(f.reduction), []).append((g, f, rows, np.clip(th[rows], lo, hi)))
+    for batch in batches.values():
+        red = batch[0][1].reduction
+        pose = np.repeat(np.arange(len(batch)), [rows.size for _, _, rows, _ in batch])
+        branch = np.repeat([f.branch for _, f, _, _ in batch], [rows.size for _, _, rows, _ in batch])
+        chain = np.stack([f.chain_pose for _, f, _, _ in batch])
+        theta = np.concatenate([th for _, _, _, th in batch])
+        members = red.robot.wrap(family_members(red.robot, red, chain, pose, branch.astype(np.intp), theta))
+        start = 0
+        for g, _, rows, _ in batch:
+            on[g][rows] |= _same_configuration(robot, members[start : start + rows.size], checks[g][0][rows])
+            start += rows.size
+    return [~m for m in on]
 
 
 def unique_families(families: tuple[Family, ...]) -> tuple[Family, ...]:

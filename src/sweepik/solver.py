@@ -338,6 +338,8 @@ def _solve_chunk(
     families: dict[int, tuple[Family, ...]] = {}
     keep = np.ones(pose_idx.size, dtype=bool)
     extra: list[tuple[int, Solutions, NDArray[np.bool_]]] = []
+    checks: list[tuple[Array, tuple[Family, ...]]] = []  # (configurations, families) of each pose, checked at once
+    targets: list[tuple[int, Solutions | None, NDArray[np.intp]]] = []
     for i in sorted(set(fams) | set(fallback)):
         fam = tuple(fams.get(i, ()))
         other = fallback.get(i)
@@ -347,9 +349,16 @@ def _solve_chunk(
         rows = np.nonzero(pose_idx == i)[0]
         if other is not None and (rows.size == 0 or red.closed_form):
             keep[rows] = False
-            extra.append((i, other, off_families(robot, other.q, fam)))
+            checks.append((other.q, fam))
+            targets.append((i, other, rows))
         else:
-            keep[rows] = off_families(robot, q[rows], fam)
+            checks.append((q[rows], fam))
+            targets.append((i, None, rows))
+    for (i, other, rows), off in zip(targets, off_families(robot, checks), strict=True):
+        if other is None:
+            keep[rows] = off
+        else:
+            extra.append((i, other, off))
     p_parts, q_parts, e_parts = [pose_idx[keep]], [q[keep]], [err_paper[keep]]
     g_parts, in_parts, m_parts = [err_geo[keep]], [inside[keep]], [mult[keep]]
     for i, other, k in extra:
