@@ -139,24 +139,28 @@ if AVAILABLE:
         (float64[:, ::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean, boolean[::1]), cache=True
     )
     def _wrap_inside(q, rev, lower, upper, ltol, beyond, inside):  # pragma: no cover
-        K, n = q.shape
+        for k in range(q.shape[0]):
+            inside[k] = wrap_inside_row(q[k], rev, lower, upper, ltol, beyond)
+
+    @internal
+    def wrap_inside_row(q, rev, lower, upper, ltol, beyond):  # pragma: no cover
+        """Steps 1 and 2 for one configuration ``q (n,)``: wrapped in place; whether it is inside the limits."""
         two_pi = 2.0 * math.pi
-        for k in range(K):
-            ok = True
-            for j in range(n):
-                x = q[k, j]
-                if rev[j] and math.isfinite(x):
-                    x = math.pi - ((math.pi - x) % two_pi)
-                    if beyond and (x < lower[j] - ltol[j] or x > upper[j] + ltol[j]):
-                        for shift in (two_pi, -two_pi):
-                            c = x + shift
-                            if lower[j] - ltol[j] <= c <= upper[j] + ltol[j]:
-                                x = c
-                                break
-                    q[k, j] = x
-                if not (lower[j] - ltol[j] <= x <= upper[j] + ltol[j]):
-                    ok = False
-            inside[k] = ok
+        ok = True
+        for j in range(q.shape[0]):
+            x = q[j]
+            if rev[j] and math.isfinite(x):
+                x = math.pi - ((math.pi - x) % two_pi)
+                if beyond and (x < lower[j] - ltol[j] or x > upper[j] + ltol[j]):
+                    for shift in (two_pi, -two_pi):
+                        c = x + shift
+                        if lower[j] - ltol[j] <= c <= upper[j] + ltol[j]:
+                            x = c
+                            break
+                q[j] = x
+            if not (lower[j] - ltol[j] <= x <= upper[j] + ltol[j]):
+                ok = False
+        return ok
 
     @internal
     def _group_order(pose):  # pragma: no cover

@@ -196,6 +196,88 @@ if AVAILABLE:
             for k in range(i * nb, (i + 1) * nb):
                 _certify_row(H, P, rev, R_end, weight, q, world[i], k, err_geo, err_paper)
 
+    from .dedupe import wrap_inside_row
+
+    @lazy_njit(
+        (_CFG, float64[:, ::1], float64[:, :, ::1], int64[::1], int64[::1], float64[::1], float64[::1], int64)
+        + (types.boolean, float64, float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64)
+        + (types.boolean[::1], float64[::1], float64[::1], float64[::1], types.boolean, int64, int64),
+        cache=True,
+        nogil=True,
+    )
+    def _bisect_members(
+        cfg,
+        params,
+        world,
+        pose,
+        branch,
+        a,
+        b,
+        steps,
+        limits,
+        tol,
+        H,
+        P,
+        rev,
+        R_end,
+        weight,
+        jrev,
+        lower,
+        upper,
+        ltol,
+        beyond,
+        start,
+        stop,
+    ):
+        """Cuts ``start .. stop - 1``: ``steps`` bisections of ``[a[k], b[k]]`` (``a`` a certified family member,
+        ``b`` not), ``a`` and ``b`` updated in place."""
+        q = np.empty((1, H.shape[0]))
+        eg = np.empty(1)
+        ep = np.empty(1)
+        for k in range(start, stop):
+            i = pose[k]
+            for _ in range(steps):
+                mid = 0.5 * (a[k] + b[k])
+                cfg(params[i], mid, branch[k], q[0])
+                _certify_row(H, P, rev, R_end, weight, q, world[i], 0, eg, ep)
+                on = eg[0] <= tol  # (inf where the member does not exist)
+                if on and limits:
+                    on = wrap_inside_row(q[0], jrev, lower, upper, ltol, beyond)
+                if on:
+                    a[k] = mid
+                else:
+                    b[k] = mid
+
+
+def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Array, b: Array, steps: int, limits, tol):
+    """``steps`` bisections of each ``[a, b]`` between a family member that is a certified solution (FK error
+    within ``tol`` and, with ``limits``, inside the joint limits) and one that is not, as
+    ``families._members_ok`` decides: the last certified points ``a`` (new arrays; ``b`` too)."""
+    a, b = np.array(a, dtype=np.float64), np.array(b, dtype=np.float64)
+    ch = robot.chain
+    lim_args = (
+        np.array(robot.is_revolute),
+        np.array(robot.lower),
+        np.array(robot.upper),
+        np.array(robot.limit_tol),
+        bool(robot._limits_beyond_pi),
+    )
+    args = (pose.astype(np.int64), branch.astype(np.int64), a, b, int(steps), bool(limits), float(tol))
+    geometry = (np.array(ch.H), np.array(ch.P), np.array(ch.revolute), np.array(ch.R_end))
+    parallel.run(
+        _bisect_members,
+        a.size,
+        PARALLEL_MIN,
+        first_class(red.kernel[1]),
+        np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
+        np.array(world, dtype=np.float64, order="C", copy=not world.flags.writeable or None),
+        *args,
+        *geometry,
+        float(orientation_weight(robot.length_unit)),
+        *lim_args,
+    )
+    return a, b
+
 
 def certify_every_branch(robot, red, chain: Array, world: Array, params: Array | None = None):
     """A closed form's candidates, every branch of every pose (pose-major, as ``solver._every_branch``), certified
