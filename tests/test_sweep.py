@@ -232,6 +232,48 @@ def test_closed_form_all_branch_configurations_are_bitwise_the_one_branch_ones(
     assert owned_kernel(OwnKernel(robot, red.plan), "kernel_configurations") is None
 
 
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.parametrize(("name", "reduction"), [("carm", "carm-d1"), ("carm", "auto"), ("ur5", "auto"), ("xarm6", None)])
+def test_compiled_family_steps_are_the_numpy_ones(name: str, reduction: str | None) -> None:
+    """The family pieces' compiled steps give the NumPy steps' values bit for bit: the cut bisection
+    (``fastcertify.bisect_members`` against ``families._members_ok`` step by step, with and without limits) and
+    the golden-section search for limit dips (``fastcertify.dip_search`` against ``families._golden_dips``,
+    including members that do not exist, NaN limit excess, and the common stop of all dips)."""
+    from sweepik import families, fastcertify, solver
+
+    robot = load_robot(name)
+    red = sweepik.get_reduction(robot, reduction)
+    if red.closed_form:  # (its fallback sweep is what has families)
+        red = sweepik.get_reduction(robot, red.fallback)
+    rng = np.random.default_rng(6)
+    q = rng.uniform(robot.lower, robot.upper, size=(40, robot.n_joints))
+    q[:20, 4] = 0.0
+    world = robot.fk(q)
+    chain = solver._chain_poses(robot, world)
+    lo, hi = solver._theta_range(robot, red, chain)
+    K = 300
+    pose = rng.integers(0, len(q), K).astype(np.intp)
+    branch = rng.integers(0, red.n_branches, K).astype(np.intp)
+    a = lo[pose] + (hi - lo)[pose] * rng.random(K)
+    b = a + (hi - lo)[pose] * rng.uniform(-0.1, 0.1, K)
+    tol = solver.ACCEPT_TOL_REL * robot.length_scale
+    for limits in (True, False):
+        got = fastcertify.bisect_members(robot, red, chain, world, pose, branch, a, b, 12, limits, tol)
+        ra, rb = a.copy(), b.copy()
+        for _ in range(12):
+            mid = 0.5 * (ra + rb)
+            on = families._members_ok(robot, red, chain, world, pose, branch, mid[:, None], limits, tol)[:, 0]
+            ra, rb = np.where(on, mid, ra), np.where(on, rb, mid)
+        np.testing.assert_array_equal(got[0], ra)
+        np.testing.assert_array_equal(got[1], rb)
+    best_x = 0.5 * (a + b)
+    best_e = np.full(K, 10.0 * robot.length_scale)
+    ref = families._golden_dips(robot, red, chain, pose, branch, a, b, best_x, best_e)
+    got = fastcertify.dip_search(robot, red, chain, pose, branch, a, b, best_x, best_e, families._DIP_STEPS)
+    np.testing.assert_array_equal(got[0], ref[0])
+    np.testing.assert_array_equal(got[1], ref[1])
+
+
 def test_compiled_sample_grid_is_the_numpy_one() -> None:
     """``fastsweep.sample_grid`` (compiled merge) gives the reference's samples exactly: hints inside and outside
     the range, NaN hints, hints on the uniform grid and repeated (runs of equal samples spread), real reductions."""

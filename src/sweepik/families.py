@@ -102,9 +102,35 @@ def _limit_dips(
         return np.zeros((K, 0))
     a, b = grid[k, np.maximum(i - 1, 0)], grid[k, np.minimum(i + 1, M - 1)]
     best_x, best_e = grid[k, i], big[k, i]
+    if red.uses_kernel and fastsweep.AVAILABLE:
+        best_x, best_e = fastcertify.dip_search(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e, _DIP_STEPS)
+    else:
+        best_x, best_e = _golden_dips(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e)
+    found = best_e <= 0.0
+    rows = k[found]
+    width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
+    extra = np.repeat(grid[:, :1], width, axis=1)
+    # the j-th dip of a span goes to column j (rows are sorted: k comes from np.nonzero)
+    col = np.arange(rows.size) - np.searchsorted(rows, rows)
+    extra[rows, col] = best_x[found]
+    return extra
+
+
+def _golden_dips(
+    robot: Robot,
+    red: Reduction,
+    chain: Array,
+    pose: NDArray[np.intp],
+    branch: NDArray[np.intp],
+    a: Array,
+    b: Array,
+    best_x: Array,
+    best_e: Array,
+) -> tuple[Array, Array]:
+    """The golden-section steps of ``_limit_dips`` (the NumPy reference; ``fastcertify.dip_search``)."""
 
     def excess(x: Array) -> Array:
-        return _limit_excess(robot, red, chain, pose[k], branch[k], x)
+        return _limit_excess(robot, red, chain, pose, branch, x)
 
     c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
     ec, ed = excess(c), excess(d)
@@ -122,14 +148,7 @@ def _limit_dips(
         e_fresh = excess(fresh)
         ec, ed = np.where(left, e_fresh, ed), np.where(left, ec, e_fresh)
         c, d = new_c, new_d
-    found = best_e <= 0.0
-    rows = k[found]
-    width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
-    extra = np.repeat(grid[:, :1], width, axis=1)
-    # the j-th dip of a span goes to column j (rows are sorted: k comes from np.nonzero)
-    col = np.arange(rows.size) - np.searchsorted(rows, rows)
-    extra[rows, col] = best_x[found]
-    return extra
+    return best_x, best_e
 
 
 def merge_spans(spans: list[FamilySpan]) -> list[FamilySpan]:

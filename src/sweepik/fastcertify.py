@@ -30,6 +30,7 @@ _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
 #: Candidates whose geodesic error exceeds this times the orientation weight (1e-4 x 100 mm = 0.01 mm) are far
 #: from any solution (accepted ones are below 1e-9 mm, polished ones below 3e-3 mm): their J is reported as inf.
 J_CUTOFF_FACTOR = 1e-4
+_MAX_FLOAT = float(np.finfo(np.float64).max)
 
 if AVAILABLE:
     from numba import float64, int64, types
@@ -248,6 +249,110 @@ if AVAILABLE:
                 else:
                     b[k] = mid
 
+    @internal
+    def _limit_excess_row(q, jrev, lower, upper, ltol, beyond):
+        """``families._limit_excess`` of one member ``q (n,)`` (changed in place), value for value: NaN becomes
+        inf and +-inf the largest float (``np.nan_to_num``); an infinite revolute value wraps to NaN."""
+        bad = False
+        for j in range(q.shape[0]):
+            x = q[j]
+            if math.isnan(x):
+                x = math.inf
+            elif x == math.inf:
+                x = _MAX_FLOAT
+            elif x == -math.inf:
+                x = -_MAX_FLOAT
+            q[j] = x
+            if x == math.inf:
+                if jrev[j]:
+                    return math.nan
+                bad = True
+        if bad:
+            return math.inf
+        wrap_inside_row(q, jrev, lower, upper, ltol, beyond)
+        out = -math.inf
+        for j in range(q.shape[0]):
+            out = max(out, max(lower[j] - q[j], q[j] - upper[j]))
+        return out
+
+    @lazy_njit(
+        (_CFG, float64[:, ::1], int64[::1], int64[::1], float64[::1], float64[::1], float64[::1], float64[::1])
+        + (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[::1], float64[::1], float64[::1])
+        + (types.boolean, int64, int64),
+        cache=True,
+        nogil=True,
+    )
+    def _dip_search(
+        cfg, params, pose, branch, a, b, best_x, best_e, hist_x, hist_e, jrev, lower, upper, ltol, beyond, start, stop
+    ):
+        """Dips ``start .. stop - 1``: the golden-section search of ``families._limit_dips`` run for all its steps,
+        the best point and excess after each step's update into ``hist_x``, ``hist_e``."""
+        q = np.empty(jrev.shape[0])
+        g = 0.5 * (math.sqrt(5.0) - 1.0)
+        for k in range(start, stop):
+            i, br, lo, hi, bx, be = pose[k], branch[k], a[k], b[k], best_x[k], best_e[k]
+            c, d = hi - g * (hi - lo), lo + g * (hi - lo)
+            cfg(params[i], c, br, q)
+            ec = _limit_excess_row(q, jrev, lower, upper, ltol, beyond)
+            cfg(params[i], d, br, q)
+            ed = _limit_excess_row(q, jrev, lower, upper, ltol, beyond)
+            for t in range(hist_x.shape[1]):
+                if ec < be:
+                    bx, be = c, ec
+                if ed < be:
+                    bx, be = d, ed
+                hist_x[k, t], hist_e[k, t] = bx, be
+                left = ec < ed  # the least excess lies in [lo, d]: d becomes the new right end
+                if left:
+                    hi = d
+                    new_c, new_d = hi - g * (hi - lo), c
+                    fresh = new_c
+                else:
+                    lo = c
+                    new_c, new_d = d, lo + g * (hi - lo)
+                    fresh = new_d
+                cfg(params[i], fresh, br, q)
+                e_fresh = _limit_excess_row(q, jrev, lower, upper, ltol, beyond)
+                if left:
+                    ec, ed = e_fresh, ec
+                else:
+                    ec, ed = ed, e_fresh
+                c, d = new_c, new_d
+
+
+def dip_search(robot, red, chain: Array, pose, branch, a: Array, b: Array, best_x: Array, best_e: Array, steps: int):
+    """``families._golden_dips`` compiled, value for value: ``(best_x, best_e)``."""
+    K = a.shape[0]
+    hist_x, hist_e = np.empty((K, steps)), np.empty((K, steps))
+    parallel.run(
+        _dip_search,
+        K,
+        PARALLEL_MIN,
+        first_class(red.kernel[1]),
+        np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
+        pose.astype(np.int64),
+        branch.astype(np.int64),
+        *(np.array(x, dtype=np.float64) for x in (a, b, best_x, best_e)),
+        hist_x,
+        hist_e,
+        *_limit_args(robot),
+    )
+    # each dip ran for every step; the NumPy steps stop for all dips once every one holds a point inside the limits
+    hit = hist_e <= 0.0
+    last = int(np.argmax(hit, axis=1).max()) if K and hit.any(axis=1).all() else steps - 1
+    return hist_x[:, last], hist_e[:, last]
+
+
+def _limit_args(robot):
+    """The robot's limits as the compiled ``wrap_inside_row`` takes them."""
+    return (
+        np.array(robot.is_revolute),
+        np.array(robot.lower),
+        np.array(robot.upper),
+        np.array(robot.limit_tol),
+        bool(robot._limits_beyond_pi),
+    )
+
 
 def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Array, b: Array, steps: int, limits, tol):
     """``steps`` bisections of each ``[a, b]`` between a family member that is a certified solution (FK error
@@ -255,13 +360,6 @@ def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Arra
     ``families._members_ok`` decides: the last certified points ``a`` (new arrays; ``b`` too)."""
     a, b = np.array(a, dtype=np.float64), np.array(b, dtype=np.float64)
     ch = robot.chain
-    lim_args = (
-        np.array(robot.is_revolute),
-        np.array(robot.lower),
-        np.array(robot.upper),
-        np.array(robot.limit_tol),
-        bool(robot._limits_beyond_pi),
-    )
     args = (pose.astype(np.int64), branch.astype(np.int64), a, b, int(steps), bool(limits), float(tol))
     geometry = (np.array(ch.H), np.array(ch.P), np.array(ch.revolute), np.array(ch.R_end))
     parallel.run(
@@ -274,7 +372,7 @@ def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Arra
         *args,
         *geometry,
         float(orientation_weight(robot.length_unit)),
-        *lim_args,
+        *_limit_args(robot),
     )
     return a, b
 
