@@ -41,6 +41,26 @@ if AVAILABLE:
     _CFGS = types.FunctionType(CONFIGURATIONS_SIG)
 
     @internal
+    def _turn(r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, angle):
+        """The rotation ``r`` (row by row) followed by a turn of ``angle`` about the unit axis ``k`` (Rodrigues)."""
+        c, s = math.cos(angle), math.sin(angle)
+        v = 1.0 - c
+        k00, k01, k02 = c + kx * kx * v, kx * ky * v - kz * s, kx * kz * v + ky * s
+        k10, k11, k12 = ky * kx * v + kz * s, c + ky * ky * v, ky * kz * v - kx * s
+        k20, k21, k22 = kz * kx * v - ky * s, kz * ky * v + kx * s, c + kz * kz * v
+        return (
+            r00 * k00 + r01 * k10 + r02 * k20,
+            r00 * k01 + r01 * k11 + r02 * k21,
+            r00 * k02 + r01 * k12 + r02 * k22,
+            r10 * k00 + r11 * k10 + r12 * k20,
+            r10 * k01 + r11 * k11 + r12 * k21,
+            r10 * k02 + r11 * k12 + r12 * k22,
+            r20 * k00 + r21 * k10 + r22 * k20,
+            r20 * k01 + r21 * k11 + r22 * k21,
+            r20 * k02 + r21 * k12 + r22 * k22,
+        )
+
+    @internal
     def _poe_fk(H, P, rev, R_end, q):
         """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain as 12 scalars (rotation
         row by row, then position): scalar locals only, no array allocated (this runs once per candidate)."""
@@ -49,25 +69,8 @@ if AVAILABLE:
         for i in range(H.shape[0]):
             kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
             if rev[i]:
-                c, s = math.cos(q[i]), math.sin(q[i])
-                v = 1.0 - c
-                k00, k01, k02 = c + kx * kx * v, kx * ky * v - kz * s, kx * kz * v + ky * s
-                k10, k11, k12 = ky * kx * v + kz * s, c + ky * ky * v, ky * kz * v - kx * s
-                k20, k21, k22 = kz * kx * v - ky * s, kz * ky * v + kx * s, c + kz * kz * v
-                r00, r01, r02 = (
-                    r00 * k00 + r01 * k10 + r02 * k20,
-                    r00 * k01 + r01 * k11 + r02 * k21,
-                    r00 * k02 + r01 * k12 + r02 * k22,
-                )
-                r10, r11, r12 = (
-                    r10 * k00 + r11 * k10 + r12 * k20,
-                    r10 * k01 + r11 * k11 + r12 * k21,
-                    r10 * k02 + r11 * k12 + r12 * k22,
-                )
-                r20, r21, r22 = (
-                    r20 * k00 + r21 * k10 + r22 * k20,
-                    r20 * k01 + r21 * k11 + r22 * k21,
-                    r20 * k02 + r21 * k12 + r22 * k22,
+                r00, r01, r02, r10, r11, r12, r20, r21, r22 = _turn(
+                    r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, q[i]
                 )
             else:
                 d = q[i]
@@ -352,6 +355,117 @@ def _limit_args(robot):
         np.array(robot.limit_tol),
         bool(robot._limits_beyond_pi),
     )
+
+
+if AVAILABLE:
+
+    @internal
+    def _put_pose(T, out):
+        """``_poe_fk``'s 12 scalars as the 4x4 matrix ``out``."""
+        for r in range(3):
+            for c in range(3):
+                out[r, c] = T[3 * r + c]
+            out[r, 3] = T[9 + r]
+            out[3, r] = 0.0
+        out[3, 3] = 1.0
+
+    @lazy_njit(
+        (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64[:, ::1], float64[:, :, ::1])
+        + (float64, float64[:, :, ::1], float64[::1], int64, int64),
+        cache=True,
+        nogil=True,
+    )
+    def _tool_poses(H, P, rev, R_end, q, target, weight, out, err, start, stop):
+        """Rows ``start .. stop - 1``: the world tool pose of ``q[k]`` into ``out[k]`` and (``target`` non-empty)
+        its geodesic error to ``target[k]`` into ``err[k]``."""
+        for k in range(start, stop):
+            T = _poe_fk(H, P, rev, R_end, q[k])
+            _put_pose(T, out[k])
+            if target.shape[0]:
+                err[k] = _errors(T, target[k], weight)[0]
+
+    @lazy_njit(
+        (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64[:, ::1], float64[:, :, ::1])
+        + (float64[:, :, ::1], int64, int64),
+        cache=True,
+        nogil=True,
+    )
+    def _pose_jacobian(H, P, rev, R_end, q, T, J, start, stop):
+        """Rows ``start .. stop - 1``: the world tool pose of ``q[k]`` into ``T[k]`` and the geometric Jacobian at
+        the tool point into ``J[k] (6, n)`` (as ``kinematics.geometric_jacobian``), along ``_poe_fk``'s chain."""
+        n = H.shape[0]
+        z = np.empty((n, 3))
+        o = np.empty((n, 3))
+        for k in range(start, stop):
+            Tk = _poe_fk(H, P, rev, R_end, q[k])
+            _put_pose(Tk, T[k])
+            # each joint's axis (world) and a point on it, from the rotations of the joints before it
+            r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+            px, py, pz = P[0, 0], P[0, 1], P[0, 2]
+            for i in range(n):
+                kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
+                z[i, 0] = r00 * kx + r01 * ky + r02 * kz
+                z[i, 1] = r10 * kx + r11 * ky + r12 * kz
+                z[i, 2] = r20 * kx + r21 * ky + r22 * kz
+                o[i, 0], o[i, 1], o[i, 2] = px, py, pz
+                if rev[i]:
+                    r00, r01, r02, r10, r11, r12, r20, r21, r22 = _turn(
+                        r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, q[k, i]
+                    )
+                else:
+                    d = q[k, i]
+                    px += z[i, 0] * d
+                    py += z[i, 1] * d
+                    pz += z[i, 2] * d
+                ax, ay, az = P[i + 1, 0], P[i + 1, 1], P[i + 1, 2]
+                px += r00 * ax + r01 * ay + r02 * az
+                py += r10 * ax + r11 * ay + r12 * az
+                pz += r20 * ax + r21 * ay + r22 * az
+            tx, ty, tz = Tk[9], Tk[10], Tk[11]
+            for i in range(n):
+                zx, zy, zz = z[i, 0], z[i, 1], z[i, 2]
+                if rev[i]:
+                    dx, dy, dz = tx - o[i, 0], ty - o[i, 1], tz - o[i, 2]
+                    J[k, 0, i], J[k, 1, i], J[k, 2, i] = zy * dz - zz * dy, zz * dx - zx * dz, zx * dy - zy * dx
+                    J[k, 3, i], J[k, 4, i], J[k, 5, i] = zx, zy, zz
+                else:
+                    J[k, 0, i], J[k, 1, i], J[k, 2, i] = zx, zy, zz
+                    J[k, 3, i], J[k, 4, i], J[k, 5, i] = 0.0, 0.0, 0.0
+
+
+def pose_and_jacobian(robot, q: Array) -> tuple[Array, Array]:
+    """World tool poses ``(K, 4, 4)`` and geometric Jacobians ``(K, 6, n)`` at the tool point of configurations
+    ``q (K, n)`` (``kinematics.geometric_jacobian``), compiled."""
+    K, n = q.shape
+    T, J = np.empty((K, 4, 4)), np.empty((K, 6, n))
+    ch = robot.chain
+    q = np.ascontiguousarray(q, dtype=np.float64)
+    args = (np.array(ch.H), np.array(ch.P), np.array(ch.revolute), np.array(ch.R_end), q, T, J)
+    parallel.run(_pose_jacobian, K, 16 * PARALLEL_MIN, *args)
+    return T, J
+
+
+def tool_poses(robot, q: Array, target: Array | None = None, weight: float = 1.0) -> tuple[Array, Array]:
+    """World tool poses ``(K, 4, 4)`` of configurations ``q (K, n)`` (any joint types, product of exponentials)
+    and, with ``target (K, 4, 4)``, their geodesic errors ``(K,)`` (position + ``weight`` x angle), compiled."""
+    K = q.shape[0]
+    out, err = np.empty((K, 4, 4)), np.empty(K if target is not None else 0)
+    ch = robot.chain
+    parallel.run(
+        _tool_poses,
+        K,
+        16 * PARALLEL_MIN,
+        np.array(ch.H),
+        np.array(ch.P),
+        np.array(ch.revolute),
+        np.array(ch.R_end),
+        np.ascontiguousarray(q, dtype=np.float64),
+        np.zeros((0, 4, 4)) if target is None else np.array(target, dtype=np.float64, order="C"),
+        float(weight),
+        out,
+        err,
+    )
+    return out, err
 
 
 def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Array, b: Array, steps: int, limits, tol):

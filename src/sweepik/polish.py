@@ -23,7 +23,21 @@ PINV_RCOND = 1e-10
 
 
 def _pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:
+    from .fastcertify import AVAILABLE, pose_and_jacobian
+
+    if AVAILABLE:
+        return pose_and_jacobian(robot, q)
     return _pose(robot, q), kinematics.geometric_jacobian(robot, q)
+
+
+def _error(robot: Robot, q: Array, target: Array, weight: float) -> Array:
+    """Geodesic errors of configurations ``q (K, n)`` to ``target (K, 4, 4)`` (compiled when Numba is present: a
+    polish of a few configurations is mostly these evaluations, ~70 us each in NumPy)."""
+    from .fastcertify import AVAILABLE, tool_poses
+
+    if AVAILABLE:
+        return tool_poses(robot, q, target, weight)[1]
+    return pose_error_geodesic(_pose(robot, q), target, weight)
 
 
 #: Newton steps at most (a step that does not lower the error ends a configuration's polish).
@@ -49,7 +63,7 @@ def polish(
     if q.shape[0] == 0:
         return q
     q = q.copy()
-    err = pose_error_geodesic(_pose(robot, q), target, weight)
+    err = _error(robot, q, target, weight)
     scale = np.array([1.0, 1.0, 1.0, weight, weight, weight])
     active = np.arange(q.shape[0])
     for _ in range(iterations):
@@ -68,7 +82,7 @@ def polish(
         todo = np.arange(active.size)
         for _ in range(BACKTRACK + 1):
             q_new = qa[todo] + step[todo]
-            err_new = pose_error_geodesic(_pose(robot, q_new), ta[todo], weight)
+            err_new = _error(robot, q_new, ta[todo], weight)
             better = np.isfinite(err_new) & (err_new < err[active[todo]])
             rows = active[todo[better]]
             q[rows], err[rows] = q_new[better], err_new[better]
@@ -84,4 +98,8 @@ def polish(
 
 
 def _pose(robot: Robot, q: Array) -> Array:
+    from .fastcertify import AVAILABLE, tool_poses
+
+    if AVAILABLE:
+        return tool_poses(robot, q)[0]
     return kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool
