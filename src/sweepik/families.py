@@ -411,8 +411,9 @@ def collapse_continua(robot: Robot, pose: NDArray[np.intp], q: Array) -> NDArray
             if np.array_equal(new, label):
                 break
             label = new
-        keep[idx] = False
-        for lab in np.unique(label):
+        labels, inverse, sizes = np.unique(label, return_inverse=True, return_counts=True)
+        keep[idx] = sizes[inverse] == 1  # (a group of one is its own medoid)
+        for lab in labels[sizes > 1]:
             g = np.nonzero(label == lab)[0]
             keep[idx[g[np.argmin(dist[np.ix_(g, g)].max(axis=1))]]] = True
     return keep
