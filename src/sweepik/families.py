@@ -187,14 +187,12 @@ def families_of(
     ok = _members_ok(robot, red, chain, world, pose, branch, grid, limits, tol)
     pad = np.zeros((len(spans), 1), np.int8)
     edges = np.diff(np.concatenate([pad, ok.astype(np.int8), pad], axis=1), axis=1)
-    pieces = []  # (span index, first ok sample, last ok sample)
-    for k in range(len(spans)):
-        for s_, e_ in zip(np.nonzero(edges[k] == 1)[0], np.nonzero(edges[k] == -1)[0], strict=True):
-            pieces.append((k, int(s_), int(e_ - 1)))
+    # pieces (span K, first ok sample S, last ok sample E), span by span: each rise of ok pairs with the next fall
+    K, S = np.nonzero(edges == 1)
+    E = np.nonzero(edges == -1)[1] - 1
     near_p, near_q = _near_family_members(robot, red, chain, pose, branch, grid, ok, used)
-    if not pieces:
+    if K.size == 0:
         return out, near_p, near_q
-    K, S, E = (np.array(x) for x in zip(*pieces, strict=True))
     M = grid.shape[1]
     # bisect each cut between the last sample inside and the first outside
     inside = np.concatenate([grid[K, S], grid[K, E]])
@@ -216,7 +214,7 @@ def families_of(
                 on = _members_ok(robot, red, chain, world, pose[which], branch[which], mid[:, None], limits, tol)
                 a, b = np.where(on[:, 0], mid, a), np.where(on[:, 0], b, mid)
         inside[cut] = a
-    n = len(pieces)
+    n = K.size
     lo, hi = inside[:n], inside[n:]
     if limits and not red.periodic:  # within the limit tolerance, but reported inside theta*'s own limits
         j = red.free_joint
@@ -294,6 +292,41 @@ def _repeated_pieces(
     dup = np.zeros(P, dtype=bool)
     if P < 2:
         return dup
+    tol = _MEMBER_TOL * np.maximum(1.0, hi - lo)
+    # pairs (i, j), j < i, of the same pose with the same interval (within i's tolerance), pose by pose
+    order = np.argsort(pose, kind="stable")
+    cuts = np.flatnonzero(np.diff(pose[order])) + 1
+    pairs_i, pairs_j = [], []
+    for g in np.split(order, cuts):
+        if g.size < 2:
+            continue
+        same = (
+            (np.abs(lo[g][:, None] - lo[g][None, :]) <= tol[g][:, None])
+            & (np.abs(hi[g][:, None] - hi[g][None, :]) <= tol[g][:, None])
+            & np.tri(g.size, k=-1, dtype=bool)
+        )
+        a, b = np.nonzero(same)
+        pairs_i.append(g[a])
+        pairs_j.append(g[b])
+    if not pairs_i:
+        return dup
+    pi, pj = np.concatenate(pairs_i), np.concatenate(pairs_j)
+    if pi.size == 0:
+        return dup
+    # every pair's members compared at once (5 points of the interval), then the pairs in order
+    used, where = np.unique(np.concatenate([pi, pj]), return_inverse=True)
+    u = np.linspace(0.0, 1.0, 5)
+    x = lo[used, None] + (hi - lo)[used, None] * u[None, :]
+    at = (np.repeat(pose[used], u.size), np.repeat(branch[used], u.size), x.ravel())
+    members = family_members(robot, red, chain, *at)
+    members = robot.wrap(members).reshape(used.size, u.size, -1)
+    mi, mj = where[: pi.size], where[pi.size :]
+    equal = np.all(_same_configuration(robot, members[mi], members[mj]), axis=-1)
+    for k in np.lexsort((pj, pi)):
+        i, j = pi[k], pj[k]
+        if not dup[i] and not dup[j] and equal[k]:
+            dup[i] = True
+    return dup
     tol = _MEMBER_TOL * np.maximum(1.0, hi - lo)
     same_iv = (
         (pose[:, None] == pose[None, :])
