@@ -235,7 +235,10 @@ class GeometricReduction(Reduction):
             return None
         out = np.zeros(poses.shape[0], dtype=np.bool_)
         singular = geometric.parallel_singular if self.plan.family == "parallel" else self._case_kernels.wrist_singular
-        singular(self.kernel_params(poses), out)
+        from .. import parallel
+        from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
+
+        parallel.run(singular, poses.shape[0], 2 * PARALLEL_MIN, self.kernel_params(poses), out)
         return out
 
     def search_range(self, poses: Array) -> Array | None:

@@ -528,12 +528,12 @@ def configure(cfg, params, pose, theta, branch, out):
 WRIST_SINGULAR = 1e-6
 
 
-@njit(cache=True)
-def parallel_singular(params, out):
-    """``out[i]``: some exact branch of joint 1 leaves pose i with joint 6's axis along the parallel axes (joint 6
-    and the sum of joints 2-4 then turn about one direction: a continuum)."""
+@njit(cache=True, nogil=True)
+def parallel_singular(params, out, start, stop):
+    """``out[i]`` for poses ``start .. stop - 1``: some exact branch of joint 1 leaves pose i with joint 6's axis
+    along the parallel axes (joint 6 and the sum of joints 2-4 then turn about one direction: a continuum)."""
     h, h5 = _h(params[0], 1), _h(params[0], 5)
-    for i in range(params.shape[0]):
+    for i in range(start, stop):
         p = params[i]
         out[i] = False
         for b in range(0, 8, 2):
@@ -548,7 +548,7 @@ def parallel_singular(params, out):
 
 class CaseKernels(NamedTuple):
     """The compiled kernels of the pair and wrist families for one position case (``position.CASES``): Python calls
-    ``wrist_singular(params, out)``; the others are :class:`~.kernels.LazyKernel` objects with the engine's
+    ``wrist_singular(params, out, start, stop)``; the others are :class:`~.kernels.LazyKernel` objects with the engine's
     signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch;
     ``pair_residuals`` and ``pair_margins`` are their all-branch kernels, ``Reduction.kernel_residuals``)."""
 
@@ -689,10 +689,11 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
                 for i in range(6):
                     out[r, i] = math.nan
 
-        def singular(params, out):
-            """``out[i]``: some exact position branch of the wrist family leaves pose i with a singular wrist."""
+        def singular(params, out, start, stop):
+            """``out[i]`` for poses ``start .. stop - 1``: some exact position branch of the wrist family leaves
+            pose i with a singular wrist."""
             h3, h5 = _h(params[0], 3), _h(params[0], 5)
-            for i in range(params.shape[0]):
+            for i in range(start, stop):
                 p = params[i]
                 out[i] = False
                 for b in range(int(p[_POS_BRANCHES])):
@@ -714,6 +715,6 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
             LazyKernel(amplitudes, RESIDUALS_SIG, cache=True),
             LazyKernel(wrist, CONFIGURATION_SIG, cache=True),
             LazyKernel(wrists, CONFIGURATIONS_SIG, cache=True),
-            njit(cache=True)(singular),
+            njit(cache=True, nogil=True)(singular),
         )
     return ck
