@@ -233,7 +233,9 @@ def test_closed_form_all_branch_configurations_are_bitwise_the_one_branch_ones(
 
 
 @pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
-@pytest.mark.parametrize(("name", "reduction"), [("carm", "carm-d1"), ("carm", "auto"), ("ur5", "auto"), ("xarm6", None)])
+@pytest.mark.parametrize(
+    ("name", "reduction"), [("carm", "carm-d1"), ("carm", "auto"), ("ur5", "auto"), ("xarm6", None)]
+)
 def test_compiled_family_steps_are_the_numpy_ones(name: str, reduction: str | None) -> None:
     """The family pieces' compiled steps give the NumPy steps' values bit for bit: the cut bisection
     (``fastcertify.bisect_members`` against ``families._members_ok`` step by step, with and without limits) and
