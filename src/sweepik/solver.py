@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Iterator, Mapping
+from functools import lru_cache
 from typing import Any, Literal
 
 import numpy as np
@@ -176,14 +177,19 @@ def _twin_copies(red: Reduction, cand: Candidates, spans: list[FamilySpan]) -> t
     )
 
 
+@lru_cache(maxsize=16)
 def _every_branch(n_poses: int, n_branches: int) -> Candidates:
-    """Candidates of a closed form: every branch of every pose (theta* unused: 0)."""
-    return Candidates(
+    """Candidates of a closed form: every branch of every pose (theta* unused: 0). Cached (a chunk's size and a
+    closed form's branches repeat): the arrays are read-only."""
+    cand = Candidates(
         pose=np.repeat(np.arange(n_poses), n_branches).astype(np.intp),
         branch=np.tile(np.arange(n_branches), n_poses).astype(np.intp),
         theta=np.zeros(n_poses * n_branches),
         mult=np.ones(n_poses * n_branches, dtype=np.intp),
     )
+    for a in (cand.pose, cand.branch, cand.theta, cand.mult):
+        a.flags.writeable = False
+    return cand
 
 
 def _solve_chunk(
@@ -196,13 +202,14 @@ def _solve_chunk(
     use_fallback: bool = True,
 ) -> Block:
     chain = _chain_poses(robot, poses)
-    lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
+    closed = red.closed_form
+    if not closed:  # (a closed form sweeps nothing)
+        lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
     weight = orientation_weight(robot.length_unit)
     spans: list[FamilySpan] = []
     fams: dict[int, list[Family]]
     compiled = red.uses_kernel and fastsweep.AVAILABLE
     err_geo = err_paper = None
-    closed = red.closed_form
     if strategy == "precise" or closed:
         if closed:  # no sweep: every branch of the closed form is a candidate
             params = red.kernel_params(chain) if compiled else None
@@ -241,11 +248,12 @@ def _solve_chunk(
             pose_idx = np.concatenate([pose_idx, sp_p])
             mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp) if sp_mult is None else sp_mult[sp_p, sp_k]])
         # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
-        spans = [
-            FamilySpan(sp.pose, sp.branch, max(sp.lo, float(lo[sp.pose])), min(sp.hi, float(hi[sp.pose])))
-            for sp in spans
-            if min(sp.hi, hi[sp.pose]) > max(sp.lo, lo[sp.pose])
-        ]
+        if spans:
+            spans = [
+                FamilySpan(sp.pose, sp.branch, max(sp.lo, float(lo[sp.pose])), min(sp.hi, float(hi[sp.pose])))
+                for sp in spans
+                if min(sp.hi, hi[sp.pose]) > max(sp.lo, lo[sp.pose])
+            ]
         fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, ACCEPT_TOL_REL * robot.length_scale)
         if fam_p.size:
             if err_geo is not None and err_paper is not None:
@@ -258,12 +266,13 @@ def _solve_chunk(
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
         mult = np.ones(pose_idx.size, dtype=np.intp)
         fams = {}
-    finite = np.all(np.isfinite(q), axis=-1)
-    pose_idx, q, mult = pose_idx[finite], q[finite], mult[finite]
+    finite = np.isfinite(q).all(axis=-1)
+    if not finite.all():
+        pose_idx, q, mult = pose_idx[finite], q[finite], mult[finite]
+        if err_geo is not None and err_paper is not None:
+            err_geo, err_paper = err_geo[finite], err_paper[finite]
     if err_geo is None or err_paper is None:
         err_geo, err_paper = _errors(robot, q, poses[pose_idx], weight)
-    else:
-        err_geo, err_paper = err_geo[finite], err_paper[finite]
     if strategy == "precise":
         scale = robot.length_scale
         near = np.nonzero(
@@ -292,7 +301,8 @@ def _solve_chunk(
         # a candidate that polishing could not certify (error between rounding level and 1e-6 of the arm):
         # the reduction's closed form is ill-conditioned there; the fallback reduction solves the pose too
         miss = ~certified & (err_geo <= POLISH_BELOW_REL * robot.length_scale)
-        rescue = np.unique(pose_idx[miss])
+        if miss.any():
+            rescue = np.unique(pose_idx[miss])
     pose_idx, q, err_paper, err_geo = pose_idx[certified], q[certified], err_paper[certified], err_geo[certified]
     mult = mult[certified]
     wrapped = None
@@ -359,19 +369,22 @@ def _solve_chunk(
             keep[rows] = off
         else:
             extra.append((i, other, off))
-    p_parts, q_parts, e_parts = [pose_idx[keep]], [q[keep]], [err_paper[keep]]
-    g_parts, in_parts, m_parts = [err_geo[keep]], [inside[keep]], [mult[keep]]
-    for i, other, k in extra:
-        p_parts.append(np.full(int(k.sum()), i, dtype=pose_idx.dtype))
-        q_parts.append(other.q[k])
-        e_parts.append(other.error[k])
-        g_parts.append(other.error_geodesic[k])
-        in_parts.append(other.within_limits[k])
-        m_parts.append(other.multiplicity[k])
-    pose_idx, q, err_paper = np.concatenate(p_parts), np.concatenate(q_parts), np.concatenate(e_parts)
-    err_geo, inside, mult = np.concatenate(g_parts), np.concatenate(in_parts), np.concatenate(m_parts)
-    # (already in pose order, as a closed form's candidates and most sweeps' are: no reordering copies)
-    order = slice(None) if np.all(pose_idx[1:] >= pose_idx[:-1]) else np.argsort(pose_idx, kind="stable")
+    if extra or not keep.all():
+        p_parts, q_parts, e_parts = [pose_idx[keep]], [q[keep]], [err_paper[keep]]
+        g_parts, in_parts, m_parts = [err_geo[keep]], [inside[keep]], [mult[keep]]
+        for i, other, k in extra:
+            p_parts.append(np.full(int(k.sum()), i, dtype=pose_idx.dtype))
+            q_parts.append(other.q[k])
+            e_parts.append(other.error[k])
+            g_parts.append(other.error_geodesic[k])
+            in_parts.append(other.within_limits[k])
+            m_parts.append(other.multiplicity[k])
+        pose_idx, q, err_paper = np.concatenate(p_parts), np.concatenate(q_parts), np.concatenate(e_parts)
+        err_geo, inside, mult = np.concatenate(g_parts), np.concatenate(in_parts), np.concatenate(m_parts)
+    # (already in pose order, as a closed form's candidates and most sweeps' are -- one pose's always: no
+    # reordering copies)
+    in_order = len(poses) == 1 or bool(np.all(pose_idx[1:] >= pose_idx[:-1]))
+    order = slice(None) if in_order else np.argsort(pose_idx, kind="stable")
     empty_reason = None
     if strategy == "paper" and not red.closed_form:  # its final resolution decides nothing about reachability
         step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"

@@ -23,6 +23,7 @@ See docs/reductions.md for a complete example.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from functools import cache
 from typing import Any
 
 import numpy as np
@@ -32,6 +33,16 @@ from ..robot import Robot
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.intp]
+
+
+@cache
+def _kernel_not_overridden(cls: type) -> bool:
+    """No class of ``cls``'s MRO below the one that sets ``kernel`` overrides ``residual`` or ``solve_rest`` (a
+    property of the class: cached, as a solve asks for it several times)."""
+    mro = cls.__mro__
+    owner = next(c for c in mro if "kernel" in vars(c))
+    below = mro[: mro.index(owner)]
+    return not any(name in vars(c) for c in below for name in ("residual", "solve_rest"))
 
 
 class Reduction(ABC):
@@ -86,10 +97,7 @@ class Reduction(ABC):
         Python must not silently run its parent's compiled kernel)."""
         if self.kernel is None:
             return False
-        mro = type(self).__mro__
-        owner = next(c for c in mro if "kernel" in vars(c))
-        below = mro[: mro.index(owner)]
-        return not any(name in vars(c) for c in below for name in ("residual", "solve_rest"))
+        return _kernel_not_overridden(type(self))
 
     def kernel_params(self, poses: Array) -> Array:
         """Per-pose parameters ``(N, P)`` of the compiled kernels (only with ``kernel``)."""
