@@ -14,6 +14,7 @@ present: no per-call array overhead, one pass over the candidates):
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -26,7 +27,7 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 
-__all__ = ["finish", "wrap_inside", "DEDUPE_ANGLE", "DEDUPE_LENGTH_REL"]
+__all__ = ["finish", "wrap_inside", "limit_args", "DEDUPE_ANGLE", "DEDUPE_LENGTH_REL"]
 
 #: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
 DEDUPE_ANGLE = 1e-6
@@ -34,8 +35,23 @@ DEDUPE_ANGLE = 1e-6
 DEDUPE_LENGTH_REL = 1e-8
 
 
+@lru_cache(maxsize=64)
 def _tolerance(robot: Robot) -> Array:
     return np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
+
+
+@lru_cache(maxsize=64)
+def limit_args(robot: Robot) -> tuple[NDArray[np.bool_], Array, Array, Array, bool]:
+    """The robot's limits as the compiled ``wrap_inside_row`` takes them: ``(is_revolute, lower, upper, limit_tol,
+    limits beyond pi)``, writable copies (the compiled signatures take writable arrays; nothing writes them), kept
+    per robot (robots are values: equal robots share them)."""
+    return (
+        np.array(robot.is_revolute),
+        np.array(robot.lower),
+        np.array(robot.upper),
+        np.array(robot.limit_tol),
+        bool(robot._limits_beyond_pi),
+    )
 
 
 def wrap_inside(robot: Robot, q: Array) -> tuple[Array, NDArray[np.bool_]]:
@@ -44,15 +60,7 @@ def wrap_inside(robot: Robot, q: Array) -> tuple[Array, NDArray[np.bool_]]:
         return robot.wrapped_within_limits(q)
     w = np.array(q, dtype=np.float64, order="C")
     inside = np.empty(q.shape[0], dtype=np.bool_)
-    _wrap_inside(
-        w,
-        np.array(robot.is_revolute),
-        np.array(robot.lower),
-        np.array(robot.upper),
-        np.array(robot.limit_tol),
-        bool(robot._limits_beyond_pi),
-        inside,
-    )
+    _wrap_inside(w, *limit_args(robot), inside)
     return w, inside
 
 
@@ -71,7 +79,7 @@ def finish(
     if not (AVAILABLE and q.shape[0]):
         return w, inside, _dedupe(robot, pose_idx, w, score)
     keep = np.empty(q.shape[0], dtype=np.bool_)
-    _dedupe_compiled(pose_idx.astype(np.int64), w, score, np.array(robot.is_revolute), _tolerance(robot), keep)
+    _dedupe_compiled(pose_idx.astype(np.int64), w, score, limit_args(robot)[0], _tolerance(robot), keep)
     return w, inside, keep
 
 

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from . import parallel
 from ._jit import internal
+from .dedupe import limit_args
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
 from .reductions.kernels import first_class, lazy_njit, owned_kernel
@@ -338,23 +339,12 @@ def dip_search(robot, red, chain: Array, pose, branch, a: Array, b: Array, best_
         *(np.array(x, dtype=np.float64) for x in (a, b, best_x, best_e)),
         hist_x,
         hist_e,
-        *_limit_args(robot),
+        *limit_args(robot),
     )
     # each dip ran for every step; the NumPy steps stop for all dips once every one holds a point inside the limits
     hit = hist_e <= 0.0
     last = int(np.argmax(hit, axis=1).max()) if K and hit.any(axis=1).all() else steps - 1
     return hist_x[:, last], hist_e[:, last]
-
-
-def _limit_args(robot):
-    """The robot's limits as the compiled ``wrap_inside_row`` takes them."""
-    return (
-        np.array(robot.is_revolute),
-        np.array(robot.lower),
-        np.array(robot.upper),
-        np.array(robot.limit_tol),
-        bool(robot._limits_beyond_pi),
-    )
 
 
 if AVAILABLE:
@@ -486,7 +476,7 @@ def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Arra
         *args,
         *geometry,
         float(orientation_weight(robot.length_unit)),
-        *_limit_args(robot),
+        *limit_args(robot),
     )
     return a, b
 

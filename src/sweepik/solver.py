@@ -395,7 +395,11 @@ def _solve_chunk(
     return Block(
         robot=robot,
         poses=poses.copy(),
-        bounds=np.searchsorted(pose_idx[order], np.arange(len(poses) + 1)).astype(np.intp),
+        bounds=(
+            np.array([0, pose_idx.size], dtype=np.intp)
+            if len(poses) == 1
+            else np.searchsorted(pose_idx[order], np.arange(len(poses) + 1)).astype(np.intp)
+        ),
         q=q[order],
         error=err_paper[order],
         error_geodesic=err_geo[order],
