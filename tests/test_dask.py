@@ -165,6 +165,11 @@ def test_solve_dask_errors(client: Client, tmp_path: Path) -> None:
         solve_dask(CARM, P, client, n_workers=2)
     with pytest.raises(UnknownOptionError, match="resume"):
         solve_dask(CARM, P, client, resume=True)
+    # refused before the store is created: the corrected call is not met by "already exists"
+    for bad_client, n_workers in ((42, None), (client, 2)):
+        with pytest.raises(UnknownOptionError):
+            solve_dask(CARM, P, bad_client, out=tmp_path / "refused.zarr", chunk_size=10, n_workers=n_workers)
+        assert not (tmp_path / "refused.zarr").exists()
     from sweepik import ShapeError
 
     with pytest.raises(ShapeError, match=r"\(N, 4, 4\)"):
@@ -294,3 +299,19 @@ def test_default_chunking_is_solve_many_bit_for_bit_on_a_swept_arm(client: Clien
 def test_malformed_scheduler_address_is_a_clear_error(address: str) -> None:
     with pytest.raises(sweepik_errors.SweepikError, match="address"):
         solve_dask(CARM, test_poses(CARM, 2, CARM_FAMILY_Q, seed=1), address)
+
+
+def test_store_of_a_run_that_cannot_connect_is_removed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A cluster that cannot be reached (or started) leaves no new store behind."""
+    from sweepik import distributed
+
+    @contextlib.contextmanager
+    def unreachable(client: Any, n_workers: int | None) -> Iterator[Any]:
+        raise sweepik_errors.SweepikError("cannot reach the Dask scheduler (test)")
+        yield  # pragma: no cover
+
+    monkeypatch.setattr(distributed, "_connected", unreachable)
+    P = CARM.fk(np.array([[800.0, 0.3, 0.2, -0.4, 0.5, 0.1]] * 20))
+    with pytest.raises(sweepik_errors.SweepikError, match="cannot reach"):
+        solve_dask(CARM, P, "tcp://127.0.0.1:9", out=tmp_path / "s.zarr", chunk_size=10)
+    assert not (tmp_path / "s.zarr").exists()

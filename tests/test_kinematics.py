@@ -263,3 +263,7 @@ def test_compiled_pose_and_jacobian_match_the_numpy_ones(seed: int, convention: 
     T2, err = fastcertify.tool_poses(robot, q, target, 0.5)
     np.testing.assert_array_equal(T2, T)
     np.testing.assert_allclose(err, pose_error_geodesic(robot.fk(q), target, 0.5), rtol=1e-9, atol=1e-14 * scale)
+    # read-only inputs (e.g. a memory-mapped file's) are taken too, with the same results
+    q.flags.writeable = target.flags.writeable = False
+    np.testing.assert_array_equal(fastcertify.pose_and_jacobian(robot, q)[1], J)
+    np.testing.assert_array_equal(fastcertify.tool_poses(robot, q, target, 0.5)[1], err)

@@ -65,22 +65,24 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    if name == "__version__":
-        from importlib.metadata import PackageNotFoundError, version
+if not TYPE_CHECKING:  # (hidden from type checkers: a module __getattr__ would make every misspelt name Any)
 
-        try:
-            value = version("sweepik")
-        except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
-            value = "0.0.0"
-    elif name in _LAZY:
-        import importlib
+    def __getattr__(name: str) -> Any:
+        if name == "__version__":
+            from importlib.metadata import PackageNotFoundError, version
 
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-    else:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    globals()[name] = value
-    return value
+            try:
+                value = version("sweepik")
+            except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
+                value = "0.0.0"
+        elif name in _LAZY:
+            import importlib
+
+            value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        else:
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        globals()[name] = value
+        return value
 
 
 def __dir__() -> list[str]:

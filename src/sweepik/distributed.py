@@ -246,9 +246,7 @@ def _client_at(distributed: Any, address: str) -> Iterator[Any]:
 def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
     """The client to use: ``client`` itself; a new one for a scheduler address; a local cluster (processes,
     one thread each) when None. Clients and clusters made here are closed on exit."""
-    distributed = _dask()
-    if client is not None and n_workers is not None:
-        raise UnknownOptionError("n_workers sizes the local cluster started when client is None; give one of them")
+    distributed = _check_client(client, n_workers)
     if client is None:
         import dask
 
@@ -270,12 +268,36 @@ def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
     elif isinstance(client, str):
         with _client_at(distributed, client) as c:
             yield c
-    elif isinstance(client, distributed.Client):
-        yield client
     else:
+        yield client
+
+
+def _check_client(client: Any, n_workers: int | None) -> Any:
+    """Refuse a ``client`` that is not a Client, an address or None, or one given with ``n_workers`` (checked
+    before the store is created, so that a refused call leaves nothing behind). Returns ``dask.distributed``."""
+    distributed = _dask()
+    if client is not None and n_workers is not None:
+        raise UnknownOptionError("n_workers sizes the local cluster started when client is None; give one of them")
+    if not (client is None or isinstance(client, str | distributed.Client)):
         raise UnknownOptionError(
             f"client must be a dask.distributed Client, a scheduler address or None, got {short_repr(client, 40)}"
         )
+    return distributed
+
+
+@contextlib.contextmanager
+def _connected_or_discarded(client: Any, n_workers: int | None, fresh: StoreWriter | None) -> Iterator[Any]:
+    """``_connected``; when no connection could be made (an unreachable scheduler, a local cluster that fails to
+    start), the store ``fresh`` created for this run is removed first."""
+    entered = False
+    try:
+        with _connected(client, n_workers) as c:
+            entered = True
+            yield c
+    except BaseException:
+        if not entered and fresh is not None:
+            fresh.discard()
+        raise
 
 
 def auto_chunk_size(n_poses: int, threads: int) -> int:
@@ -346,10 +368,11 @@ def run(
             raise StoreError(f"{path}: cannot create the store: directory {str(path.parent)!r} is missing")
     # the store is created (or opened and checked, with resume) before a local cluster starts whenever the chunk
     # size is known by then: a store that cannot be written or resumed costs no cluster start
+    _check_client(client, n_workers)
     local = _local_threads(client, n_workers)
     cs = stored_chunk or chunk_size or (None if local is None else auto_chunk_size(src.n, local))
     writer = None if out is None or cs is None else _open_writer(out, robot, options, src, cs, resume)
-    with _connected(client, n_workers) as c:
+    with _connected_or_discarded(client, n_workers, None if resume else writer) as c:
         threads = max(1, sum(c.nthreads().values()))
         if cs is None:
             cs = auto_chunk_size(src.n, threads)

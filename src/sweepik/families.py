@@ -327,26 +327,6 @@ def _repeated_pieces(
         if not dup[i] and not dup[j] and equal[k]:
             dup[i] = True
     return dup
-    tol = _MEMBER_TOL * np.maximum(1.0, hi - lo)
-    same_iv = (
-        (pose[:, None] == pose[None, :])
-        & (np.abs(lo[:, None] - lo[None, :]) <= tol[:, None])
-        & (np.abs(hi[:, None] - hi[None, :]) <= tol[:, None])
-        & np.tri(P, k=-1, dtype=bool)
-    )
-    rows = np.nonzero(same_iv.any(axis=1))[0]
-    if rows.size == 0:
-        return dup
-    u = np.linspace(0.0, 1.0, 5)
-    x = lo[:, None] + (hi - lo)[:, None] * u[None, :]
-    members = family_members(robot, red, chain, np.repeat(pose, u.size), np.repeat(branch, u.size), x.ravel())
-    members = robot.wrap(members).reshape(P, u.size, -1)
-    for i in rows:
-        for j in np.nonzero(same_iv[i])[0]:
-            if not dup[j] and np.all(_same_configuration(robot, members[i], members[j])):
-                dup[i] = True
-                break
-    return dup
 
 
 def off_families(robot: Robot, checks: list[tuple[Array, tuple[Family, ...]]]) -> list[NDArray[np.bool_]]:

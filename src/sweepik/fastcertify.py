@@ -9,10 +9,11 @@ hundred small array operations per solve.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import parallel
 from ._jit import internal
@@ -423,15 +424,26 @@ if AVAILABLE:
                     J[k, 3, i], J[k, 4, i], J[k, 5, i] = 0.0, 0.0, 0.0
 
 
+@lru_cache(maxsize=64)
+def chain_args(robot) -> tuple[Array, Array, NDArray[np.bool_], Array]:
+    """The robot's chain ``(H, P, revolute, R_end)`` as the compiled kernels take it: writable copies (their
+    signatures take writable arrays; nothing writes them), kept per robot (robots are values)."""
+    ch = robot.chain
+    return np.array(ch.H), np.array(ch.P), np.array(ch.revolute), np.array(ch.R_end)
+
+
+def _writable(a: ArrayLike) -> Array:
+    """``a`` as a C-contiguous, writable float64 array (the compiled signatures' kind): copied only if needed."""
+    a = np.asarray(a)
+    return np.array(a, dtype=np.float64, order="C", copy=not a.flags.writeable or None)
+
+
 def pose_and_jacobian(robot, q: Array) -> tuple[Array, Array]:
     """World tool poses ``(K, 4, 4)`` and geometric Jacobians ``(K, 6, n)`` at the tool point of configurations
     ``q (K, n)`` (``kinematics.geometric_jacobian``), compiled."""
     K, n = q.shape
     T, J = np.empty((K, 4, 4)), np.empty((K, 6, n))
-    ch = robot.chain
-    q = np.ascontiguousarray(q, dtype=np.float64)
-    args = (np.array(ch.H), np.array(ch.P), np.array(ch.revolute), np.array(ch.R_end), q, T, J)
-    parallel.run(_pose_jacobian, K, 16 * PARALLEL_MIN, *args)
+    parallel.run(_pose_jacobian, K, 16 * PARALLEL_MIN, *chain_args(robot), _writable(q), T, J)
     return T, J
 
 
@@ -440,17 +452,13 @@ def tool_poses(robot, q: Array, target: Array | None = None, weight: float = 1.0
     and, with ``target (K, 4, 4)``, their geodesic errors ``(K,)`` (position + ``weight`` x angle), compiled."""
     K = q.shape[0]
     out, err = np.empty((K, 4, 4)), np.empty(K if target is not None else 0)
-    ch = robot.chain
     parallel.run(
         _tool_poses,
         K,
         16 * PARALLEL_MIN,
-        np.array(ch.H),
-        np.array(ch.P),
-        np.array(ch.revolute),
-        np.array(ch.R_end),
-        np.ascontiguousarray(q, dtype=np.float64),
-        np.zeros((0, 4, 4)) if target is None else np.array(target, dtype=np.float64, order="C"),
+        *chain_args(robot),
+        _writable(q),
+        np.zeros((0, 4, 4)) if target is None else _writable(target),
         float(weight),
         out,
         err,
@@ -463,16 +471,15 @@ def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Arra
     within ``tol`` and, with ``limits``, inside the joint limits) and one that is not, as
     ``families._members_ok`` decides: the last certified points ``a`` (new arrays; ``b`` too)."""
     a, b = np.array(a, dtype=np.float64), np.array(b, dtype=np.float64)
-    ch = robot.chain
     args = (pose.astype(np.int64), branch.astype(np.int64), a, b, int(steps), bool(limits), float(tol))
-    geometry = (np.array(ch.H), np.array(ch.P), np.array(ch.revolute), np.array(ch.R_end))
+    geometry = chain_args(robot)
     parallel.run(
         _bisect_members,
         a.size,
         PARALLEL_MIN,
         first_class(red.kernel[1]),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
-        np.array(world, dtype=np.float64, order="C", copy=not world.flags.writeable or None),
+        _writable(world),
         *args,
         *geometry,
         float(orientation_weight(robot.length_unit)),
@@ -505,19 +512,15 @@ def _run(kernel, n, min_parallel, K, robot, red, chain, world, params, cfg, *mid
     q = np.empty((K, robot.n_joints))
     eg = np.empty(K)
     ep = np.empty(K)
-    ch = robot.chain
     parallel.run(
         kernel,
         n,
         min_parallel,
         cfg,
         np.ascontiguousarray(red.kernel_params(chain) if params is None else params, dtype=np.float64),
-        np.array(world, dtype=np.float64, order="C", copy=not world.flags.writeable or None),  # compiled: writable
+        _writable(world),
         *middle,
-        np.array(ch.H),  # writable copies: the compiled signature takes writable arrays
-        np.array(ch.P),
-        np.array(ch.revolute),
-        np.array(ch.R_end),
+        *chain_args(robot),
         float(orientation_weight(robot.length_unit)),
         q,
         eg,

@@ -98,8 +98,5 @@ def polish(
 
 
 def _pose(robot: Robot, q: Array) -> Array:
-    from .fastcertify import AVAILABLE, tool_poses
-
-    if AVAILABLE:
-        return tool_poses(robot, q)[0]
+    """World tool poses (the NumPy path: with Numba the compiled ``fastcertify`` kernels are used instead)."""
     return kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool

@@ -48,6 +48,7 @@ import dataclasses
 import hashlib
 import json
 import os
+import shutil
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
@@ -395,6 +396,13 @@ class StoreWriter:
             }
         )
         return stats
+
+    def discard(self) -> None:
+        """Remove a store this writer created and wrote no chunk to (the run could not start): nothing is left
+        behind that would make the same call, corrected, fail as 'already exists'."""
+        if self.done():
+            raise StoreError(f"{self.path}: holds solved chunks; not removed")  # pragma: no cover - caller's check
+        shutil.rmtree(self.path, ignore_errors=True)
 
     def finish(self) -> dict[str, int]:
         """Mark the store complete (atomically, the last write); StoreError if a chunk is missing. The summary."""
