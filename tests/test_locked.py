@@ -131,6 +131,34 @@ def test_analyze_locks_are_what_solve_does(name: str) -> None:
                 assert recovers(robot, sweepik.solve(robot, robot.fk(qi), locked={k: v}), qi)
 
 
+@pytest.mark.parametrize(
+    ("name", "joint"), [("franka_panda", "joint3"), ("franka_panda", "joint1"), ("kuka_iiwa14", "A3")]
+)
+def test_analyze_with_locks_numbers_theta_star_as_solve_takes_it(name: str, joint: str) -> None:
+    """With joints held, every swept plan's ``free_joint`` from ``analyze`` is the full arm's index: given back to
+    ``solve(..., locked=..., free_joint=...)`` it sweeps that joint (the solutions then contain q); a joint no plan
+    sweeps is refused naming the sweepable ones by the full arm's indices and numbers."""
+    robot = sweepik.load_robot(name)
+    k = robot.joint_names.index(joint)
+    lock = {joint: 0.4}
+    info = sweepik.analyze(robot, locked=lock)
+    assert info["held"] == lock and k + 1 not in info["arm_joints"] and len(info["arm_joints"]) == 6
+    swept = [p for p in info["plans"] if not p["closed_form"]]
+    assert swept
+    q = _configurations(robot, 1, 3, {k: 0.4})[0]
+    for plan in swept:
+        j = plan["free_joint"]
+        assert robot.joint_names[j] == plan["free_joint_name"] and plan["free_joint_number"] == j + 1
+        assert recovers(robot, sweepik.solve(robot, robot.fk(q), locked=lock, free_joint=j), q)
+    other = next(j for j in range(robot.n_joints) if j != k and j not in {p["free_joint"] for p in swept})
+    with pytest.raises(sweepik.NoReductionError) as err:
+        sweepik.solve(robot, robot.fk(q), locked=lock, free_joint=other)
+    for plan in swept:
+        assert f"{plan['free_joint_name']} (index {plan['free_joint']}, number {plan['free_joint'] + 1})" in str(
+            err.value
+        )
+
+
 def test_family_of_a_held_arm_is_full_length() -> None:
     """A 7-joint arm built from the KUKA KR 6 with an extra joint; at its singular wrist the held arm has a
     self-motion family, whose members are full-length configurations reaching the pose."""

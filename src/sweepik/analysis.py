@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from .errors import UnknownOptionError
-from .origin_axis import hold_joints
+from .origin_axis import HeldJoints, hold_joints
 from .reductions.decompose import explain
 from .robot import Robot
 from .robot_file import load_robot
@@ -65,9 +65,12 @@ def analyze(robot: Robot | str, locked: Mapping[Any, float] | None = None) -> di
     ``chain`` ('forward' or 'reversed'), ``case``, ``branches``, ``blind_spot`` and ``steps``, the subproblem
     chain in words, joints numbered from 1), ``chosen`` (a plan or None) and ``reason`` (why none, else None).
     ``robot``: a Robot, or a bundled name or robot file path. ``locked`` (joint name or index -> value, as
-    :func:`~sweepik.solve` takes it): analyse the arm with those joints held (joints then numbered in the smaller
-    arm). A seven-joint arm without ``locked`` has no plans of its own; its ``locks`` key (see
-    :func:`lock_options`) tells, joint by joint, which lock gives a closed form or a sweep.
+    :func:`~sweepik.solve` takes it): analyse the arm with those joints held; ``free_joint`` and
+    ``free_joint_number`` are then still the full arm's (what ``solve(..., locked=..., free_joint=...)`` takes),
+    while ``structure`` and ``steps`` number the joints of the smaller arm: ``arm_joints`` gives their numbers in
+    the full arm (from 1), ``held`` the held joints' values. A seven-joint arm without ``locked`` has no plans of
+    its own; its ``locks`` key (see :func:`lock_options`) tells, joint by joint, which lock gives a closed form or a
+    sweep.
 
     >>> from sweepik import analyze
     >>> info = analyze("puma560")
@@ -79,7 +82,8 @@ def analyze(robot: Robot | str, locked: Mapping[Any, float] | None = None) -> di
     if not isinstance(robot, Robot):
         raise UnknownOptionError(f"robot must be a sweepik.Robot or a name/path, got {type(robot).__name__}")
     if locked:
-        return explain(hold_joints(robot, locked).arm)
+        held = hold_joints(robot, locked)
+        return _numbered_in_full_arm(explain(held.arm), held)
     info = explain(robot)
     if robot.n_joints == 7:
         info["locks"] = lock_options(robot)
@@ -87,6 +91,18 @@ def analyze(robot: Robot | str, locked: Mapping[Any, float] | None = None) -> di
             f"robot {robot.name!r} has 7 joints: lock one (solve(..., locked={{name: value}}), --lock NAME=VALUE); "
             "'locks' tells which lock gives a closed form or a sweep"
         )
+    return info
+
+
+def _numbered_in_full_arm(info: dict[str, Any], held: HeldJoints) -> dict[str, Any]:
+    """``explain`` of the smaller arm with each plan's ``free_joint`` (and number) those of the full arm, as
+    ``solve(..., locked=..., free_joint=...)`` takes them; ``held`` and ``arm_joints`` keys added."""
+    for plan in [*info["plans"], *([info["chosen"]] if info["chosen"] else [])]:
+        if plan["free_joint"] is not None:
+            plan["free_joint"] = held.free[plan["free_joint"]]
+            plan["free_joint_number"] = plan["free_joint"] + 1
+    info["held"] = {held.robot.joint_names[k]: v for k, v in held.held}
+    info["arm_joints"] = [k + 1 for k in held.free]
     return info
 
 

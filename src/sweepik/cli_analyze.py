@@ -67,6 +67,12 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         _print_json(info)
         return 0
     print(f"{info['robot']}: {info['structure']}")
+    if "arm_joints" in info:
+        held = ", ".join(info["held"])
+        print(
+            f"  ({held} held: structure and steps number the other joints 1-{len(info['arm_joints'])}, i.e. "
+            f"joints {', '.join(map(str, info['arm_joints']))} of the arm; theta* below by the arm's numbers)"
+        )
     if "locks" in info:
         _print_locks(robot, info["locks"])
         return 0

@@ -18,13 +18,14 @@ from . import fastcertify, fastsweep
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch
 from .dedupe import finish, wrap_inside
-from .errors import LockedJointError, ShapeError, UnknownOptionError
+from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from .families import collapse_continua, families_of, off_families, unique_families
 from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
 from .polish import polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, get_reduction
+from .reductions.decompose import not_sweepable
 from .reductions.kernels import owned_kernel
 from .robot import Robot
 from .solutions import Family, Solutions
@@ -556,7 +557,13 @@ def _prepare(
         raise UnknownOptionError(
             f"reduction must be a name, a Reduction instance or None, got {type(reduction).__name__}"
         )
-    red = get_reduction(robot, reduction, _free_joint_index(robot, free_joint, reduction))
+    fj = _free_joint_index(robot, free_joint, reduction)
+    try:
+        red = get_reduction(robot, reduction, fj)
+    except NoReductionError:
+        if held is None or fj is None:
+            raise
+        raise NoReductionError(not_sweepable(robot, fj, held.robot, held.free)) from None
     if red.robot != robot:
         raise UnknownOptionError(
             f"the reduction {red.name!r} was built for robot {red.robot.name!r}, not for {robot.name!r}"

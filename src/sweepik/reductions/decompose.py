@@ -13,6 +13,7 @@ one with; fewer branches (less work per sample); the forward chain before the re
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import lru_cache
 from typing import Any
 
@@ -285,18 +286,29 @@ def _missing(robot: Robot) -> str:
     )
 
 
+def not_sweepable(robot: Robot, free_joint: int, full: Robot | None = None, joints: Sequence[int] = ()) -> str:
+    """Why ``free_joint`` cannot be theta*, and which joints can (by name, index from 0 and number from 1). With
+    ``full`` (an arm with joints held; ``robot`` is the smaller arm solved, its joint i being ``full``'s joint
+    ``joints[i]``) the joints are named and counted as in ``full``."""
+    avail = sorted({p.free_joint for p in plans(robot) if not p.closed_form})
+    arm, index = (robot, list(range(robot.n_joints))) if full is None else (full, list(joints))
+
+    def name(j: int) -> str:
+        return f"{arm.joint_names[index[j]]} (index {index[j]}, number {index[j] + 1})"
+
+    held = "" if full is None else " (with joints held)"
+    return f"robot {arm.name!r}{held}: no decomposition sweeps {name(free_joint)}; joints that can be swept: " + (
+        ", ".join(name(j) for j in avail) or "none"
+    )
+
+
 def choose(robot: Robot, free_joint: int | None = None) -> Plan:
     """The best plan for ``robot`` (with theta* = ``free_joint`` if given); NoReductionError if there is none."""
     options = plans(robot)
     if free_joint is not None:
         options = tuple(p for p in options if not p.closed_form and p.free_joint == free_joint)
         if not options:
-            avail = sorted({p.free_joint for p in plans(robot) if not p.closed_form})
-            names = ", ".join(f"{j} ({robot.joint_names[j]})" for j in avail) or "none"
-            raise NoReductionError(
-                f"robot {robot.name!r}: no decomposition sweeps joint index {free_joint} "
-                f"({robot.joint_names[free_joint]}); joints that can be swept (index from 0): {names}"
-            )
+            raise NoReductionError(not_sweepable(robot, free_joint))
         return options[0]
     usable = [p for p in options if not p.conditional]
     if not usable:
