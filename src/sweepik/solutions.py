@@ -46,38 +46,49 @@ def weighted_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Arr
 
 #: Members sampled along a self-motion family before the nearest one is refined (golden section).
 _FAMILY_SAMPLES = 721
+#: Local minima of the sampled distance refined by ``_nearest_on_family`` (the lowest ones).
+_NEAREST_MINIMA = 4
 _GOLDEN_ITERS = 60
 
 
 def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, float]:
-    """Member of ``fam`` nearest ``ref`` (weighted distance): dense sampling, then golden-section search."""
+    """Member of ``fam`` nearest ``ref`` (weighted distance): dense sampling, then a golden-section search around
+    each local minimum of the samples (``_NEAREST_MINIMA`` at most, the lowest first), the best kept. Every local
+    minimum, not only the lowest sample: the nearest member can lie next to another sample of the same distance,
+    e.g. across the seam of a family that turns theta* through a whole circle (both ends are the same member)."""
     lo, hi = fam.interval
     grid = np.linspace(lo, hi, _FAMILY_SAMPLES)
     members = fam.at(grid)
     d = weighted_joint_distance(robot, members, ref)
     d = np.where(np.all(np.isfinite(members), axis=-1), d, np.inf)
-    i = int(np.argmin(d))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    left = np.concatenate([[np.inf], d[:-1]])
+    right = np.concatenate([d[1:], [np.inf]])
+    minima = np.nonzero(np.isfinite(d) & (d <= left) & (d <= right))[0]
+    minima = minima[np.argsort(d[minima], kind="stable")][:_NEAREST_MINIMA]
+    i0 = int(np.argmin(d))
+    best, bd = members[i0], float(d[i0])
 
     def dist(t: float) -> float:
         return float(weighted_joint_distance(robot, fam.at(t), ref))
 
     g = (np.sqrt(5.0) - 1.0) / 2.0
-    c, e = b - g * (b - a), a + g * (b - a)
-    fc, fe = dist(c), dist(e)
-    for _ in range(_GOLDEN_ITERS):
-        if fc <= fe:
-            b, e, fe = e, c, fc
-            c = b - g * (b - a)
-            fc = dist(c)
-        else:
-            a, c, fc = c, e, fe
-            e = a + g * (b - a)
-            fe = dist(e)
-    t = c if fc <= fe else e
-    best, bd = fam.at(t), dist(t)
-    if not bd <= float(d[i]):
-        best, bd = members[i], float(d[i])
+    for i in minima:
+        a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+        c, e = b - g * (b - a), a + g * (b - a)
+        fc, fe = dist(c), dist(e)
+        for _ in range(_GOLDEN_ITERS):
+            if fc <= fe:
+                b, e, fe = e, c, fc
+                c = b - g * (b - a)
+                fc = dist(c)
+            else:
+                a, c, fc = c, e, fe
+                e = a + g * (b - a)
+                fe = dist(e)
+        t = c if fc <= fe else e
+        dt = dist(t)
+        if dt < bd:
+            best, bd = fam.at(t), dt
     return np.asarray(best, dtype=np.float64), bd
 
 
