@@ -4,6 +4,8 @@ A piece that shrinks to a point where a family touches the limits becomes an iso
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -128,10 +130,14 @@ def _golden_dips(
     best_e: Array,
 ) -> tuple[Array, Array]:
     """The golden-section steps of ``_limit_dips`` (the NumPy reference; ``fastcertify.dip_search``)."""
+    return _golden_least(lambda x: _limit_excess(robot, red, chain, pose, branch, x), a, b, best_x, best_e)
 
-    def excess(x: Array) -> Array:
-        return _limit_excess(robot, red, chain, pose, branch, x)
 
+def _golden_least(
+    excess: Callable[[Array], Array], a: Array, b: Array, best_x: Array, best_e: Array
+) -> tuple[Array, Array]:
+    """Golden-section search of the least ``excess(x)`` in each bracket ``[a, b]``, starting from the best point
+    known ``best_x`` (value ``best_e``); it stops once every best value is at most 0. ``(best_x, best_e)``."""
     c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
     ec, ed = excess(c), excess(d)
     for _ in range(_DIP_STEPS):
@@ -149,6 +155,54 @@ def _golden_dips(
         ec, ed = np.where(left, e_fresh, ed), np.where(left, ec, e_fresh)
         c, d = new_c, new_d
     return best_x, best_e
+
+
+#: A local maximum of the limit excess among a span's samples, inside the limits, is searched between its
+#: neighbouring samples when it lies within this many times the rise from a neighbour below zero: the excess can
+#: exceed zero between two samples inside the limits only where it is still climbing that steeply (a joint turning
+#: through +-pi, outside limits narrower than the circle, between two samples is the common case).
+PEAK_REACH = 2.0
+
+
+def _limit_peaks(
+    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], grid: Array
+) -> Array:
+    """``(K, D)`` extra samples for the family spans sampled at ``grid (K, M)``: where a joint's limit excess has a
+    local maximum at or below zero among the samples (``PEAK_REACH``), its greatest excess between the neighbouring
+    samples is located (golden section); where it is outside the limits, that point is an extra sample, so that
+    the span is cut around it. The counterpart of ``_limit_dips`` (an excursion out of the limits narrower than
+    the sampling). ``D`` is the most extra samples of one span (0 in the common case)."""
+    K, M = grid.shape
+    q = family_members(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel())
+    w = robot.wrap(np.nan_to_num(q, nan=np.inf)).reshape(K, M, -1)
+    e = np.maximum(robot.lower - w, w - robot.upper)  # (K, M, n): each joint's excess (a peak of one joint can
+    # hide under another joint's rising excess)
+    big = np.where(np.isfinite(e), e, -np.inf)
+    pad = np.full((K, 1, e.shape[2]), -np.inf)
+    left = np.concatenate([pad, big[:, :-1]], axis=1)
+    right = np.concatenate([big[:, 1:], pad], axis=1)
+    with np.errstate(invalid="ignore"):
+        rise = np.maximum(np.where(np.isfinite(left), big - left, 0.0), np.where(np.isfinite(right), big - right, 0.0))
+    peak = np.isfinite(big) & (big <= 0.0) & (big >= left) & (big >= right) & (big > -PEAK_REACH * rise)
+    k, i, j = np.nonzero(peak)
+    if k.size == 0:
+        return np.zeros((K, 0))
+    a, b = grid[k, np.maximum(i - 1, 0)], grid[k, np.minimum(i + 1, M - 1)]
+    J = j  # the joint whose excess peaks (of each bracket)
+
+    def negated(x: Array) -> Array:
+        q = family_members(robot, red, chain, pose[k], branch[k], x)
+        w = robot.wrap(np.nan_to_num(q, nan=np.inf))[np.arange(x.size), J]
+        return -np.maximum(robot.lower[J] - w, w - robot.upper[J])
+
+    best_x, best_e = _golden_least(negated, a, b, grid[k, i], -big[k, i, j])
+    found = best_e < 0.0
+    rows = k[found]
+    width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
+    extra = np.repeat(grid[:, :1], width, axis=1)
+    col = np.arange(rows.size) - np.searchsorted(rows, rows)
+    extra[rows, col] = best_x[found]
+    return extra
 
 
 def merge_spans(spans: list[FamilySpan]) -> list[FamilySpan]:
@@ -184,6 +238,9 @@ def families_of(
         # a stretch inside the limits narrower than the sampling (a joint dipping just under its limit between
         # samples) gets a sample of its own
         grid = np.sort(np.concatenate([grid, _limit_dips(robot, red, chain, pose, branch, grid)], axis=1), axis=1)
+        # and an excursion out of the limits narrower than the sampling (a joint turning through +-pi between two
+        # samples) gets one too, which cuts the span there
+        grid = np.sort(np.concatenate([grid, _limit_peaks(robot, red, chain, pose, branch, grid)], axis=1), axis=1)
     ok = _members_ok(robot, red, chain, world, pose, branch, grid, limits, tol)
     pad = np.zeros((len(spans), 1), np.int8)
     edges = np.diff(np.concatenate([pad, ok.astype(np.int8), pad], axis=1), axis=1)

@@ -72,7 +72,7 @@ def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, fl
         return float(weighted_joint_distance(robot, fam.at(t), ref))
 
     g = (np.sqrt(5.0) - 1.0) / 2.0
-    for i in minima:
+    for i in minima.tolist():
         a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
         c, e = b - g * (b - a), a + g * (b - a)
         fc, fe = dist(c), dist(e)
