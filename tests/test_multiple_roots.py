@@ -182,3 +182,21 @@ def test_huge_rail_limits_solve_every_pose(rng: np.random.Generator) -> None:
     for sol, qq, TT in zip(solve_many(robot, T), q, T, strict=True):
         assert len(sol) and joint_distance(robot, sol.q, qq).max(axis=-1).min() <= 1e-6
         assert np.all(pose_error_geodesic(robot.fk(sol.q), TT, 100.0) <= 2e-13 * robot.length_scale)
+
+
+@pytest.mark.parametrize("name", ["ur3", "ur5", "ur10"])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_closed_form_reports_a_double_root_as_the_sweeps_do(name: str, seed: int) -> None:
+    """Elbow straight (joint 3 at 0 on a UR arm: the Jacobian loses rank): the closed form's two elbow branches
+    meet. Its solutions are those of a sweep of joint 2 (another decomposition), each with the sweep's
+    multiplicity (2 at the merged elbow), not 1."""
+    robot = load_robot(name)
+    q = np.random.default_rng(seed).uniform(-2.5, 2.5, 6)
+    q[2] = 0.0
+    T = robot.fk(q)
+    closed, swept = solve(robot, T, limits=False), solve(robot, T, limits=False, free_joint=1)
+    assert sweepik.analyze(robot)["chosen"]["closed_form"] and len(closed) == len(swept) > 0
+    for qs, m in zip(swept.q, swept.multiplicity, strict=True):
+        k = _index_of(closed, qs)
+        assert k is not None and closed.multiplicity[k] == m
+    assert closed.multiplicity[_index_of(closed, q)] == 2

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 
-__all__ = ["finish", "wrap_inside", "limit_args", "DEDUPE_ANGLE", "DEDUPE_LENGTH_REL"]
+__all__ = ["finish", "wrap_inside", "limit_args", "merged_multiplicity", "DEDUPE_ANGLE", "DEDUPE_LENGTH_REL"]
 
 #: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
 DEDUPE_ANGLE = 1e-6
@@ -81,6 +81,26 @@ def finish(
     keep = np.empty(q.shape[0], dtype=np.bool_)
     _dedupe_compiled(pose_idx.astype(np.int64), w, score, limit_args(robot)[0], _tolerance(robot), keep)
     return w, inside, keep
+
+
+def merged_multiplicity(
+    robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_], mult: NDArray[np.intp]
+) -> NDArray[np.intp]:
+    """``mult`` of the candidates ``w (K, n)`` (wrapped, as ``finish`` gives them) with each kept one's raised by
+    the multiplicities of the dropped ones equal to it (step 3's equality): where branches of a closed form meet,
+    the solution they share is a multiple root. The dropped candidates are few (singular poses): compared in
+    NumPy."""
+    out = np.array(mult, dtype=np.intp)
+    tol = _tolerance(robot)
+    kept = np.nonzero(keep)[0]
+    for d in np.nonzero(~keep)[0]:
+        k = kept[pose_idx[kept] == pose_idx[d]]
+        diff = w[k] - w[d]
+        diff = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - diff, 2.0 * np.pi)), np.abs(diff))
+        same = k[np.all(diff <= tol, axis=-1)]
+        if same.size:
+            out[same[0]] += mult[d]
+    return out
 
 
 def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:

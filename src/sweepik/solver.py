@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import fastcertify, fastsweep
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch
-from .dedupe import finish, wrap_inside
+from .dedupe import finish, merged_multiplicity, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from .families import collapse_continua, families_of, off_families, unique_families
 from .origin_axis import HeldJoints, hold_joints
@@ -324,6 +324,8 @@ def _solve_chunk(
     # duplicates first (of twins, the one inside the limits is kept), so that limits=True is exactly
     # limits=False filtered by the limits
     q, inside, keep = finish(robot, pose_idx, q, err_geo, wrapped)
+    if closed and not keep.all():  # branches of the closed form that meet: one solution, a multiple root
+        mult = merged_multiplicity(robot, pose_idx, q, keep, mult)
     if strategy == "precise":  # a numerical continuum of certified solutions is reported once
         keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
     n_reachable = np.bincount(pose_idx[keep], minlength=len(poses))
