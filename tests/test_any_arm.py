@@ -230,6 +230,24 @@ FAMILIES = {
         ("revolute", 0, 90, _L(g), 0),
         ("revolute", 0, 0, _L(g), 0),
     ],
+    # cylindrical arm RPP (a turn, a lift along it, a radial reach) + spherical wrist: closed form (rpp)
+    "wrist_rpp": lambda g: [
+        ("revolute", 0, 0, _L(g), 0),
+        ("prismatic", 0, -90, 0, 0),
+        ("prismatic", 0, 0, 0, 0),
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 90, 0, 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # a skewed cylindrical arm (slides neither along nor across the turn), the last two axes meeting only: swept
+    "pair_rpp": lambda g: [
+        ("revolute", 0.1 * _L(g), 20, _L(g), 0),
+        ("prismatic", 0.1 * _L(g), -70, 0.1, 10),
+        ("prismatic", 0.1 * _L(g), 30, 0.1, 0),
+        ("revolute", _L(g), -90, _L(g), 0),
+        ("revolute", 0, 90, _L(g), 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
     # C-Arm-like: a prismatic rail first, other dimensions
     "rail_pair": lambda g: [
         ("prismatic", 0, 0, 0, 0),
@@ -342,6 +360,23 @@ def test_arm_outside_the_catalogue_is_refused():
         sweepik.solve(robot, robot.fk(np.zeros(6)))
     with pytest.raises(NoReductionError):
         sweepik.solve(robot, robot.fk(np.zeros(6)), free_joint=0)
+
+
+def test_ur_family_refused_for_its_continuum_says_so():
+    """Axes 2-4 parallel with an offset wrist whose joint 6 can turn parallel to them, and no two axes meeting at
+    the tool or the base (an offset a1): the closed form cannot report the continuum at q5 = 0 and no sweep fits,
+    and the refusal says that (not the generic description of the catalogue)."""
+    rows = [
+        ("revolute", 0.1, 90, 0.089, 0),
+        ("revolute", -0.425, 0, 0, 0),
+        ("revolute", -0.392, 0, 0, 0),
+        ("revolute", 0, 90, 0.109, 0),
+        ("revolute", 0.05, -90, 0.095, 0),
+        ("revolute", 0, 0, 0.082, 0),
+    ]
+    robot = _arm(rows, np.random.default_rng(0))
+    with pytest.raises(NoReductionError, match=r"UR family.*continuum"):
+        sweepik.solve(robot, robot.fk(np.full(6, 0.3)))
 
 
 def test_free_joint_errors():

@@ -133,6 +133,13 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
         if not ok or all(_parallel(np.cross(g[0], g[1]), g[2]) for g in geo):
             return no
         return True, cond, None
+    if case == "rpp":
+        if not ra or rb or rc:
+            return no
+        ok, cond = dots(lambda g: float(np.linalg.norm(np.cross(g[1], g[2]))))
+        if not ok or all(_parallel(np.cross(g[1], g[2]), g[0]) for g in geo):
+            return no  # (slides in the plane of the turn: W has a continuum of solutions)
+        return True, cond, None
     if case == "ac_par":
         if not (ra and rc) or rb or not all(_parallel(g[0], g[2]) for g in geo):
             return no
@@ -278,11 +285,19 @@ def _missing(robot: Robot) -> str:
     if robot.n_joints != 6:
         return f"robot {robot.name!r} has {robot.n_joints} joints: the decompositions solve 6-joint arms"
     st = robot.structure()
-    return (
-        f"robot {robot.name!r} ({st.describe()}) is outside sweepik's catalogue: a decomposition needs the last two "
-        "axes (or the first two) revolute and meeting at a point, with the other joints placing that point by "
-        "subproblems (two of them parallel or intersecting, or prismatic), or axes 2-4 parallel (the UR family; "
-        "after a slide with an offset wrist only if joint 6's axis can never turn parallel to them)"
+    head = f"robot {robot.name!r} ({st.describe()}) is outside sweepik's catalogue: "
+    found = [p for rev_chain, chain, s in _structures(robot) for p in _parallel_plans(robot, chain, rev_chain, s)]
+    if found:  # the UR family's closed form, refused for its continuum (_continuum_covered)
+        return head + (
+            "axes 2-4 are parallel (the UR family), but joint 6's axis can turn parallel to them (its wrist has an "
+            "offset): at joint 5 = 0 the solutions form a continuum that only a sweep can report, and no sweep fits "
+            "this arm (it needs two axes meeting at the tool or at the base)"
+        )
+    return head + (
+        "a decomposition needs the last two axes (or the first two) revolute and meeting at a point, with the "
+        "other joints placing that point by a chain of subproblems (two revolute axes among them parallel or "
+        "meeting, two parallel revolute axes around a slide, a revolute joint before or after two slides, or three "
+        "slides), or axes 2-4 parallel (the UR family)"
     )
 
 

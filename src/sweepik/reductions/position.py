@@ -19,6 +19,7 @@ case         structure                                     subproblem chain (bra
 ``ppp``      three prismatic                               lines3 (1)
 ``ppr``      a, b prismatic, c revolute                    c: sp4 on the normal of a, b (2); a, b: lines2
 ``ac_par``   a, c revolute and parallel, b prismatic       b: lp4 on the a-height (1); c: sp3 (2); a: sp1
+``rpp``      a revolute, b, c prismatic                    a: sp4 on the normal of b, c (2); b, c: lines2
 ===========  ============================================  ===========================================
 
 Outside a branch's domain (a circle or line that misses its sphere or plane) a step continues with its
@@ -47,7 +48,7 @@ from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 __all__ = ["CASES", "BRANCHES", "BOTH", "NEITHER", "reduce_chain", "place", "motion", "angle", "move", "move_back"]
 
 #: Case names, in the order of their integer codes in a family's parameter row.
-CASES = ("ab_par", "bc_par", "ab_int", "bc_int", "ppp", "ppr", "ac_par")
+CASES = ("ab_par", "bc_par", "ab_int", "bc_int", "ppp", "ppr", "ac_par", "rpp")
 #: Branches of each case: (with the first unknown revolute, with it prismatic) for the cases where it matters.
 BRANCHES = {
     "ab_par": (4, 2),  # indexed by joint c's type
@@ -57,6 +58,7 @@ BRANCHES = {
     "ppp": (1, 1),
     "ppr": (2, 2),
     "ac_par": (2, 2),
+    "rpp": (2, 2),
 }
 
 
@@ -271,6 +273,22 @@ def _ac_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return _rev(ca, sa), _pris(qb), _rev(ua, va), _rev(cb, sb), _pris(qb), _rev(ub, vb), 0.0, c2, math.inf, r2
 
 
+@internal
+def _rpp(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``rpp`` of ``place`` (a cylindrical arm's slides after its turn): ``W - o = R_a (p + qb hb + qc hc)``
+    with ``p = pab + pbc + pcw``, so the height of ``R_a^T tp`` along ``n = hb x hc`` is ``n . p`` whatever qb, qc:
+    ``tp . R_a n = n . p`` (sp4 about h_a, 2 branches); then ``R_a^T tp - p`` along hb and hc (lines2)."""
+    n = cross(hb, hc)
+    if norm(n) == 0.0:  # parallel slides (a blind spot of a plan whose slides turn with theta*)
+        return _no_case(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+    n = unit(n)
+    p = add(add(pab, pbc), pcw)
+    ua, va, ub, vb, c2, r2 = sp4_cs(tp, n, ha, dot(n, p))
+    qb, qc = lines2(hb, hc, sub(rot_cs(ha, ua, -va, tp), p)) if _first(b2) else _NO_ANGLE
+    qb2, qc2 = lines2(hb, hc, sub(rot_cs(ha, ub, -vb, tp), p)) if _second(b2) else _NO_ANGLE
+    return _rev(ua, va), _pris(qb), _pris(qc), _rev(ub, vb), _pris(qb2), _pris(qc2), 0.0, c2, math.inf, r2
+
+
 def place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Motions putting ``W`` at ``tp`` on branch ``b1`` of the first step and branch ``b2`` of the second (0, 1,
     ``BOTH`` or ``NEITHER``): ``(ma, mb, mc)`` (see ``motion``) of branch ``2 b1``, those of branch ``2 b1 + 1``
@@ -291,13 +309,13 @@ def place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
 
     For compiled code only (an ``overload``, ``_place``): with ``case`` a constant of the caller's (a literal type,
     as a family kernel made for one arm's case passes it), only that case's chain of subproblems is compiled, not all
-    seven (about 2 s less on a fresh install); with a variable ``case``, every case.
+    eight (about 2 s less on a fresh install); with a variable ``case``, every case.
     """
     raise NotImplementedError("position.place is compiled code's")
 
 
 #: The cases' functions, in the order of ``CASES``.
-_CASE_FUNCTIONS = (_ab_par, _bc_par, _ab_int, _bc_int, _ppp, _ppr, _ac_par)
+_CASE_FUNCTIONS = (_ab_par, _bc_par, _ab_int, _bc_int, _ppp, _ppr, _ac_par, _rpp)
 
 
 @internal
@@ -334,6 +352,8 @@ def _place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
             return place(5, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         if case == 6:
             return place(6, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        if case == 7:
+            return place(7, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         return place(-1, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
 
     return every
