@@ -141,6 +141,12 @@ def test_robot_validation() -> None:
         two_link(T_flange_tool=np.eye(3))
     with pytest.raises(RobotDefinitionError, match="single 4x4"):
         two_link(T_world_base=np.stack([np.eye(4), np.eye(4)]))
+    # refused when the robot is made, not at its first solve
+    with pytest.raises(RobotDefinitionError, match=r"unknown length unit 'furlong'; supported: mm, cm, m, in"):
+        two_link(length_unit="furlong")
+    twins = tuple(dataclasses.replace(j, name="elbow") for j in two_link().joints)
+    with pytest.raises(RobotDefinitionError, match="joint names must differ.*'elbow' used more than once"):
+        Robot("two", twins)
 
 
 def test_robot_is_immutable() -> None:

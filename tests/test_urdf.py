@@ -17,7 +17,7 @@ import pytest
 import yourdfpy
 
 import sweepik
-from sweepik.errors import SweepikError, UnknownOptionError, UrdfError
+from sweepik.errors import RobotDefinitionError, SweepikError, UnknownOptionError, UrdfError
 from sweepik.pose import pose_from_xyz_zyz
 from sweepik.units import mm_per_unit
 from sweepik.urdf import (
@@ -474,12 +474,15 @@ def test_round_trip_with_base_tool_and_origin_axis_form(rng: np.random.Generator
 
 def test_writer_names() -> None:
     ur5 = sweepik.load_robot("ur5")
-    joints = tuple(dataclasses.replace(j, name="tool_joint" if i < 2 else j.name) for i, j in enumerate(ur5.joints))
-    twins = dataclasses.replace(ur5, joints=joints, name='a <"quoted"> & odd name')
-    back = robot_from_urdf(urdf_text(twins), SOURCE, tip_link="tool")
-    assert back.name == twins.name
-    assert back.joint_names[:2] == ["tool_joint", "tool_joint_2"]  # URDF joint names must differ
-    assert "tool_joint_3" in urdf_text(twins)  # the fixed joint to the tool gives way
+    joints = tuple(dataclasses.replace(j, name="tool_joint" if i == 0 else j.name) for i, j in enumerate(ur5.joints))
+    named = dataclasses.replace(ur5, joints=joints, name='a <"quoted"> & odd name')
+    back = robot_from_urdf(urdf_text(named), SOURCE, tip_link="tool")
+    assert back.name == named.name
+    assert back.joint_names[0] == "tool_joint"
+    assert "tool_joint_2" in urdf_text(named)  # the fixed joint to the tool gives way (URDF joint names must differ)
+    twins = tuple(dataclasses.replace(j, name="tool_joint" if i < 2 else j.name) for i, j in enumerate(ur5.joints))
+    with pytest.raises(RobotDefinitionError, match="'tool_joint' used more than once"):
+        dataclasses.replace(ur5, joints=twins)
     with pytest.raises(UrdfError, match="characters XML cannot write"):
         urdf_text(dataclasses.replace(ur5, name="bad\x01name"))
     with pytest.raises(UnknownOptionError, match="needs a Robot"):

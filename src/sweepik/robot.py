@@ -31,6 +31,7 @@ from ._validate import check_configuration, check_poses
 from .chain import Chain
 from .errors import RobotDefinitionError, SweepikError
 from .structure import INTERSECT_TOL_REL, Structure, structure_of
+from .units import mm_per_unit
 
 __all__ = ["Joint", "Robot", "JointType", "DHConvention"]
 
@@ -181,6 +182,14 @@ class Robot:
                 raise RobotDefinitionError(
                     f"{label}: DH parameters a/alpha/d/theta are not used with dh_convention 'none'"
                 )
+        names = [j.name or f"q{i + 1}" for i, j in enumerate(joints)]  # (as joint_names)
+        repeated = sorted({n for n in names if names.count(n) > 1})
+        if repeated:
+            raise RobotDefinitionError(
+                f"{self.name}: joint names must differ (solve's free_joint and locked name joints): "
+                f"{', '.join(map(repr, repeated))} used more than once"
+            )
+        mm_per_unit(self.length_unit)  # (RobotDefinitionError naming the supported units)
         object.__setattr__(self, "joints", joints)
         g = np.array(_finite_triple(self.gravity, f"{self.name}: gravity"))
         if float(np.linalg.norm(g)) < AXIS_MIN_NORM:
