@@ -77,25 +77,41 @@ _DIP_STEPS = 50
 _GOLDEN = 0.5 * (np.sqrt(5.0) - 1.0)
 
 
+def _joint_excess(
+    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], x: Array
+) -> Array:
+    """``(K, n)``: how far each joint of the family member at ``x (K,)`` lies outside its limits (<= 0 inside, inf
+    where the member does not exist)."""
+    q = family_members(robot, red, chain, pose, branch, x)
+    w = robot.wrap(np.nan_to_num(q, nan=np.inf))
+    return np.asarray(np.maximum(robot.lower - w, w - robot.upper))
+
+
 def _limit_excess(
     robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], x: Array
 ) -> Array:
     """How far the family member at ``x (K,)`` lies outside the joint limits (its largest excess; <= 0 inside,
     inf where the member does not exist)."""
-    q = family_members(robot, red, chain, pose, branch, x)
-    w = robot.wrap(np.nan_to_num(q, nan=np.inf))
-    return np.asarray(np.max(np.maximum(robot.lower - w, w - robot.upper), axis=-1))
+    return np.asarray(np.max(_joint_excess(robot, red, chain, pose, branch, x), axis=-1))
 
 
 def _limit_dips(
-    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], grid: Array
+    robot: Robot,
+    red: Reduction,
+    chain: Array,
+    pose: NDArray[np.intp],
+    branch: NDArray[np.intp],
+    grid: Array,
+    e: Array | None = None,
 ) -> Array:
     """``(K, D)`` extra samples for the family spans sampled at ``grid (K, M)``: where the limit excess has a
     local minimum above zero among the samples, the least excess between the neighbouring samples is located
     (golden section); where it is inside the limits, that point is an extra sample. ``D`` is the most extra
-    samples of one span (0 in the common case); shorter rows repeat the span's first sample."""
+    samples of one span (0 in the common case); shorter rows repeat the span's first sample. ``e (K, M)``: the
+    samples' limit excess, when the caller has it."""
     K, M = grid.shape
-    e = _limit_excess(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel()).reshape(K, M)
+    if e is None:
+        e = _limit_excess(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel()).reshape(K, M)
     big = np.where(np.isfinite(e), e, np.inf)
     left = np.concatenate([np.full((K, 1), np.inf), big[:, :-1]], axis=1)
     right = np.concatenate([big[:, 1:], np.full((K, 1), np.inf)], axis=1)
@@ -134,17 +150,28 @@ def _golden_dips(
 
 
 def _golden_least(
-    excess: Callable[[Array], Array], a: Array, b: Array, best_x: Array, best_e: Array
+    excess: Callable[[Array], Array],
+    a: Array,
+    b: Array,
+    best_x: Array,
+    best_e: Array,
+    steps: int = _DIP_STEPS,
+    slope: Array | None = None,
 ) -> tuple[Array, Array]:
     """Golden-section search of the least ``excess(x)`` in each bracket ``[a, b]``, starting from the best point
-    known ``best_x`` (value ``best_e``); it stops once every best value is at most 0. ``(best_x, best_e)``."""
+    known ``best_x`` (value ``best_e``); it stops once every best value is at most 0, or after ``steps``. With
+    ``slope`` (a bound on ``|d excess / dx|`` per bracket), a bracket is also settled once the excess cannot drop
+    to 0 in it any more (``best_e - slope (b - a) > 0``). ``(best_x, best_e)``."""
     c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
     ec, ed = excess(c), excess(d)
-    for _ in range(_DIP_STEPS):
+    for _ in range(steps):
         for x, ex in ((c, ec), (d, ed)):
             better = ex < best_e
             best_x, best_e = np.where(better, x, best_x), np.where(better, ex, best_e)
-        if np.all(best_e <= 0.0):
+        settled = best_e <= 0.0
+        if slope is not None:
+            settled |= best_e - slope * (b - a) > 0.0
+        if np.all(settled):
             break
         left = ec < ed  # the least excess lies in [a, d]: d becomes the new right end, c the new inner right point
         a, b = np.where(left, a, c), np.where(left, d, b)
@@ -157,33 +184,38 @@ def _golden_least(
     return best_x, best_e
 
 
-#: A local maximum of the limit excess among a span's samples, inside the limits, is searched between its
+#: A local maximum of a joint's limit excess among a span's samples, inside the limits, is searched between its
 #: neighbouring samples when it lies within this many times the rise from a neighbour below zero: the excess can
 #: exceed zero between two samples inside the limits only where it is still climbing that steeply (a joint turning
-#: through +-pi, outside limits narrower than the circle, between two samples is the common case).
-PEAK_REACH = 2.0
+#: through +-pi, outside limits narrower than the circle, between two samples is the common case). Where the excess
+#: is linear on both sides of its peak, the peak is at most one rise above the sample (1 would do); 1.5 leaves room
+#: for curvature.
+PEAK_REACH = 1.5
+#: Golden-section steps of a peak's search: the bracket (two sample steps) shrinks to 0.618^24 ~ 1e-5 of itself, so
+#: an excursion out of the limits wider than ~1e-5 of the sampling is found (most searches find none and run them
+#: all: fewer than the dips' steps, which usually stop early).
+_PEAK_STEPS = 24
 
 
 def _limit_peaks(
-    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], grid: Array
+    robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], grid: Array, e: Array
 ) -> Array:
     """``(K, D)`` extra samples for the family spans sampled at ``grid (K, M)``: where a joint's limit excess has a
     local maximum at or below zero among the samples (``PEAK_REACH``), its greatest excess between the neighbouring
     samples is located (golden section); where it is outside the limits, that point is an extra sample, so that
     the span is cut around it. The counterpart of ``_limit_dips`` (an excursion out of the limits narrower than
-    the sampling). ``D`` is the most extra samples of one span (0 in the common case)."""
+    the sampling). ``D`` is the most extra samples of one span (0 in the common case). ``e (K, M, n)``: each
+    joint's limit excess at the samples (per joint: a peak of one joint can hide under another's rising excess)."""
     K, M = grid.shape
-    q = family_members(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel())
-    w = robot.wrap(np.nan_to_num(q, nan=np.inf)).reshape(K, M, -1)
-    e = np.maximum(robot.lower - w, w - robot.upper)  # (K, M, n): each joint's excess (a peak of one joint can
-    # hide under another joint's rising excess)
     big = np.where(np.isfinite(e), e, -np.inf)
     pad = np.full((K, 1, e.shape[2]), -np.inf)
     left = np.concatenate([pad, big[:, :-1]], axis=1)
     right = np.concatenate([big[:, 1:], pad], axis=1)
     with np.errstate(invalid="ignore"):
         rise = np.maximum(np.where(np.isfinite(left), big - left, 0.0), np.where(np.isfinite(right), big - right, 0.0))
-    peak = np.isfinite(big) & (big <= 0.0) & (big >= left) & (big >= right) & (big > -PEAK_REACH * rise)
+    # (a revolute joint whose limits span the circle is always inside them, once wrapped)
+    bounded = ~(robot.is_revolute & (robot.upper - robot.lower >= 2.0 * np.pi))
+    peak = np.isfinite(big) & (big <= 0.0) & (big >= left) & (big >= right) & (big > -PEAK_REACH * rise) & bounded
     k, i, j = np.nonzero(peak)
     if k.size == 0:
         return np.zeros((K, 0))
@@ -191,11 +223,11 @@ def _limit_peaks(
     J = j  # the joint whose excess peaks (of each bracket)
 
     def negated(x: Array) -> Array:
-        q = family_members(robot, red, chain, pose[k], branch[k], x)
-        w = robot.wrap(np.nan_to_num(q, nan=np.inf))[np.arange(x.size), J]
-        return -np.maximum(robot.lower[J] - w, w - robot.upper[J])
+        return -_joint_excess(robot, red, chain, pose[k], branch[k], x)[np.arange(x.size), J]
 
-    best_x, best_e = _golden_least(negated, a, b, grid[k, i], -big[k, i, j])
+    # the excess changes at most ~PEAK_REACH x its rise per sample step (the brackets are two steps wide)
+    slope = PEAK_REACH * rise[k, i, j] / np.maximum(0.5 * (b - a), np.finfo(float).tiny)
+    best_x, best_e = _golden_least(negated, a, b, grid[k, i], -big[k, i, j], _PEAK_STEPS, slope)
     found = best_e < 0.0
     rows = k[found]
     width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
@@ -236,11 +268,13 @@ def families_of(
     grid = np.array([sp.lo for sp in spans])[:, None] + np.array([sp.hi - sp.lo for sp in spans])[:, None] * u
     if limits:
         # a stretch inside the limits narrower than the sampling (a joint dipping just under its limit between
-        # samples) gets a sample of its own
-        grid = np.sort(np.concatenate([grid, _limit_dips(robot, red, chain, pose, branch, grid)], axis=1), axis=1)
-        # and an excursion out of the limits narrower than the sampling (a joint turning through +-pi between two
-        # samples) gets one too, which cuts the span there
-        grid = np.sort(np.concatenate([grid, _limit_peaks(robot, red, chain, pose, branch, grid)], axis=1), axis=1)
+        # samples) gets a sample of its own, and an excursion out of the limits narrower than the sampling (a joint
+        # turning through +-pi between two samples) one that cuts the span there
+        S, M = grid.shape
+        e = _joint_excess(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel()).reshape(S, M, -1)
+        dips = _limit_dips(robot, red, chain, pose, branch, grid, np.max(e, axis=-1))
+        peaks = _limit_peaks(robot, red, chain, pose, branch, grid, e)
+        grid = np.sort(np.concatenate([grid, dips, peaks], axis=1), axis=1)
     ok = _members_ok(robot, red, chain, world, pose, branch, grid, limits, tol)
     pad = np.zeros((len(spans), 1), np.int8)
     edges = np.diff(np.concatenate([pad, ok.astype(np.int8), pad], axis=1), axis=1)
