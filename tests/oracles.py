@@ -513,7 +513,7 @@ def ssik_solutions(robot: Any, pose: np.ndarray, *, info: dict[str, Any] | None 
     held back by a limit), one representative per geometric branch, target position in metres; its other options
     at their defaults (``allow_rescue=True``: a T-perturbation rescue when the analytic path finds nothing; its
     answers are tagged ``refinement_used == "lm"``, counted in ``info["rescued"]``). The first call on an arm
-    without a closed form in ssik derives its elimination (~1.5 min; cached on disk by ssik, ``~/.cache/ssik``).
+    without a closed form in ssik derives its elimination (1.5 to 3.5 min; cached on disk by ssik, ``~/.cache/ssik``).
     ``info`` also gets ``dispatched`` (ssik's solver) and ``fk_residual_max`` (ssik's own FK residual).
     """
     try:

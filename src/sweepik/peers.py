@@ -2,8 +2,8 @@
 ``ssik``).
 
 ``sweepik bench --arms`` times them on the same poses as sweepik; the test suite uses the same adapters as
-independent oracles (``tests/oracles.py``, which also FK-checks their answers). Both peers take a revolute chain
-in product-of-exponentials form: axes ``H (6, 3)`` and link vectors ``P (7, 3)`` at q = 0 with the end
+independent oracles (``tests/oracles.py``, which also FK-checks their answers). EAIK and IK-Geo take a revolute
+chain in product-of-exponentials form: axes ``H (6, 3)`` and link vectors ``P (7, 3)`` at q = 0 with the end
 orientation the identity, so a target's rotation is passed as ``R_target @ R_end^T`` (``chain.R_end``).
 
 * EAIK (``eaik.IK_HP.HPRobot(H, P)``): its own automatic decomposition; ``hasKnownDecomposition()`` says whether it
@@ -229,7 +229,7 @@ def ssik_manipulator(robot: Any, *, limits: bool = True) -> Any:
     (``respect_limits=True``, its default) drops answers outside them; ``limits=False``: every joint continuous,
     answers wrapped to (-pi, pi].
     The first ``solve`` of an arm without a closed form in ssik derives its Raghavan-Roth elimination with SymPy
-    (about a minute and a half; ssik keeps it on disk, ``~/.cache/ssik``, for later processes).
+    (1.5 to 3.5 minutes on the bundled swept arms; ssik keeps it on disk, ``~/.cache/ssik``, for later processes).
     ValueError for an arm that is not 6R: ssik has no solver for prismatic joints (it dispatches such a chain to a
     revolute solver that answers nothing or raises); ImportError without ssik.
     """
@@ -273,7 +273,7 @@ class SsikPrebuilt:
     A: Array
     #: ``(4, 4)``: the artifact's end frame to the robot's tool frame (metres).
     B: Array
-    #: The artifact's joint limits are the robot's (its ``solve`` then filters and winds as sweepik does).
+    #: The artifact's joint limits are the robot's (its ``solve`` then drops what sweepik's drops).
     same_limits: bool
 
     def target(self, T_world_tool: Array, m_per_unit: float) -> Array:
