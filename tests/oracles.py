@@ -14,19 +14,23 @@ Nothing here uses sweepik's solver. Three oracles:
 * :func:`ikgeo_solutions` -- IK-Geo's Python bindings (``pip install ik-geo``; Elias & Wen), 6R arms whose
   structure matches one of its closed-form decompositions (chosen here from the axes, on the chain or on the
   reversed chain); its 1D/2D searches only on request (in 1.0.3 they are coarse and incomplete).
+* :func:`ssik_solutions` -- ssik (``pip install ssik``): every 6R arm, closed forms where the structure has one,
+  else a Raghavan-Roth elimination (a 16th-degree problem solved as an eigenvalue problem), so it is an
+  independent oracle for the arms sweepik sweeps. Called live on the robot's own chain (not a prebuilt artifact).
 
-All three take the target ``pose`` (4x4, world frame: base and tool transforms included, as ``robot.fk``) and
+All four take the target ``pose`` (4x4, world frame: base and tool transforms included, as ``robot.fk``) and
 return an array ``(k, n)`` of distinct solutions (revolute values wrapped to (-pi, pi], prismatic as is),
-joint limits NOT applied, sorted lexicographically. The two wrappers return None when the package is not
+joint limits NOT applied, sorted lexicographically. The three wrappers return None when the package is not
 installed or cannot handle the arm; the solutions they return are filtered to those whose FK matches the pose
 within ``FK_TOL`` (relative to ``length_scale`` for position, radians for orientation). Pass a dict as
 ``info`` to learn what the solver returned (counts of solutions, least-squares flags, rejected ones, the
 decomposition used).
 
-Both packages describe the arm in product-of-exponentials form, which ``robot.chain`` provides (``H (n, 3)``,
+EAIK and IK-Geo describe the arm in product-of-exponentials form, which ``robot.chain`` provides (``H (n, 3)``,
 ``P (n + 1, 3)``, ``R_end``; world frame at q = 0). Their end effector has orientation I at q = 0, so their
 target orientation is ``R_target @ R_end.T``. Quirk: ik_geo 1.0.3's Python layer reads the rotation matrix
-transposed (and returns its own ``forward_kinematics`` rotation transposed), so it is handed ``R.T``.
+transposed (and returns its own ``forward_kinematics`` rotation transposed), so it is handed ``R.T``. ssik gets the
+same chain as a list of joint transforms (``sweepik.peers.ssik_manipulator``), in metres.
 """
 
 from __future__ import annotations
@@ -39,6 +43,8 @@ from numpy.typing import NDArray
 from sweepik.peers import chain_arrays as _chain_arrays
 from sweepik.peers import eaik_robot as _eaik_robot
 from sweepik.peers import ikgeo_setup as _ikgeo_setup
+from sweepik.peers import metres_per_unit as _metres_per_unit
+from sweepik.peers import ssik_manipulator as _ssik_manipulator
 
 Array = NDArray[np.float64]
 
@@ -47,6 +53,7 @@ __all__ = [
     "numerical_solutions",
     "eaik_solutions",
     "ikgeo_solutions",
+    "ssik_solutions",
     "wrap",
     "pose_errors",
     "same_solution_set",
@@ -490,6 +497,51 @@ def ikgeo_solutions(
     if reverse:
         Q = Q[:, ::-1]
     return _filter(robot, target, Q, is_ls, "ik_geo", info, decomposition=name, kind=kind, reversed=reverse)
+
+
+# ----------------------------------------------------------------------------------------------------------
+# 2c. ssik
+# ----------------------------------------------------------------------------------------------------------
+
+
+def ssik_solutions(robot: Any, pose: np.ndarray, *, info: dict[str, Any] | None = None) -> Array | None:
+    """ssik's IK solutions of ``pose`` (``(k, n)``, FK-checked), or None (no ssik, the arm is not 6R, or ssik
+    raises on it: ``info["error"]``).
+
+    Called as ``ssik_manipulator(robot, limits=False).solve(T, respect_limits=False, enumerate_windings=False)``:
+    ssik's live ``Manipulator`` on the robot's own chain with every joint continuous (no limit filter, no polish
+    held back by a limit), one representative per geometric branch, target position in metres; its other options
+    at their defaults (``allow_rescue=True``: a T-perturbation rescue when the analytic path finds nothing; its
+    answers are tagged ``refinement_used == "lm"``, counted in ``info["rescued"]``). The first call on an arm
+    without a closed form in ssik derives its elimination (1.5 to 3.5 min; cached on disk by ssik, ``~/.cache/ssik``).
+    ``info`` also gets ``dispatched`` (ssik's solver) and ``fk_residual_max`` (ssik's own FK residual).
+    """
+    try:
+        import ssik  # noqa: F401
+    except ImportError:
+        return None
+    rev = np.asarray(robot.is_revolute, dtype=bool)
+    if len(rev) != 6 or not np.all(rev):
+        if info is not None:
+            info.update(solver="ssik", unsupported=True)
+        return None
+    arm = _ssik_manipulator(robot, limits=False)
+    target = np.asarray(pose, dtype=np.float64)
+    T = target.copy()
+    T[:3, 3] *= _metres_per_unit(robot)
+    try:
+        sols = arm.solve(T, respect_limits=False, enumerate_windings=False)
+    except (RuntimeError, ValueError) as exc:  # e.g. a dispatched solver that refuses the chain when it solves
+        if info is not None:
+            info.update(solver="ssik", dispatched=arm.solver_name, error=repr(exc))
+        return None
+    Q = np.array([s.q for s in sols], dtype=np.float64).reshape(-1, 6)
+    extra = {
+        "dispatched": arm.solver_name,
+        "rescued": sum(s.refinement_used == "lm" for s in sols),
+        "fk_residual_max": max((float(s.fk_residual) for s in sols), default=0.0),
+    }
+    return _filter(robot, target, Q, np.zeros(len(Q), dtype=bool), "ssik", info, **extra)
 
 
 def in_metres(robot: Any, name: str) -> Any:

@@ -129,9 +129,12 @@ def test_bench_arms_small(capsys: pytest.CaptureFixture[str]) -> None:
     assert ur5["plan"] == "closed form" and carm["plan"] == "sweep joint 1"
     assert ur5["sweepik"]["batched_us"] > 0 and ur5["sweepik"]["single_us"] > 0 and ur5["peak_rss_mib"] > 0
     assert "sweepik carm-d1" in carm and isinstance(carm["misses"], list)
+    # ssik, the swept arms' yardstick: 6R arms only (a column either way; timed when installed)
+    assert carm["ssik"]["solves"] is False and carm["ssik"]["why"] == "not 6R" and "ssik" not in carm["peers"]
+    assert ur5["ssik"]["solves"] == ("ssik" in ur5["peers"])
     assert main(argv[:3] + ["--single", "0", "--batch", "16", "--memory", "0", "--repeats", "1"]) == 0
     table = capsys.readouterr().out
-    assert table.splitlines()[0].startswith("arm") and "ur5" in table
+    assert table.splitlines()[0].startswith("arm") and "ur5" in table and "ssik single/batched" in table
 
 
 def test_bench_arms_unknown_robot_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:

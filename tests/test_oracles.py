@@ -1,9 +1,9 @@
 """The reference IK oracles of tests/oracles.py agree with forward kinematics and with each other.
 
-Three oracles: a many-start numerical search (always available), EAIK and IK-Geo (skipped when the packages
-``EAIK`` / ``ik-geo`` are not installed). On the PUMA 560 (both DH conventions) and a UR5, for random joint
-values q: each oracle's solution set contains q (modulo 2 pi), every solution it returns reproduces the pose,
-and the three return the same set for at least 95% of the poses.
+Four oracles: a many-start numerical search (always available), EAIK, IK-Geo and ssik (skipped when the packages
+``EAIK`` / ``ik-geo`` / ``ssik`` are not installed). On the PUMA 560 (both DH conventions) and a UR5, for random
+joint values q: each oracle's solution set contains q (modulo 2 pi), every solution it returns reproduces the pose,
+and they return the same set for at least 95% of the poses.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from oracles import (
     numerical_solutions,
     pose_errors,
     same_solution_set,
+    ssik_solutions,
 )
 
 from sweepik import Robot, load_robot, robot_from_dict
@@ -121,6 +122,23 @@ def test_ikgeo_oracle(name: str) -> None:
 
 
 @pytest.mark.parametrize("name", ROBOTS)
+def test_ssik_oracle(name: str) -> None:
+    """ssik (live, on the robot's own chain, limits off) recovers q, answers only FK-exact configurations, and
+    returns the numerical search's set on at least 95% of the poses."""
+    pytest.importorskip("ssik")
+    robot = _robot(name)
+    agree = 0
+    for q, pose, num in _cases(name):
+        info: dict[str, object] = {}
+        sols = ssik_solutions(robot, pose, info=info)
+        assert sols is not None, info
+        assert info["rejected"] == 0, info  # everything ssik returned passed the FK check
+        _check_solutions(robot, q, pose, sols, 1e-6)
+        agree += same_solution_set(sols, num, robot.is_revolute, robot.length_scale, SET_TOL)
+    assert agree >= 0.95 * N_POSES, f"{name}: ssik and the numerical search agree on only {agree} of {N_POSES} poses"
+
+
+@pytest.mark.parametrize("name", ROBOTS)
 def test_oracles_agree(name: str) -> None:
     pytest.importorskip("eaik")
     pytest.importorskip("ik_geo")
@@ -169,6 +187,9 @@ def test_unsupported_arms_give_none_and_numerical_handles_prismatic() -> None:
     pose = carm.fk(q)
     assert eaik_solutions(carm, pose) is None
     assert ikgeo_solutions(carm, pose) is None
+    assert ssik_solutions(carm, pose) is None  # ssik has no prismatic solver (also None without ssik)
+    stanford = load_robot("stanford")
+    assert ssik_solutions(stanford, stanford.fk(np.array([0.1, 0.2, 0.5, 0.3, 0.4, 0.5]))) is None
     _check_solutions(carm, q, pose, numerical_solutions(carm, pose), 1e-9)
 
     general = _dh_robot(  # no two axes parallel or intersecting: no closed form in either package
