@@ -4,7 +4,8 @@ For each arm: N random in-limit configurations plus edge cases (each joint at ea
 ``sweepik.solve_many(robot, robot.fk(Q))`` with no options (the C-Arm: reduction="auto"). Reports recall
 (q among the solutions, or on a reported family), FK certification (<= 1e-9 x length scale), limits, and the
 agreement of each pose's solution set (within limits) with an independent reference: IK-Geo where it has a
-closed form for the arm, else the many-start numerical search of tests/oracles.py.
+closed form for the arm, else ssik (all-solutions, Raghavan-Roth elimination; the bench extra) for 6R arms, else the
+many-start numerical search of tests/oracles.py.
 
     python scripts/evaluate_arms.py [--n 2000] [--arms ur5 carm ...] [--numerical-max 2000]
 """
@@ -27,6 +28,7 @@ from oracles import (  # noqa: E402
     numerical_solutions,
     recovers,
     same_solution_set,
+    ssik_solutions,
 )
 
 import sweepik  # noqa: E402
@@ -61,6 +63,9 @@ def main() -> None:
         worst = []
         for i, (s, t) in enumerate(zip(S, T, strict=True)):
             ref = ikgeo_solutions(robot, t) if robot.is_revolute.all() else None
+            if ref is None and robot.is_revolute.all():
+                ref = ssik_solutions(robot, t)  # (a 6R arm IK-Geo has no closed form for: ssik, if installed)
+                kind = "ssik" if ref is not None else kind
             if ref is None:
                 kind = "numerical"
                 if compared >= args.numerical_max:
