@@ -221,8 +221,9 @@ def _solve_chunk(
                 q, err_geo, err_paper = fastcertify.certify(
                     robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
                 )
-            else:
-                q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+            else:  # (writable copies of the cached candidates: a reduction's code may want to write them)
+                q = red.solve_rest(chain[cand.pose], np.array(cand.theta)[:, None], np.array(cand.branch)[:, None])
+                q = q[:, 0]
         elif compiled:
             params = red.kernel_params(chain)
             cand, spans = _twin_copies(red, *fastsweep.search(red, chain, lo, hi, n_samples, params))
