@@ -14,7 +14,7 @@ from .pose import pose_error_geodesic
 from .reductions import Reduction
 from .robot import Robot
 from .solutions import Family
-from .sweep import CLUSTER_FAMILY_REL, FamilySpan
+from .sweep import CLUSTER_FAMILY_REL, Spans
 from .units import orientation_weight
 
 Array = NDArray[np.float64]
@@ -237,35 +237,42 @@ def _limit_peaks(
     return extra
 
 
-def merge_spans(spans: list[FamilySpan]) -> list[FamilySpan]:
-    """One span per stretch: spans of one pose and branch that overlap or touch are united (the sweep finds a
-    family from its samples and again from flat stretches around roots)."""
-    out: list[FamilySpan] = []
-    for sp in sorted(spans, key=lambda x: (x.pose, x.branch, x.lo)):
-        last = out[-1] if out else None
-        if last is not None and last.pose == sp.pose and last.branch == sp.branch and sp.lo <= last.hi:
-            out[-1] = FamilySpan(last.pose, last.branch, last.lo, max(last.hi, sp.hi))
+def merge_spans(spans: Spans) -> Spans:
+    """One span per stretch, in order of (pose, branch, lo): spans of one pose and branch that overlap or touch are
+    united (the sweep finds a family from its samples and again from flat stretches around roots)."""
+    if len(spans) < 2:
+        return spans
+    order = np.lexsort((spans.lo, spans.branch, spans.pose))
+    pose, branch = spans.pose[order].tolist(), spans.branch[order].tolist()
+    lo, hi = spans.lo[order].tolist(), spans.hi[order].tolist()
+    first = [0]  # the first span of each merged one, and its hi
+    ends = [hi[0]]
+    for k in range(1, len(lo)):
+        if pose[k] == pose[k - 1] and branch[k] == branch[k - 1] and lo[k] <= ends[-1]:
+            ends[-1] = max(ends[-1], hi[k])
         else:
-            out.append(sp)
-    return out
+            first.append(k)
+            ends.append(hi[k])
+    keep = order[first]
+    return Spans(spans.pose[keep], spans.branch[keep], spans.lo[keep], np.array(ends))
 
 
 def families_of(
-    robot: Robot, red: Reduction, chain: Array, world: Array, spans: list[FamilySpan], limits: bool, tol: float
+    robot: Robot, red: Reduction, chain: Array, world: Array, spans: Spans, limits: bool, tol: float
 ) -> tuple[dict[int, list[Family]], NDArray[np.intp], Array]:
     """Family objects per pose: each span cut to the sub-intervals whose members are certified by FK
     (and, with limits, inside the limits): sampled, then each cut located by bisection.
     Pieces that shrink to a point are returned as isolated members ``(pose index, q)``."""
     out: dict[int, list[Family]] = {}
     spans = merge_spans(spans)
-    if not spans:
+    if not len(spans):
         return out, np.zeros(0, np.intp), np.zeros((0, robot.n_joints))
     # only the poses with a family are worked on (the compiled kernels take every pose's parameters)
-    used, pose = np.unique(np.array([sp.pose for sp in spans]), return_inverse=True)
+    used, pose = np.unique(spans.pose, return_inverse=True)
     chain_all, chain, world = chain, chain[used], world[used]
-    branch = np.array([sp.branch for sp in spans])
+    branch = spans.branch
     u = np.linspace(0.0, 1.0, _FAMILY_SAMPLES)
-    grid = np.array([sp.lo for sp in spans])[:, None] + np.array([sp.hi - sp.lo for sp in spans])[:, None] * u
+    grid = spans.lo[:, None] + (spans.hi - spans.lo)[:, None] * u
     if limits:
         # a stretch inside the limits narrower than the sampling (a joint dipping just under its limit between
         # samples) gets a sample of its own, and an excursion out of the limits narrower than the sampling (a joint
@@ -313,12 +320,11 @@ def families_of(
     # a piece that shrinks to a point (the family touches the limits there) is an isolated solution
     point = hi - lo <= CLUSTER_FAMILY_REL * (grid[K, -1] - grid[K, 0] + 1.0)
     duplicate = _repeated_pieces(robot, red, chain, pose[K], branch[K], lo, hi) & ~point
-    for j, k in enumerate(K):
-        if not point[j] and not duplicate[j]:
-            sp = spans[k]
-            out.setdefault(sp.pose, []).append(
-                Family(red.free_joint, (float(lo[j]), float(hi[j])), red, chain_all[sp.pose], sp.branch)
-            )
+    f_pose, f_branch = spans.pose[K].tolist(), spans.branch[K].tolist()
+    for j in np.nonzero(~point & ~duplicate)[0].tolist():
+        out.setdefault(f_pose[j], []).append(
+            Family(red.free_joint, (float(lo[j]), float(hi[j])), red, chain_all[f_pose[j]], f_branch[j])
+        )
     pk = K[point]
     # its member: of the piece's ends and middle, the one deepest inside the limits
     three = np.stack([lo[point], 0.5 * (lo + hi)[point], hi[point]], axis=1)
@@ -424,32 +430,51 @@ def off_families(robot: Robot, checks: list[tuple[Array, tuple[Family, ...]]]) -
     """For each ``(q (k, n), families)`` of ``checks``, the ``(k,)`` mask of the configurations that are not members
     of any of the families. The members (at the configurations within a family's interval) are evaluated in one
     batch per reduction, bit for bit what ``Family.at`` gives."""
-    on = [np.zeros(q.shape[0], dtype=bool) for q, _ in checks]
-    batches: dict[int, list[tuple[int, Family, NDArray[np.intp], Array]]] = {}
-    for g, (q, families) in enumerate(checks):
-        for f in families:
-            th = q[:, f.free_joint]
-            lo, hi = f.interval
-            slack = _MEMBER_TOL * np.maximum(1.0, np.abs(th))  # a configuration at an end of the interval is on it
-            rows = np.nonzero((th >= lo - slack) & (th <= hi + slack))[0]
-            if rows.size == 0:
+    sizes = np.array([q.shape[0] for q, _ in checks], dtype=np.intp)
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.intp)
+    on = np.zeros(int(offsets[-1]), dtype=bool)
+    if on.size:
+        q_all = np.concatenate([q for q, _ in checks])
+        pairs: dict[int, list[tuple[int, Family]]] = {}  # (check, family) per reduction
+        for g, (q, families) in enumerate(checks):
+            if q.shape[0] == 0:
                 continue
-            if f.held is not None:  # (members of the full arm: as Family.at expands them)
-                on[g][rows] |= _same_configuration(robot, f.at(np.clip(th[rows], lo, hi)), q[rows])
-            else:
-                batches.setdefault(id(f.reduction), []).append((g, f, rows, np.clip(th[rows], lo, hi)))
-    for batch in batches.values():
-        red = batch[0][1].reduction
-        pose = np.repeat(np.arange(len(batch)), [rows.size for _, _, rows, _ in batch])
-        branch = np.repeat([f.branch for _, f, _, _ in batch], [rows.size for _, _, rows, _ in batch])
-        chain = np.stack([f.chain_pose for _, f, _, _ in batch])
-        theta = np.concatenate([th for _, _, _, th in batch])
-        members = red.robot.wrap(family_members(red.robot, red, chain, pose, branch.astype(np.intp), theta))
-        start = 0
-        for g, _, rows, _ in batch:
-            on[g][rows] |= _same_configuration(robot, members[start : start + rows.size], checks[g][0][rows])
-            start += rows.size
-    return [~m for m in on]
+            for f in families:
+                if f.held is not None:  # (members of the full arm: as Family.at expands them)
+                    th = q[:, f.free_joint]
+                    lo, hi = f.interval
+                    rows = np.nonzero(_in_interval(th, lo, hi))[0]
+                    if rows.size:
+                        same = _same_configuration(robot, f.at(np.clip(th[rows], lo, hi)), q[rows])
+                        on[offsets[g] + rows] |= same
+                else:
+                    pairs.setdefault(id(f.reduction), []).append((g, f))
+        for batch in pairs.values():
+            red = batch[0][1].reduction
+            checked = np.array([gi for gi, _ in batch], dtype=np.intp)
+            # every (pair, row of its check): the rows whose theta* lies in the family's interval
+            n = sizes[checked]
+            pair = np.repeat(np.arange(checked.size), n)
+            row = np.arange(pair.size) - np.repeat(np.cumsum(n) - n, n) + offsets[checked][pair]
+            fj = np.array([f.free_joint for _, f in batch], dtype=np.intp)
+            f_lo = np.array([f.interval[0] for _, f in batch])
+            f_hi = np.array([f.interval[1] for _, f in batch])
+            th = q_all[row, fj[pair]]
+            sel = np.nonzero(_in_interval(th, f_lo[pair], f_hi[pair]))[0]
+            if sel.size == 0:
+                continue
+            pair, row, th = pair[sel], row[sel], np.clip(th[sel], f_lo[pair[sel]], f_hi[pair[sel]])
+            branch = np.array([f.branch for _, f in batch], dtype=np.intp)[pair]
+            chain = np.stack([f.chain_pose for _, f in batch])
+            members = red.robot.wrap(family_members(red.robot, red, chain, pair, branch, th))
+            on[row[_same_configuration(robot, members, q_all[row])]] = True
+    return [~on[offsets[g] : offsets[g + 1]] for g in range(len(checks))]
+
+
+def _in_interval(th: Array, lo: Array | float, hi: Array | float) -> NDArray[np.bool_]:
+    """theta* ``th`` within a family's interval ``[lo, hi]``: a configuration at an end of it is on it."""
+    slack = _MEMBER_TOL * np.maximum(1.0, np.abs(th))
+    return np.asarray((th >= lo - slack) & (th <= hi + slack))
 
 
 def unique_families(families: tuple[Family, ...]) -> tuple[Family, ...]:

@@ -683,18 +683,17 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
             theta=out_t[0, :k0].copy(),
             mult=out_m[0, :k0].astype(np.intp),
         )
-        return single, []
+        return single, _ref.Spans.empty()
     over = (cnt > MAX_CAND) | (fcnt > MAX_FAM)
     counts = np.where(over, 0, cnt)
     pose_idx = np.repeat(np.arange(N), counts)
     slot = np.arange(pose_idx.size) - np.repeat(np.cumsum(counts) - counts, counts)
     cand_p, cand_b, cand_t = [pose_idx], [out_b[pose_idx, slot]], [out_t[pose_idx, slot]]
     cand_m = [out_m[pose_idx, slot]]
-    spans: list[_ref.FamilySpan] = []
+    spans = [_ref.Spans.empty()]
     if fcnt.any():
         fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(fcnt, MAX_FAM)[:, None]) & ~over[:, None])
-        for i, k in zip(fp, fs, strict=True):
-            spans.append(_ref.FamilySpan(int(i), int(fam[i, k, 2]), float(fam[i, k, 0]), float(fam[i, k, 1])))
+        spans.append(_ref.Spans(fp.astype(np.intp), fam[fp, fs, 2].astype(np.intp), fam[fp, fs, 0], fam[fp, fs, 1]))
     if over.any():
         idx = np.nonzero(over)[0]
         c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples)
@@ -702,14 +701,14 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         cand_b.append(c2.branch)
         cand_t.append(c2.theta)
         cand_m.append(c2.mult)
-        spans += [_ref.FamilySpan(int(idx[s.pose]), s.branch, s.lo, s.hi) for s in s2]
+        spans.append(_ref.Spans(idx[s2.pose].astype(np.intp), s2.branch, s2.lo, s2.hi))
     cand = _ref.Candidates(
         pose=np.concatenate(cand_p).astype(np.intp),
         branch=np.concatenate(cand_b).astype(np.intp),
         theta=np.concatenate(cand_t),
         mult=np.concatenate(cand_m).astype(np.intp),
     )
-    return cand, spans
+    return cand, _ref.Spans.concat(spans)
 
 
 if AVAILABLE:

@@ -29,7 +29,7 @@ from .reductions.decompose import not_sweepable
 from .reductions.kernels import owned_kernel
 from .robot import Robot
 from .solutions import Family, Solutions
-from .sweep import N_SAMPLES, Candidates, FamilySpan, find_candidates
+from .sweep import N_SAMPLES, Candidates, Spans, find_candidates
 from .units import mm_per_unit, orientation_weight
 
 __all__ = ["solve", "solve_many", "iter_solve", "STRATEGIES"]
@@ -154,7 +154,7 @@ def _snap_to_limits(
     return w_all, inside
 
 
-def _twin_copies(red: Reduction, cand: Candidates, spans: list[FamilySpan]) -> tuple[Candidates, list[FamilySpan]]:
+def _twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candidates, Spans]:
     """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
     branches of the class too: their residuals are the same, their configurations differ."""
     if not red.twins:
@@ -164,9 +164,12 @@ def _twin_copies(red: Reduction, cand: Candidates, spans: list[FamilySpan]) -> t
         k = np.nonzero(cand.branch == cls[0])[0]
         for b in cls[1:]:
             parts.append(Candidates(cand.pose[k], np.full(k.size, b, dtype=np.intp), cand.theta[k], cand.mult[k]))
-    spans = spans + [
-        FamilySpan(s.pose, b, s.lo, s.hi) for cls in red.twins for s in spans if s.branch == cls[0] for b in cls[1:]
-    ]
+    twin_spans = [spans]
+    for cls in red.twins:
+        k = np.nonzero(spans.branch == cls[0])[0]
+        for b in cls[1:]:
+            twin_spans.append(Spans(spans.pose[k], np.full(k.size, b, dtype=np.intp), spans.lo[k], spans.hi[k]))
+    spans = Spans.concat(twin_spans)
     return (
         Candidates(
             np.concatenate([c.pose for c in parts]),
@@ -207,7 +210,7 @@ def _solve_chunk(
     if not closed:  # (a closed form sweeps nothing)
         lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
     weight = orientation_weight(robot.length_unit)
-    spans: list[FamilySpan] = []
+    spans = Spans.empty()
     fams: dict[int, list[Family]]
     compiled = red.uses_kernel and fastsweep.AVAILABLE
     err_geo = err_paper = None
@@ -250,12 +253,10 @@ def _solve_chunk(
             pose_idx = np.concatenate([pose_idx, sp_p])
             mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp) if sp_mult is None else sp_mult[sp_p, sp_k]])
         # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
-        if spans:
-            spans = [
-                FamilySpan(sp.pose, sp.branch, max(sp.lo, float(lo[sp.pose])), min(sp.hi, float(hi[sp.pose])))
-                for sp in spans
-                if min(sp.hi, hi[sp.pose]) > max(sp.lo, lo[sp.pose])
-            ]
+        if len(spans):
+            s_lo, s_hi = np.maximum(spans.lo, lo[spans.pose]), np.minimum(spans.hi, hi[spans.pose])
+            keep_span = s_hi > s_lo
+            spans = Spans(spans.pose[keep_span], spans.branch[keep_span], s_lo[keep_span], s_hi[keep_span])
         fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, ACCEPT_TOL_REL * robot.length_scale)
         if fam_p.size:
             if err_geo is not None and err_paper is not None:

@@ -118,13 +118,35 @@ class Candidates:
 
 
 @dataclass(frozen=True)
-class FamilySpan:
-    """A run of theta* along which branch ``branch`` of pose ``pose`` solves the pose identically."""
+class Spans:
+    """Runs of theta* along which a branch of a pose solves the pose identically (self-motion families): pose
+    index, branch and the run's ends ``[lo, hi]``, for ``K`` runs (arrays: a batch has thousands of them)."""
 
-    pose: int
-    branch: int
-    lo: float
-    hi: float
+    pose: IntArray
+    branch: IntArray
+    lo: Array
+    hi: Array
+
+    @staticmethod
+    def empty() -> Spans:
+        return Spans(np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0), np.zeros(0))
+
+    @staticmethod
+    def concat(parts: list[Spans]) -> Spans:
+        if len(parts) == 1:
+            return parts[0]
+        return Spans(
+            np.concatenate([s.pose for s in parts]).astype(np.intp),
+            np.concatenate([s.branch for s in parts]).astype(np.intp),
+            np.concatenate([s.lo for s in parts]).astype(np.float64),
+            np.concatenate([s.hi for s in parts]).astype(np.float64),
+        )
+
+    def take(self, idx: IntArray | NDArray[np.bool_]) -> Spans:
+        return Spans(self.pose[idx], self.branch[idx], self.lo[idx], self.hi[idx])
+
+    def __len__(self) -> int:
+        return int(self.pose.size)
 
 
 @lru_cache(maxsize=8)
@@ -204,7 +226,7 @@ class _Search:
         self.roots_b: list[IntArray] = []
         self.roots_t: list[Array] = []
         self.br: list[tuple[IntArray, IntArray, Array, Array, Array, Array]] = []
-        self.spans: list[FamilySpan] = []
+        self.spans = Spans.empty()
         #: |residual| above which a sample or extremum is no candidate (see ``FAR_NOISE``)
         self.far = FAR_NOISE * reduction.residual_noise
 
@@ -421,8 +443,8 @@ class _Search:
         p = np.concatenate(self.roots_p).astype(np.intp)
         b = np.concatenate(self.roots_b).astype(np.intp)
         t, lo, hi, family = self._center_flat(p, b, np.concatenate(self.roots_t))
-        for k in np.nonzero(family)[0]:
-            self.spans.append(FamilySpan(int(p[k]), int(b[k]), float(lo[k]), float(hi[k])))
+        if family.any():
+            self.spans = Spans(p[family], b[family], lo[family], hi[family])
         cand = self._merge_clusters(p[~family], b[~family], t[~family])
         return Candidates(cand.pose, cand.branch, cand.theta, self._multiplicity(cand.pose, cand.branch, cand.theta))
 
@@ -552,13 +574,13 @@ def _extend(reduction: Reduction, poses: Array, branch: IntArray, inside: Array,
 
 def _families(
     reduction: Reduction, poses: Array, theta: Array, f: Array, valid: NDArray[np.bool_], span: Array
-) -> tuple[list[FamilySpan], NDArray[np.bool_]]:
+) -> tuple[Spans, NDArray[np.bool_]]:
     """Runs of vanishing samples ``(N, M, B)`` -> family spans (ends located by bisection towards the
     neighbouring samples), and the mask of samples they cover."""
     flat = valid & (np.abs(f) <= FAMILY_TOL)
     in_family = np.zeros_like(flat)
     if not flat.any():
-        return [], in_family
+        return Spans.empty(), in_family
     runs = []  # (pose, branch, first sample, last sample)
     for p, b in zip(*np.nonzero(flat.sum(axis=1) >= FAMILY_MIN_RUN), strict=True):
         col = flat[p, :, b]
@@ -569,14 +591,13 @@ def _families(
                 runs.append((int(p), int(b), int(s0), int(e0 - 1)))
                 in_family[p, s0:e0, b] = True
     if not runs:
-        return [], in_family
+        return Spans.empty(), in_family
     P, Bb, S0, S1 = (np.array(x) for x in zip(*runs, strict=True))
     M = theta.shape[1]
     lo, hi = theta[P, S0], theta[P, S1]
     lo = np.where(S0 > 0, _extend(reduction, poses[P], Bb, lo, theta[P, np.maximum(S0 - 1, 0)]), lo)
     hi = np.where(S1 < M - 1, _extend(reduction, poses[P], Bb, hi, theta[P, np.minimum(S1 + 1, M - 1)]), hi)
-    spans = [FamilySpan(int(p), int(b), float(x), float(y)) for p, b, x, y in zip(P, Bb, lo, hi, strict=True)]
-    return spans, in_family
+    return Spans(P.astype(np.intp), Bb.astype(np.intp), lo, hi), in_family
 
 
 class PoseErrorResidual(Reduction):
@@ -612,7 +633,7 @@ def find_candidates(
     lo: Array,
     hi: Array,
     n_samples: int = N_SAMPLES,
-) -> tuple[Candidates, list[FamilySpan]]:
+) -> tuple[Candidates, Spans]:
     """Candidates for all N chain poses ``(N, 4, 4)`` with theta* ranges ``lo, hi (N,)``."""
     theta = sample_grid(reduction, poses, lo, hi, n_samples)
     f = reduction.residual(poses, theta)
@@ -633,4 +654,4 @@ def find_candidates(
     vs = valid.transpose(0, 2, 1).reshape(N * B, M)
     search.scan(p, b, theta[p], fs, vs, 0)
     cand = search.finish()
-    return cand, spans + search.spans
+    return cand, Spans.concat([spans, search.spans])
