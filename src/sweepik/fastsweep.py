@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from . import parallel
 from . import sweep as _ref
-from ._jit import internal
+from ._jit import internal, unowned
 from .reductions.kernels import first_class, lazy_njit, owned_kernel
 from .robot import Robot
 
@@ -388,6 +388,11 @@ if AVAILABLE:
                 _push(out_t, out_b, cnt, _root(res, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
 
     @internal
+    def _alive(*arrays):
+        """Nothing: a use of the work arrays after their last unowned view is used, so that they are freed after it."""
+        return len(arrays)
+
+    @internal
     def _sort_pairs(keys, values, n):
         """The first ``n`` pairs ``(keys[k], values[k])`` sorted in place, by key, then by value (insertion sort: a
         pose has a few dozen candidates at most; ``values`` are never NaN)."""
@@ -439,30 +444,45 @@ if AVAILABLE:
 
         One function, not a loop calling a function per pose: Numba re-optimises everything a compiled function calls
         when it compiles the caller, and each level costs seconds on a fresh install."""
+        # the arguments as views Numba does not reference-count: each kernel call would count them up and down
+        params, grid, out_t, out_b, out_m = (
+            unowned(params),
+            unowned(grid),
+            unowned(out_t),
+            unowned(out_b),
+            unowned(out_m),
+        )
+        cnt, fam, fcnt, span = unowned(cnt), unowned(fam), unowned(fcnt), unowned(span)
         M = grid.shape[1]
         # work arrays, shared by the poses (each pose sets what it reads). Explicit loops rather than np.zeros,
         # np.full, slice copies or np.argsort: each of those adds to the first compilation (docs/performance.md)
-        c = np.empty(1, dtype=np.int64)
-        stk_t = np.empty((STACK, SUB + 2))
-        stk_f = np.empty((STACK, SUB + 2))
-        stk_i = np.empty((STACK, 3), dtype=np.int64)
-        stk_c = np.empty((STACK, 5))
-        no_ctx = np.empty(4)
+        own_c = np.empty(1, dtype=np.int64)
+        own_stk_t = np.empty((STACK, SUB + 2))
+        own_stk_f = np.empty((STACK, SUB + 2))
+        own_stk_i = np.empty((STACK, 3), dtype=np.int64)
+        own_stk_c = np.empty((STACK, 5))
+        own_no_ctx = np.empty(4)
         for k in range(4):
-            no_ctx[k] = np.nan
+            own_no_ctx[k] = np.nan
         W = M if M > SUB + 2 else SUB + 2
-        wv = np.empty(W, dtype=np.bool_)
-        wx = np.empty(W)
-        wdd = np.empty(W)
-        buf_t = np.empty(SUB + 2)
-        buf_f = np.empty(SUB + 2)
-        buf_c = np.empty(4)
+        own_wv = np.empty(W, dtype=np.bool_)
+        own_wx = np.empty(W)
+        own_wdd = np.empty(W)
+        own_buf_t = np.empty(SUB + 2)
+        own_buf_f = np.empty(SUB + 2)
+        own_buf_c = np.empty(4)
         nb_all = n_all if n_all > 1 else 1
-        f_all = np.empty((M, nb_all))
-        edge_f = np.empty((M, SUB + 1, nb_all))  # all-branch sub-samples of edge intervals (level 0)
-        edge_ok = np.empty(M, dtype=np.bool_)
-        f = np.empty(M)
-        top = np.empty(1, dtype=np.int64)
+        own_f_all = np.empty((M, nb_all))
+        own_edge_f = np.empty((M, SUB + 1, nb_all))  # all-branch sub-samples of edge intervals (level 0)
+        own_edge_ok = np.empty(M, dtype=np.bool_)
+        own_f = np.empty(M)
+        own_top = np.empty(1, dtype=np.int64)
+        # ... and the work arrays too (their owners are used at the end, ``_alive``: they outlive the views)
+        c, stk_t, stk_f, stk_i = unowned(own_c), unowned(own_stk_t), unowned(own_stk_f), unowned(own_stk_i)
+        stk_c, no_ctx, wv, wx = unowned(own_stk_c), unowned(own_no_ctx), unowned(own_wv), unowned(own_wx)
+        wdd, buf_t, buf_f, buf_c = unowned(own_wdd), unowned(own_buf_t), unowned(own_buf_f), unowned(own_buf_c)
+        f_all, edge_f, edge_ok, f = unowned(own_f_all), unowned(own_edge_f), unowned(own_edge_ok), unowned(own_f)
+        top = unowned(own_top)
         for i in range(start, stop):
             p = params[i]
             th = grid[i]
@@ -567,6 +587,8 @@ if AVAILABLE:
                 cnt[i] = w if c[0] <= out_t.shape[1] else c[0]
             for k in range(min(cnt[i], out_t.shape[1])):
                 out_m[i, k] = _multiplicity(res, p, out_t[i, k], out_b[i, k], noise, span[i])
+        _alive(own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx, own_wdd)
+        _alive(own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top)
 
     @lazy_njit(RESIDUALS_SIG, cache=True)
     def _no_residuals(params, theta, out):  # pragma: no cover - never called (n_all = 0)
