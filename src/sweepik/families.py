@@ -102,16 +102,14 @@ def _limit_dips(
     pose: NDArray[np.intp],
     branch: NDArray[np.intp],
     grid: Array,
-    e: Array | None = None,
+    e: Array,
 ) -> Array:
     """``(K, D)`` extra samples for the family spans sampled at ``grid (K, M)``: where the limit excess has a
     local minimum above zero among the samples, the least excess between the neighbouring samples is located
     (golden section); where it is inside the limits, that point is an extra sample. ``D`` is the most extra
     samples of one span (0 in the common case); shorter rows repeat the span's first sample. ``e (K, M)``: the
-    samples' limit excess, when the caller has it."""
+    samples' limit excess."""
     K, M = grid.shape
-    if e is None:
-        e = _limit_excess(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel()).reshape(K, M)
     big = np.where(np.isfinite(e), e, np.inf)
     left = np.concatenate([np.full((K, 1), np.inf), big[:, :-1]], axis=1)
     right = np.concatenate([big[:, 1:], np.full((K, 1), np.inf)], axis=1)
@@ -220,10 +218,9 @@ def _limit_peaks(
     if k.size == 0:
         return np.zeros((K, 0))
     a, b = grid[k, np.maximum(i - 1, 0)], grid[k, np.minimum(i + 1, M - 1)]
-    J = j  # the joint whose excess peaks (of each bracket)
 
-    def negated(x: Array) -> Array:
-        return -_joint_excess(robot, red, chain, pose[k], branch[k], x)[np.arange(x.size), J]
+    def negated(x: Array) -> Array:  # (of each bracket, the joint j whose excess peaks)
+        return -_joint_excess(robot, red, chain, pose[k], branch[k], x)[np.arange(x.size), j]
 
     # the excess changes at most ~PEAK_REACH x its rise per sample step (the brackets are two steps wide)
     slope = PEAK_REACH * rise[k, i, j] / np.maximum(0.5 * (b - a), np.finfo(float).tiny)

@@ -159,26 +159,29 @@ def _twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candid
     branches of the class too: their residuals are the same, their configurations differ."""
     if not red.twins:
         return cand, spans
-    parts = [cand]
-    for cls in red.twins:
-        k = np.nonzero(cand.branch == cls[0])[0]
-        for b in cls[1:]:
-            parts.append(Candidates(cand.pose[k], np.full(k.size, b, dtype=np.intp), cand.theta[k], cand.mult[k]))
-    twin_spans = [spans]
-    for cls in red.twins:
-        k = np.nonzero(spans.branch == cls[0])[0]
-        for b in cls[1:]:
-            twin_spans.append(Spans(spans.pose[k], np.full(k.size, b, dtype=np.intp), spans.lo[k], spans.hi[k]))
-    spans = Spans.concat(twin_spans)
+    c_rows, c_branch = _twin_rows(red, cand.branch)
+    s_rows, s_branch = _twin_rows(red, spans.branch)
     return (
         Candidates(
-            np.concatenate([c.pose for c in parts]),
-            np.concatenate([c.branch for c in parts]),
-            np.concatenate([c.theta for c in parts]),
-            np.concatenate([c.mult for c in parts]),
+            np.concatenate([cand.pose, cand.pose[c_rows]]),
+            np.concatenate([cand.branch, c_branch]),
+            np.concatenate([cand.theta, cand.theta[c_rows]]),
+            np.concatenate([cand.mult, cand.mult[c_rows]]),
         ),
-        spans,
+        Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])]),
     )
+
+
+def _twin_rows(red: Reduction, branch: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
+    that branch: ``(rows, branches)``."""
+    rows, branches = [np.zeros(0, np.intp)], [np.zeros(0, np.intp)]
+    for cls in red.twins:
+        k = np.nonzero(branch == cls[0])[0]
+        for b in cls[1:]:
+            rows.append(k)
+            branches.append(np.full(k.size, b, dtype=np.intp))
+    return np.concatenate(rows).astype(np.intp), np.concatenate(branches)
 
 
 @lru_cache(maxsize=16)

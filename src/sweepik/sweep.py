@@ -142,9 +142,6 @@ class Spans:
             np.concatenate([s.hi for s in parts]).astype(np.float64),
         )
 
-    def take(self, idx: IntArray | NDArray[np.bool_]) -> Spans:
-        return Spans(self.pose[idx], self.branch[idx], self.lo[idx], self.hi[idx])
-
     def __len__(self) -> int:
         return int(self.pose.size)
 
