@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .fastsweep import AVAILABLE
+from .solutions import joint_distance
 
 if TYPE_CHECKING:
     from .robot import Robot
@@ -95,9 +96,7 @@ def merged_multiplicity(
     kept = np.nonzero(keep)[0]
     for d in np.nonzero(~keep)[0]:
         k = kept[pose_idx[kept] == pose_idx[d]]
-        diff = w[k] - w[d]
-        diff = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - diff, 2.0 * np.pi)), np.abs(diff))
-        same = k[np.all(diff <= tol, axis=-1)]
+        same = k[np.all(joint_distance(robot, w[k], w[d]) <= tol, axis=-1)]
         if same.size:
             out[same[0]] += mult[d]
     return out
@@ -136,8 +135,7 @@ def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> N
 
 def _keep_pairwise(robot: Robot, q: Array, err: Array, rows: NDArray[np.intp], cols: NDArray[np.intp], tol: Array):
     """``(G, r)``: candidate ``rows[g, i]`` has no better equal among ``cols[g]`` (index -1: padding, never equal)."""
-    d = q[rows][:, :, None, :] - q[cols][:, None, :, :]
-    d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi)), np.abs(d))
+    d = joint_distance(robot, q[rows][:, :, None, :], q[cols][:, None, :, :])
     same = (
         np.all(d <= tol, axis=-1)
         & (rows[:, :, None] >= 0)

@@ -13,7 +13,7 @@ from . import fastcertify, fastsweep
 from .pose import pose_error_geodesic
 from .reductions import Reduction
 from .robot import Robot
-from .solutions import Family
+from .solutions import Family, joint_distance
 from .sweep import CLUSTER_FAMILY_REL, Spans
 from .units import orientation_weight
 
@@ -372,8 +372,7 @@ _MEMBER_TOL = 1e-6
 
 
 def _same_configuration(robot: Robot, a: Array, b: Array) -> NDArray[np.bool_]:
-    d = np.abs(a - b)
-    d = np.where(robot.is_revolute, np.abs(np.pi - np.mod(np.pi - (a - b), 2.0 * np.pi)), d)
+    d = joint_distance(robot, a, b)
     return np.asarray(np.all(d <= _MEMBER_TOL * np.maximum(1.0, np.abs(a)), axis=-1))
 
 

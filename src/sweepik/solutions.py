@@ -85,8 +85,7 @@ def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, fl
                 a, c, fc = c, e, fe
                 e = a + g * (b - a)
                 fe = dist(e)
-        t = c if fc <= fe else e
-        dt = dist(t)
+        t, dt = (c, fc) if fc <= fe else (e, fe)
         if dt < bd:
             best, bd = fam.at(t), dt
     return np.asarray(best, dtype=np.float64), bd

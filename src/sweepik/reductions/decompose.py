@@ -286,8 +286,8 @@ def _missing(robot: Robot) -> str:
         return f"robot {robot.name!r} has {robot.n_joints} joints: the decompositions solve 6-joint arms"
     st = robot.structure()
     head = f"robot {robot.name!r} ({st.describe()}) is outside sweepik's catalogue: "
-    found = [p for rev_chain, chain, s in _structures(robot) for p in _parallel_plans(robot, chain, rev_chain, s)]
-    if found:  # the UR family's closed form, refused for its continuum (_continuum_covered)
+    # the UR family's closed form, refused for its continuum (_continuum_covered)
+    if any(_parallel_plans(robot, chain, rev_chain, s) for rev_chain, chain, s in _structures(robot)):
         return head + (
             "axes 2-4 are parallel (the UR family), but joint 6's axis can turn parallel to them (its wrist has an "
             "offset): at joint 5 = 0 the solutions form a continuum that only a sweep can report, and no sweep fits "
