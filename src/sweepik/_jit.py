@@ -11,7 +11,7 @@ try:
 except ImportError:  # pragma: no cover - without numba the NumPy engine is used
     _njit = None
 
-__all__ = ["internal", "unowned"]
+__all__ = ["internal", "unowned", "function_at"]
 
 
 def internal(fn: Any) -> Any:
@@ -44,3 +44,35 @@ if _njit is not None:
             return ary._getvalue()
 
         return a(a), codegen
+
+
+def function_at(sig: Any) -> Any:
+    """An intrinsic for compiled code: ``function_at(sig)(address)`` is the compiled function of signature ``sig``
+    whose Numba entry point is at ``address`` (an int64, see ``reductions.kernels.address_of``), as a first-class
+    function value that compiled code calls like any other.
+
+    A kernel takes a reduction's function as its address rather than as a first-class function argument: Numba
+    unboxes a first-class argument through two Python calls on every call of the kernel (~4 us each time), and calls
+    it through its C wrapper; from the address it is called directly, with Numba's own calling convention. The address
+    must be that of a compiled function of exactly this signature that outlives the call (the dispatcher holds it).
+    """
+    if _njit is None:  # pragma: no cover
+        return None
+    fnty = types.FunctionType(sig)
+
+    @intrinsic
+    def at(typingctx: Any, address: Any) -> Any:
+        if not isinstance(address, types.Integer):
+            return None
+
+        def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+            fn = cgutils.create_struct_proxy(fnty)(context, builder)
+            voidptr = context.get_value_type(types.voidptr)
+            fn.c_addr = cgutils.get_null_value(voidptr)
+            fn.py_addr = cgutils.get_null_value(voidptr)
+            fn.jit_addr = builder.inttoptr(args[0], voidptr)
+            return fn._getvalue()
+
+        return fnty(address), codegen
+
+    return at

@@ -20,7 +20,7 @@ from ._jit import internal
 from .dedupe import limit_args
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
-from .reductions.kernels import first_class, lazy_njit, owned_kernel
+from .reductions.kernels import address_of, lazy_njit, owned_kernel
 from .units import orientation_weight
 
 if TYPE_CHECKING:
@@ -37,10 +37,10 @@ _MAX_FLOAT = float(np.finfo(np.float64).max)
 if AVAILABLE:
     from numba import float64, int64, types
 
-    from .reductions.kernels import CONFIGURATION_SIG, CONFIGURATIONS_SIG
+    from .reductions.kernels import as_configuration, as_configurations
 
-    _CFG = types.FunctionType(CONFIGURATION_SIG)
-    _CFGS = types.FunctionType(CONFIGURATIONS_SIG)
+    #: A reduction's configuration kernel (all-branch kernel: ``_CFGS``) enters as its address (``address_of``).
+    _CFG = _CFGS = int64
 
     @internal
     def _turn(r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, angle):
@@ -173,6 +173,7 @@ if AVAILABLE:
     def _certify(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper, start, stop):
         """Candidates ``start .. stop - 1``: the configuration of candidate k (pose ``pose[k]``) into ``q[k]``, its
         geodesic error and paper J (inf where the branch does not exist)."""
+        cfg = as_configuration(cfg)
         for k in range(start, stop):
             i = pose[k]
             cfg(params[i], theta[k], branch[k], q[k])
@@ -197,6 +198,7 @@ if AVAILABLE:
     def _certify_every_branch(cfgs, params, world, nb, H, P, rev, R_end, weight, q, err_geo, err_paper, start, stop):
         """Poses ``start .. stop - 1``: every branch's configuration at once (rows ``i nb .. i nb + nb - 1`` of
         ``q`` for pose i) and their errors."""
+        cfgs = as_configurations(cfgs)
         for i in range(start, stop):
             cfgs(params[i], 0.0, q[i * nb : (i + 1) * nb])
             for k in range(i * nb, (i + 1) * nb):
@@ -237,6 +239,7 @@ if AVAILABLE:
     ):
         """Cuts ``start .. stop - 1``: ``steps`` bisections of ``[a[k], b[k]]`` (``a`` a certified family member,
         ``b`` not), ``a`` and ``b`` updated in place."""
+        cfg = as_configuration(cfg)
         q = np.empty((1, H.shape[0]))
         eg = np.empty(1)
         ep = np.empty(1)
@@ -292,6 +295,7 @@ if AVAILABLE:
     ):
         """Dips ``start .. stop - 1``: the golden-section search of ``families._limit_dips`` run for all its steps,
         the best point and excess after each step's update into ``hist_x``, ``hist_e``."""
+        cfg = as_configuration(cfg)
         q = np.empty(jrev.shape[0])
         g = 0.5 * (math.sqrt(5.0) - 1.0)
         for k in range(start, stop):
@@ -333,7 +337,7 @@ def dip_search(robot, red, chain: Array, pose, branch, a: Array, b: Array, best_
         _dip_search,
         K,
         PARALLEL_MIN,
-        first_class(red.kernel[1]),
+        address_of(red.kernel[1]),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
         pose.astype(np.int64),
         branch.astype(np.int64),
@@ -477,7 +481,7 @@ def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Arra
         _bisect_members,
         a.size,
         PARALLEL_MIN,
-        first_class(red.kernel[1]),
+        address_of(red.kernel[1]),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
         _writable(world),
         *args,
@@ -493,7 +497,7 @@ def certify_every_branch(robot, red, chain: Array, world: Array, params: Array |
     with its all-branch configuration kernel (``owned_kernel(red, "kernel_configurations")``, which must exist):
     ``(q (N n_branches, n), geodesic errors, paper errors)``, as :func:`certify` gives them branch by branch."""
     N, nb = chain.shape[0], red.n_branches
-    cfgs = first_class(owned_kernel(red, "kernel_configurations"))
+    cfgs = address_of(owned_kernel(red, "kernel_configurations"))
     return _run(_certify_every_branch, N, 2 * PARALLEL_MIN, N * nb, robot, red, chain, world, params, cfgs, int(nb))
 
 
@@ -501,7 +505,7 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, 
     """Configurations ``(K, n)``, geodesic errors and paper errors ``(K,)`` of the candidates
     (inf errors where the branch does not exist)."""
     K = pose.shape[0]
-    cfg = first_class(red.kernel[1])
+    cfg = address_of(red.kernel[1])
     ids = (pose.astype(np.int64), theta.astype(np.float64), branch.astype(np.int64))
     return _run(_certify, K, 16 * PARALLEL_MIN, K, robot, red, chain, world, params, cfg, *ids)
 
@@ -533,6 +537,7 @@ if AVAILABLE:
 
     @lazy_njit((_CFG, float64[:, ::1], int64[::1], float64[::1], int64[::1], float64[:, ::1]), cache=True)
     def _configurations(cfg, params, pose, theta, branch, q):
+        cfg = as_configuration(cfg)
         for k in range(pose.shape[0]):
             cfg(params[pose[k]], theta[k], branch[k], q[k])
 
@@ -543,7 +548,7 @@ def configurations(robot: Robot, red: Reduction, chain: Array, pose: IntArray, t
     q = np.empty((pose.shape[0], robot.n_joints))
     assert red.kernel is not None  # callers check red.uses_kernel
     _configurations(
-        first_class(red.kernel[1]),
+        address_of(red.kernel[1]),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
         pose.astype(np.int64),
         theta.astype(np.float64),

@@ -9,8 +9,8 @@ search is a few hundred scalar residual evaluations, which compiled code does in
 
 A kernel is ``residual(params, theta, branch) -> float`` compiled with ``numba.njit`` to the signature
 ``reductions.kernels.RESIDUAL_SIG``, where ``params`` is one row of ``Reduction.kernel_params(poses)``; the
-engine takes it as a first-class function (``Reduction.kernel[0]``), so one compiled engine serves every
-reduction.
+engine takes it by the address of its compiled code (``Reduction.kernel[0]``, ``kernels.address_of``), so one
+compiled engine serves every reduction.
 
 The constants below are frozen into the compiled code, and Numba's on-disk cache is keyed on this file's time
 stamp only: after changing one of them in :mod:`sweepik.sweep`, touch this file (or delete its ``*.nbi`` cache).
@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from . import parallel
 from . import sweep as _ref
 from ._jit import internal, unowned
-from .reductions.kernels import first_class, lazy_njit, owned_kernel
+from .reductions.kernels import address_of, lazy_njit, owned_kernel
 from .robot import Robot
 
 try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
@@ -411,13 +411,13 @@ if AVAILABLE:
 
     from numba import float64, int64, types
 
-    from .reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG
+    from .reductions.kernels import RESIDUALS_SIG, as_residual, as_residuals
 
-    #: The engine's entry signature: the residual is a first-class function, so the engine is compiled once
-    #: (and cached) for every reduction.
+    #: The engine's entry signature: the residual enters as the address of a compiled function
+    #: (``kernels.address_of``), so the engine is compiled once (and cached) for every reduction.
     _SEARCH_SIG = (
-        types.FunctionType(RESIDUAL_SIG),
-        types.FunctionType(RESIDUALS_SIG),
+        int64,
+        int64,
         int64,
         float64[:, ::1],
         float64[:, ::1],
@@ -444,6 +444,7 @@ if AVAILABLE:
 
         One function, not a loop calling a function per pose: Numba re-optimises everything a compiled function calls
         when it compiles the caller, and each level costs seconds on a fresh install."""
+        res, res_all = as_residual(res), as_residuals(res_all)
         # the arguments as views Numba does not reference-count: each kernel call would count them up and down
         params, grid, out_t, out_b, out_m = (
             unowned(params),
@@ -682,8 +683,8 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         _search,
         N,
         PARALLEL_MIN,
-        first_class(reduction.kernel[0]),
-        first_class(_no_residuals if res_all is None else res_all),
+        address_of(reduction.kernel[0]),
+        address_of(_no_residuals if res_all is None else res_all),
         0 if res_all is None else reduction.n_branches,
         params,
         np.ascontiguousarray(theta),

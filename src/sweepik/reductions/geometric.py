@@ -49,7 +49,10 @@ from .kernels import (
     RESIDUAL_SIG,
     RESIDUALS_SIG,
     LazyKernel,
-    first_class,
+    address_of,
+    as_configuration,
+    as_residual,
+    as_residuals,
     lazy_njit,
 )
 from .position import BOTH, NEITHER, angle, motion, place, reduce_chain
@@ -389,10 +392,11 @@ SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 @njit(cache=True, nogil=True)
 def _swing(amp, amps, params, lo, hi, n, periodic, ks, out, start, stop):
-    """Swing hints of poses ``start .. stop - 1`` (``swing_hints``). ``amp``: ``amplitude`` as a first-class
-    function (called, not linked in: Numba re-optimises everything a compiled function links, and the amplitude
-    links the whole position case), ``amps`` every step's at once (``amplitudes``, for the scan's samples); one
-    function rather than a loop calling a per-pose one, for the same reason."""
+    """Swing hints of poses ``start .. stop - 1`` (``swing_hints``). ``amp``: the address of ``amplitude``
+    (``kernels.address_of``: called, not linked in: Numba re-optimises everything a compiled function links, and the
+    amplitude links the whole position case), ``amps`` every step's at once (``amplitudes``, for the scan's samples);
+    one function rather than a loop calling a per-pose one, for the same reason."""
+    amp, amps = as_residual(amp), as_residuals(amps)
     scan = np.empty((n + 3, 3))  # the amplitudes at lo - h, lo, lo + h, ..., lo + (n + 1) h
     vals = np.empty(3)
     for i in range(start, stop):
@@ -462,8 +466,8 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
         _swing,
         params.shape[0],
         PARALLEL_MIN,
-        first_class(amplitude),
-        first_class(amplitudes),
+        address_of(amplitude),
+        address_of(amplitudes),
         params,
         lo,
         hi,
@@ -479,10 +483,10 @@ parallel_configuration = LazyKernel(_parallel_configuration, CONFIGURATION_SIG, 
 parallel_configurations = LazyKernel(_parallel_configurations, CONFIGURATIONS_SIG, cache=True)
 
 
-# Kernels enter as first-class functions (``kernels.first_class``) through an explicit signature: compiled once
-# and cached (a dispatcher argument would be typed, compiled and appended to the cache anew in every process).
+# Kernels enter as addresses (``kernels.address_of``) through an explicit signature: compiled once and cached (a
+# dispatcher argument would be typed, compiled and appended to the cache anew in every process).
 _EVALUATE_SIG = (
-    types.FunctionType(RESIDUAL_SIG),
+    int64,
     float64[:, ::1],
     int64[::1],
     float64[::1],
@@ -490,7 +494,7 @@ _EVALUATE_SIG = (
     float64[::1],
 )
 _CONFIGURE_SIG = (
-    types.FunctionType(CONFIGURATION_SIG),
+    int64,
     float64[:, ::1],
     int64[::1],
     float64[::1],
@@ -501,24 +505,26 @@ _CONFIGURE_SIG = (
 
 @lazy_njit(_EVALUATE_SIG, cache=True)
 def _evaluate(res, params, pose, theta, branch, out):
+    res = as_residual(res)
     for k in range(pose.shape[0]):
         out[k] = res(params[pose[k]], theta[k], branch[k])
 
 
 @lazy_njit(_CONFIGURE_SIG, cache=True)
 def _configure(cfg, params, pose, theta, branch, out):
+    cfg = as_configuration(cfg)
     for k in range(pose.shape[0]):
         cfg(params[pose[k]], theta[k], branch[k], out[k])
 
 
 def evaluate(res, params, pose, theta, branch, out):
     """``out[k] = res(params[pose[k]], theta[k], branch[k])`` (vectorised residual for the NumPy engine)."""
-    _evaluate(first_class(res), params, pose, theta, branch, out)
+    _evaluate(address_of(res), params, pose, theta, branch, out)
 
 
 def configure(cfg, params, pose, theta, branch, out):
     """``cfg(params[pose[k]], theta[k], branch[k], out[k])`` for every k."""
-    _configure(first_class(cfg), params, pose, theta, branch, out)
+    _configure(address_of(cfg), params, pose, theta, branch, out)
 
 
 #: A closed form's wrist is singular (joint 6's target axis along joint 4's, or along the parallel axes: a continuum

@@ -3,7 +3,7 @@
 A reduction's kernel is a pair of compiled functions with fixed signatures (``RESIDUAL_SIG``,
 ``CONFIGURATION_SIG``): ``residual(params, theta, branch) -> float`` and ``configuration(params, theta, branch,
 out)``, where ``params`` is one row of ``Reduction.kernel_params(poses)``. The engine receives them as
-first-class functions, so it is compiled once for every reduction. These two compute exactly what
+addresses of compiled code (``address_of``), so it is compiled once for every reduction. These two compute exactly what
 ``CArmD1``/``CArmTheta2`` compute vectorised (``residual``, ``solve_rest``), for one pose, theta* and branch.
 """
 
@@ -125,7 +125,7 @@ class LazyKernel:
     """A Numba function with one explicit signature, compiled (or loaded from the disk cache) on first use instead
     of at import: a process loads only the kernels its arms need (each takes 10-100 ms to load from the cache).
 
-    Call it like the compiled function; :func:`first_class` takes it like a dispatcher. Only for functions called
+    Call it like the compiled function; :func:`address_of` takes it like a dispatcher. Only for functions called
     from Python (compiled code needs the dispatcher itself). ``fn`` may be a dispatcher that compiled code calls too:
     the kernel is then that dispatcher's overload for ``sig`` (compiled once, not a second time by a dispatcher of
     its own), and ``options`` are that dispatcher's.
@@ -193,40 +193,38 @@ def owned_kernel(reduction: Any, name: str) -> Any:
     return vars(reduction).get(name, vars(owner)[name])
 
 
-_FIRST_CLASS: dict[Any, Any] = {}
+_ADDRESSES: dict[Any, int] = {}
 
 
-def first_class(fn: Any) -> Any:
-    """``fn`` (compiled with exactly one explicit signature) as a first-class function object for the engine.
-
-    Numba types a dispatcher argument anew on every call (~50 us); this object carries its type
-    (``_numba_type_``) and the address of the compiled function (``__wrapper_address__``). One per function.
-    """
-    wap = _FIRST_CLASS.get(fn)
-    if wap is None:
-        from numba import types
-
+def address_of(fn: Any) -> int:
+    """The address of ``fn``'s compiled entry point (``fn`` compiled with exactly one explicit signature: a
+    :class:`LazyKernel` or a dispatcher), for an engine kernel to call it through ``as_residual`` & co.
+    (``_jit.function_at``): an int costs nothing to pass, where a first-class function argument costs two Python
+    calls per kernel call. Compiles ``fn`` (or loads it from the cache) on first use; one lookup per function."""
+    address = _ADDRESSES.get(fn)
+    if address is None:
         if isinstance(fn, LazyKernel):
             disp, sig = fn.dispatcher, fn.signature
         else:
             disp = fn
             (sig,) = disp.nopython_signatures
         cres = disp.overloads[sig.args]
-        address = cres.library.get_pointer_to_function(cres.fndesc.llvm_cfunc_wrapper_name)
+        address = _ADDRESSES[fn] = int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+    return address
 
-        class _Kernel:
-            # the wrapper address protocol, without subclassing numba's class: typeof() then reads the type from
-            # _numba_type_ (made once) instead of building a FunctionType on every call (~50 us each)
-            _numba_type_ = types.FunctionType(sig)
 
-            def __wrapper_address__(self) -> int:
-                return int(address)
+as_residual: Any = None
+as_residuals: Any = None
+as_configuration: Any = None
+as_configurations: Any = None
+if _njit is not None:
+    from .._jit import function_at
 
-            def signature(self) -> Any:
-                return sig
-
-        wap = _FIRST_CLASS[fn] = _Kernel()
-    return wap
+    #: In compiled code, the function at an address (``address_of``) of each kernel signature.
+    as_residual = function_at(RESIDUAL_SIG)
+    as_residuals = function_at(RESIDUALS_SIG)
+    as_configuration = function_at(CONFIGURATION_SIG)
+    as_configurations = function_at(CONFIGURATIONS_SIG)
 
 
 def _carm_configuration(p, x: float, b: int, out, rail: bool) -> None:
