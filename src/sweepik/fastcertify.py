@@ -121,8 +121,10 @@ if AVAILABLE:
         return _wrap(alpha), beta, _wrap(gamma)
 
     @internal
-    def _errors(T, Td, weight):
-        """(geodesic error, paper J) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``."""
+    def _errors(T, Td, weight, zd):
+        """(geodesic error, paper J) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``. ``zd (4,)``:
+        the Z-Y-Z angles of ``Td`` once computed (``zd[1:]``, when ``zd[0]`` is 1; set here when needed, so that
+        candidates of one target compute them once: the caller sets ``zd[0] = 0`` for a new target)."""
         r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
         dp = math.sqrt((px - Td[0, 3]) ** 2 + (py - Td[1, 3]) ** 2 + (pz - Td[2, 3]) ** 2)
         # geodesic: angle of M = Td^T R (only its trace and skew part are needed)
@@ -141,7 +143,12 @@ if AVAILABLE:
         if geo > J_CUTOFF_FACTOR * weight:  # far from a solution: the paper's J is not needed
             return geo, np.inf
         a, b, g = _zyz(r00, r01, r02, r10, r11, r12, r20, r21, r22)
-        ad, bd, gd = _zyz(Td[0, 0], Td[0, 1], Td[0, 2], Td[1, 0], Td[1, 1], Td[1, 2], Td[2, 0], Td[2, 1], Td[2, 2])
+        if zd[0] == 0.0:
+            zd[1], zd[2], zd[3] = _zyz(
+                Td[0, 0], Td[0, 1], Td[0, 2], Td[1, 0], Td[1, 1], Td[1, 2], Td[2, 0], Td[2, 1], Td[2, 2]
+            )
+            zd[0] = 1.0
+        ad, bd, gd = zd[1], zd[2], zd[3]
         da, db, dg = _wrap(a - ad), b - bd, _wrap(g - gd)
         if b < GIMBAL_TOL or bd < GIMBAL_TOL:
             da, dg = 0.0, _wrap((a + g) - (ad + gd))
@@ -174,19 +181,24 @@ if AVAILABLE:
         """Candidates ``start .. stop - 1``: the configuration of candidate k (pose ``pose[k]``) into ``q[k]``, its
         geodesic error and paper J (inf where the branch does not exist)."""
         cfg = as_configuration(cfg)
+        zd = np.empty(4)
+        last = -1
         for k in range(start, stop):
             i = pose[k]
+            if i != last:  # (a pose's candidates are consecutive)
+                zd[0], last = 0.0, i
             cfg(params[i], theta[k], branch[k], q[k])
-            _certify_row(H, P, rev, R_end, weight, q, world[i], k, err_geo, err_paper)
+            _certify_row(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper)
 
     @internal
-    def _certify_row(H, P, rev, R_end, weight, q, Td, k, err_geo, err_paper):
-        """Errors of candidate ``k`` (configuration ``q[k]``, target ``Td``): inf where the branch does not exist."""
+    def _certify_row(H, P, rev, R_end, weight, q, Td, zd, k, err_geo, err_paper):
+        """Errors of candidate ``k`` (configuration ``q[k]``, target ``Td`` with its angles ``zd``, see ``_errors``):
+        inf where the branch does not exist."""
         for j in range(q.shape[1]):
             if not math.isfinite(q[k, j]):
                 err_geo[k], err_paper[k] = np.inf, np.inf
                 return
-        err_geo[k], err_paper[k] = _errors(_poe_fk(H, P, rev, R_end, q[k]), Td, weight)
+        err_geo[k], err_paper[k] = _errors(_poe_fk(H, P, rev, R_end, q[k]), Td, weight, zd)
 
     @lazy_njit(
         (_CFGS, float64[:, ::1], float64[:, :, ::1], int64)
@@ -199,10 +211,12 @@ if AVAILABLE:
         """Poses ``start .. stop - 1``: every branch's configuration at once (rows ``i nb .. i nb + nb - 1`` of
         ``q`` for pose i) and their errors."""
         cfgs = as_configurations(cfgs)
+        zd = np.empty(4)
         for i in range(start, stop):
             cfgs(params[i], 0.0, q[i * nb : (i + 1) * nb])
+            zd[0] = 0.0
             for k in range(i * nb, (i + 1) * nb):
-                _certify_row(H, P, rev, R_end, weight, q, world[i], k, err_geo, err_paper)
+                _certify_row(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper)
 
     from .dedupe import wrap_inside_row
 
@@ -243,12 +257,14 @@ if AVAILABLE:
         q = np.empty((1, H.shape[0]))
         eg = np.empty(1)
         ep = np.empty(1)
+        zd = np.empty(4)
         for k in range(start, stop):
             i = pose[k]
+            zd[0] = 0.0
             for _ in range(steps):
                 mid = 0.5 * (a[k] + b[k])
                 cfg(params[i], mid, branch[k], q[0])
-                _certify_row(H, P, rev, R_end, weight, q, world[i], 0, eg, ep)
+                _certify_row(H, P, rev, R_end, weight, q, world[i], zd, 0, eg, ep)
                 on = eg[0] <= tol  # (inf where the member does not exist)
                 if on and limits:
                     on = wrap_inside_row(q[0], jrev, lower, upper, ltol, beyond)
@@ -373,11 +389,13 @@ if AVAILABLE:
     def _tool_poses(H, P, rev, R_end, q, target, weight, out, err, start, stop):
         """Rows ``start .. stop - 1``: the world tool pose of ``q[k]`` into ``out[k]`` and (``target`` non-empty)
         its geodesic error to ``target[k]`` into ``err[k]``."""
+        zd = np.empty(4)
         for k in range(start, stop):
             T = _poe_fk(H, P, rev, R_end, q[k])
             _put_pose(T, out[k])
             if target.shape[0]:
-                err[k] = _errors(T, target[k], weight)[0]
+                zd[0] = 0.0
+                err[k] = _errors(T, target[k], weight, zd)[0]
 
     @lazy_njit(
         (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64[:, ::1], float64[:, :, ::1])
