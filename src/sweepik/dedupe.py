@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 
-__all__ = ["finish", "wrap_inside", "limit_args", "merged_multiplicity", "DEDUPE_ANGLE", "DEDUPE_LENGTH_REL"]
+__all__ = ["finish", "settle", "wrap_inside", "limit_args", "merged_multiplicity", "DEDUPE_ANGLE", "DEDUPE_LENGTH_REL"]
 
 #: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
 DEDUPE_ANGLE = 1e-6
@@ -82,6 +82,56 @@ def finish(
     keep = np.empty(q.shape[0], dtype=np.bool_)
     _dedupe_compiled(pose_idx.astype(np.int64), w, score, limit_args(robot)[0], _tolerance(robot), keep)
     return w, inside, keep
+
+
+def settle(
+    robot: Robot,
+    q: Array,
+    err_geo: Array,
+    err_paper: Array,
+    pose_idx: NDArray[np.intp],
+    thresholds: tuple[float, float, float, float],
+    reach: Array,
+) -> tuple[NDArray[np.intp], Array, NDArray[np.bool_], NDArray[np.bool_]] | None:
+    """The solver's steps from candidates to final ones, in one compiled pass, for a chunk where none of its rarer
+    steps is due: ``(rows, w, inside, keep)``, the certified rows of ``q`` (finite, ``err_geo`` within the
+    acceptance) with ``finish``'s wrapped configurations, limit check and duplicate mask, the same values the
+    solver's NumPy steps give. None when a candidate is due a polish (``err_geo`` at most ``thresholds[0]`` and
+    above ``thresholds[1]``, or ``err_paper`` above ``thresholds[2]``), when a certified one lies outside the limits
+    by at most ``reach`` (per joint: the solver tries it at the limit), or without Numba. ``thresholds``: (polish
+    below, polish above, polish above on the paper's J, acceptance), absolute."""
+    if not AVAILABLE:
+        return None
+    K = q.shape[0]
+    rows = np.empty(K, dtype=np.int64)
+    w = np.empty((K, robot.n_joints))
+    score = np.empty(K)
+    inside = np.empty(K, dtype=np.bool_)
+    keep = np.empty(K, dtype=np.bool_)
+    rev, lower, upper, ltol, beyond = limit_args(robot)
+    c = _settle(
+        np.ascontiguousarray(q, dtype=np.float64),
+        np.ascontiguousarray(err_geo, dtype=np.float64),
+        np.ascontiguousarray(err_paper, dtype=np.float64),
+        pose_idx.astype(np.int64),
+        np.array(thresholds, dtype=np.float64),
+        rev,
+        lower,
+        upper,
+        ltol,
+        beyond,
+        reach,
+        _tolerance(robot),
+        float(robot.length_scale),
+        rows,
+        w,
+        score,
+        inside,
+        keep,
+    )
+    if c < 0:
+        return None
+    return rows[:c].astype(np.intp), w[:c], inside[:c], keep[:c]
 
 
 def merged_multiplicity(
@@ -216,6 +266,11 @@ if AVAILABLE:
 
     @lazy_njit((int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True)
     def _dedupe_compiled(pose, q, score, rev, tol, keep):  # pragma: no cover
+        _dedupe_rows(pose, q, score, rev, tol, keep)
+
+    @internal
+    def _dedupe_rows(pose, q, score, rev, tol, keep):  # pragma: no cover
+        """Step 3 (``keep``) for candidates ``q`` (wrapped) of poses ``pose`` with scores ``score``."""
         K, n = q.shape
         two_pi = 2.0 * math.pi
         for k in range(K):
@@ -244,3 +299,47 @@ if AVAILABLE:
                         keep[i] = False
                         break
             start = stop
+
+    @lazy_njit(
+        (float64[:, ::1], float64[::1], float64[::1], int64[::1], float64[::1], boolean[::1], float64[::1])
+        + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, int64[::1], float64[:, ::1])
+        + (float64[::1], boolean[::1], boolean[::1]),
+        cache=True,
+    )
+    def _settle(
+        q, eg, ep, pose, thr, rev, lower, upper, ltol, beyond, reach, tol, length_scale, idx, w, score, inside, keep
+    ):  # pragma: no cover
+        """``settle``'s kernel: 0 and the certified rows (``idx``, their wrapped configurations ``w``, ``score``,
+        ``inside``, ``keep``; their count is returned) when no row needs the solver's rarer steps, else -1."""
+        polish_below, polish_above, polish_paper_above, accept = thr[0], thr[1], thr[2], thr[3]
+        K, n = q.shape
+        c = 0
+        for k in range(K):
+            finite = True
+            for j in range(n):
+                if not math.isfinite(q[k, j]):
+                    finite = False
+            if not finite:
+                continue
+            e = eg[k]
+            if e <= polish_below and (e > polish_above or ep[k] > polish_paper_above):
+                return -1  # a Newton polish (or, failing it, the fallback reduction) is due
+            if not e <= accept:
+                continue
+            for j in range(n):
+                w[c, j] = q[k, j]
+            ok = wrap_inside_row(w[c], rev, lower, upper, ltol, beyond)
+            if not ok:
+                near = True  # within reach of the limits: the solver tries it at the limit
+                for j in range(n):
+                    over = max((lower[j] - ltol[j]) - w[c, j], (w[c, j] - upper[j]) - ltol[j])
+                    if not over <= reach[j]:
+                        near = False
+                        break
+                if near:
+                    return -1
+            idx[c], inside[c] = k, ok
+            score[c] = e if ok else e + length_scale
+            c += 1
+        _dedupe_rows(pose[idx[:c]], w[:c], score[:c], rev, tol, keep[:c])
+        return c

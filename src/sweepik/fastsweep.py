@@ -409,7 +409,7 @@ if AVAILABLE:
     _U_UNIFORM_ARR = _U_UNIFORM.copy()
     _U_EDGE_ARR = _U_EDGE.copy()
 
-    from numba import float64, int64, types
+    from numba import float64, int64
 
     from .reductions.kernels import RESIDUALS_SIG, as_residual, as_residuals
 

@@ -7,6 +7,7 @@ configurations -> FK check against the target -> joint limits -> duplicates remo
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Iterator, Mapping
 from functools import lru_cache
 from typing import Any, Literal
@@ -17,9 +18,9 @@ from numpy.typing import ArrayLike, NDArray
 from . import fastcertify, fastsweep
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch
-from .dedupe import finish, merged_multiplicity, wrap_inside
+from .dedupe import finish, merged_multiplicity, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
-from .families import collapse_continua, families_of, off_families, unique_families
+from .families import MAX_ISOLATED_SOLUTIONS, collapse_continua, families_of, off_families, unique_families
 from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
 from .polish import polish
@@ -82,8 +83,11 @@ def _theta_range(robot: Robot, red: Reduction, chain: Array, paper_limits: bool 
         lo, hi = rng[:, 0], rng[:, 1]
     else:
         lo, hi = np.full(n, robot.lower[j]), np.full(n, robot.upper[j])
-    with np.errstate(invalid="ignore", over="ignore"):
-        finite = np.isfinite(hi - lo).all()  # (lo and hi finite, and their difference too)
+    if n == 1:  # (Python floats: no NumPy error state to set for one pose)
+        finite = math.isfinite(float(hi[0]) - float(lo[0]))
+    else:
+        with np.errstate(invalid="ignore", over="ignore"):
+            finite = bool(np.isfinite(hi - lo).all())  # (lo and hi finite, and their difference too)
     if not finite:
         raise ShapeError(f"joint {robot.joint_names[j]} (theta*) needs finite limits to be swept")
     return lo, hi
@@ -124,6 +128,12 @@ SNAP_REACH = 1e-4
 SNAP_ITERATIONS = 4
 
 
+@lru_cache(maxsize=64)
+def _snap_reach(robot: Robot) -> Array:
+    """``SNAP_REACH`` per joint (times the length scale for a prismatic one)."""
+    return np.where(robot.is_revolute, SNAP_REACH, SNAP_REACH * robot.length_scale)
+
+
 def _snap_to_limits(
     robot: Robot, q: Array, err_geo: Array, err_paper: Array, poses: Array, pose_idx: NDArray[np.intp], weight: float
 ) -> tuple[Array, NDArray[np.bool_]]:
@@ -135,9 +145,8 @@ def _snap_to_limits(
     if out.size == 0:
         return w_all, inside
     w = w_all[out]
-    reach = np.where(robot.is_revolute, SNAP_REACH, SNAP_REACH * robot.length_scale)
     over = np.maximum(robot.lower - robot.limit_tol - w, w - robot.upper - robot.limit_tol)
-    near = np.all(over <= reach, axis=-1)
+    near = np.all(over <= _snap_reach(robot), axis=-1)
     k, w, over = out[near], w[near], over[near]
     if k.size == 0:
         return w_all, inside
@@ -272,6 +281,153 @@ def _solve_chunk(
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
         mult = np.ones(pose_idx.size, dtype=np.intp)
         fams = {}
+    settled = None
+    if strategy == "precise" and err_geo is not None and err_paper is not None:
+        # the common case in one compiled pass (None when a candidate needs polishing, the fallback or a limit snap)
+        ls = robot.length_scale
+        bounds = (POLISH_BELOW_REL * ls, POLISH_ABOVE_REL * ls, POLISH_PAPER_ABOVE_REL * ls, ACCEPT_TOL_REL * ls)
+        settled = settle(robot, q, err_geo, err_paper, pose_idx, bounds, _snap_reach(robot))
+        if settled is not None:
+            rows, q, inside, keep = settled
+            pose_idx, err_paper, err_geo, mult = pose_idx[rows], err_paper[rows], err_geo[rows], mult[rows]
+    if settled is None:
+        pose_idx, q, err_paper, err_geo, mult, inside, keep = _settle_stepwise(
+            robot, red, poses, strategy, limits, n_samples, use_fallback, pose_idx, q, mult, err_geo, err_paper
+        )
+    assert err_geo is not None and err_paper is not None  # (both paths set them)
+    if closed and not keep.all():  # branches of the closed form that meet: one solution, a multiple root
+        mult = merged_multiplicity(robot, pose_idx, q, keep, mult)
+    if strategy == "precise" and pose_idx.size > MAX_ISOLATED_SOLUTIONS:  # (fewer: no pose can hold a continuum)
+        # a numerical continuum of certified solutions is reported once
+        keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
+    n_reachable = np.bincount(pose_idx[keep], minlength=len(poses))
+    if limits:
+        keep &= inside
+    pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
+    mult = mult[keep]
+    fallback: dict[int, Solutions] = {}
+    if strategy == "precise" and use_fallback and red.fallback is not None:
+        deg = red.degenerate(chain)
+        if deg is not None and deg.any():
+            idx = np.nonzero(deg)[0]
+            alt = _solve_chunk(
+                robot, get_reduction(robot, red.fallback), poses[idx], strategy, limits, n_samples, False
+            )
+            if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
+                fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx)}
+            else:  # the reduction's blind spot: the fallback's families
+                fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)}
+    # poses with families (few): their isolated solutions lying on a family are reported by the family; the
+    # reduction's blind spot: the fallback reduction's families are added, and its isolated solutions when this
+    # reduction has none (a closed form: always)
+    families: dict[int, tuple[Family, ...]] = {}
+    if fams or fallback:
+        families, pose_idx, q, err_paper, err_geo, inside, mult = _with_families(
+            robot, red, fams, fallback, pose_idx, q, err_paper, err_geo, inside, mult
+        )
+    # (already in pose order, as a closed form's candidates and most sweeps' are -- one pose's always: no
+    # reordering copies)
+    in_order = len(poses) == 1 or bool(np.all(pose_idx[1:] >= pose_idx[:-1]))
+    order = slice(None) if in_order else np.argsort(pose_idx, kind="stable")
+    empty_reason = None
+    if strategy == "paper" and not red.closed_form:  # its final resolution decides nothing about reachability
+        step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"
+        empty_reason = (
+            f"no solution with J < 1e-5 mm found by the paper's strategy (its final {step} step "
+            "misses roots off its grid); strategy='precise' finds every solution"
+        )
+    return Block(
+        robot=robot,
+        poses=poses.copy(),
+        bounds=(
+            np.array([0, pose_idx.size], dtype=np.intp)
+            if len(poses) == 1
+            else np.searchsorted(pose_idx[order], np.arange(len(poses) + 1)).astype(np.intp)
+        ),
+        q=q[order],
+        error=err_paper[order],
+        error_geodesic=err_geo[order],
+        within_limits=inside[order],
+        multiplicity=mult[order].astype(np.intp),
+        families=families,
+        n_reachable=n_reachable.astype(np.intp),
+        empty_reason=empty_reason,
+    )
+
+
+def _with_families(
+    robot: Robot,
+    red: Reduction,
+    fams: dict[int, list[Family]],
+    fallback: dict[int, Solutions],
+    pose_idx: NDArray[np.intp],
+    q: Array,
+    err_paper: Array,
+    err_geo: Array,
+    inside: NDArray[np.bool_],
+    mult: NDArray[np.intp],
+) -> tuple[dict[int, tuple[Family, ...]], NDArray[np.intp], Array, Array, Array, NDArray[np.bool_], NDArray[np.intp]]:
+    """The families of the poses that have some (``fams``, and the fallback reduction's, ``fallback``), and the
+    solutions with those on a family dropped and the fallback's added: ``(families, pose_idx, q, err_paper,
+    err_geo, inside, mult)``."""
+    families: dict[int, tuple[Family, ...]] = {}
+    keep = np.ones(pose_idx.size, dtype=bool)
+    extra: list[tuple[int, Solutions, NDArray[np.bool_]]] = []
+    checks: list[tuple[Array, tuple[Family, ...]]] = []  # (configurations, families) of each pose, checked at once
+    targets: list[tuple[int, Solutions | None, NDArray[np.intp]]] = []
+    for i in sorted(set(fams) | set(fallback)):
+        fam = tuple(fams.get(i, ()))
+        other = fallback.get(i)
+        if other is not None:
+            fam = unique_families(fam + other.families)
+        families[i] = fam
+        rows = np.nonzero(pose_idx == i)[0]
+        if other is not None and (rows.size == 0 or red.closed_form):
+            keep[rows] = False
+            checks.append((other.q, fam))
+            targets.append((i, other, rows))
+        else:
+            checks.append((q[rows], fam))
+            targets.append((i, None, rows))
+    for (i, other, rows), off in zip(targets, off_families(robot, checks), strict=True):
+        if other is None:
+            keep[rows] = off
+        else:
+            extra.append((i, other, off))
+    if extra or not keep.all():
+        p_parts, q_parts, e_parts = [pose_idx[keep]], [q[keep]], [err_paper[keep]]
+        g_parts, in_parts, m_parts = [err_geo[keep]], [inside[keep]], [mult[keep]]
+        for i, other, k in extra:
+            p_parts.append(np.full(int(k.sum()), i, dtype=pose_idx.dtype))
+            q_parts.append(other.q[k])
+            e_parts.append(other.error[k])
+            g_parts.append(other.error_geodesic[k])
+            in_parts.append(other.within_limits[k])
+            m_parts.append(other.multiplicity[k])
+        pose_idx, q, err_paper = np.concatenate(p_parts), np.concatenate(q_parts), np.concatenate(e_parts)
+        err_geo, inside, mult = np.concatenate(g_parts), np.concatenate(in_parts), np.concatenate(m_parts)
+    return families, pose_idx, q, err_paper, err_geo, inside, mult
+
+
+def _settle_stepwise(
+    robot: Robot,
+    red: Reduction,
+    poses: Array,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    use_fallback: bool,
+    pose_idx: NDArray[np.intp],
+    q: Array,
+    mult: NDArray[np.intp],
+    err_geo: Array | None,
+    err_paper: Array | None,
+) -> tuple[NDArray[np.intp], Array, Array, Array, NDArray[np.intp], NDArray[np.bool_], NDArray[np.bool_]]:
+    """Candidates to certified, wrapped ones with ``finish``'s limit check and duplicate mask, step by step: the
+    polish of near misses, the certification, the fallback reduction for poses it could not certify, the snap of
+    solutions just outside the limits (``dedupe.settle`` does the same in one compiled pass when none of these is
+    due). Returns ``(pose_idx, q, err_paper, err_geo, mult, inside, keep)``."""
+    weight = orientation_weight(robot.length_unit)
     finite = np.isfinite(q).all(axis=-1)
     if not finite.all():
         pose_idx, q, mult = pose_idx[finite], q[finite], mult[finite]
@@ -329,94 +485,7 @@ def _solve_chunk(
     # duplicates first (of twins, the one inside the limits is kept), so that limits=True is exactly
     # limits=False filtered by the limits
     q, inside, keep = finish(robot, pose_idx, q, err_geo, wrapped)
-    if closed and not keep.all():  # branches of the closed form that meet: one solution, a multiple root
-        mult = merged_multiplicity(robot, pose_idx, q, keep, mult)
-    if strategy == "precise":  # a numerical continuum of certified solutions is reported once
-        keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
-    n_reachable = np.bincount(pose_idx[keep], minlength=len(poses))
-    if limits:
-        keep &= inside
-    pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
-    mult = mult[keep]
-    fallback: dict[int, Solutions] = {}
-    if strategy == "precise" and use_fallback and red.fallback is not None:
-        deg = red.degenerate(chain)
-        if deg is not None and deg.any():
-            idx = np.nonzero(deg)[0]
-            alt = _solve_chunk(
-                robot, get_reduction(robot, red.fallback), poses[idx], strategy, limits, n_samples, False
-            )
-            if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
-                fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx)}
-            else:  # the reduction's blind spot: the fallback's families
-                fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)}
-    # poses with families (few): their isolated solutions lying on a family are reported by the family; the
-    # reduction's blind spot: the fallback reduction's families are added, and its isolated solutions when this
-    # reduction has none (a closed form: always)
-    families: dict[int, tuple[Family, ...]] = {}
-    keep = np.ones(pose_idx.size, dtype=bool)
-    extra: list[tuple[int, Solutions, NDArray[np.bool_]]] = []
-    checks: list[tuple[Array, tuple[Family, ...]]] = []  # (configurations, families) of each pose, checked at once
-    targets: list[tuple[int, Solutions | None, NDArray[np.intp]]] = []
-    for i in sorted(set(fams) | set(fallback)):
-        fam = tuple(fams.get(i, ()))
-        other = fallback.get(i)
-        if other is not None:
-            fam = unique_families(fam + other.families)
-        families[i] = fam
-        rows = np.nonzero(pose_idx == i)[0]
-        if other is not None and (rows.size == 0 or red.closed_form):
-            keep[rows] = False
-            checks.append((other.q, fam))
-            targets.append((i, other, rows))
-        else:
-            checks.append((q[rows], fam))
-            targets.append((i, None, rows))
-    for (i, other, rows), off in zip(targets, off_families(robot, checks), strict=True):
-        if other is None:
-            keep[rows] = off
-        else:
-            extra.append((i, other, off))
-    if extra or not keep.all():
-        p_parts, q_parts, e_parts = [pose_idx[keep]], [q[keep]], [err_paper[keep]]
-        g_parts, in_parts, m_parts = [err_geo[keep]], [inside[keep]], [mult[keep]]
-        for i, other, k in extra:
-            p_parts.append(np.full(int(k.sum()), i, dtype=pose_idx.dtype))
-            q_parts.append(other.q[k])
-            e_parts.append(other.error[k])
-            g_parts.append(other.error_geodesic[k])
-            in_parts.append(other.within_limits[k])
-            m_parts.append(other.multiplicity[k])
-        pose_idx, q, err_paper = np.concatenate(p_parts), np.concatenate(q_parts), np.concatenate(e_parts)
-        err_geo, inside, mult = np.concatenate(g_parts), np.concatenate(in_parts), np.concatenate(m_parts)
-    # (already in pose order, as a closed form's candidates and most sweeps' are -- one pose's always: no
-    # reordering copies)
-    in_order = len(poses) == 1 or bool(np.all(pose_idx[1:] >= pose_idx[:-1]))
-    order = slice(None) if in_order else np.argsort(pose_idx, kind="stable")
-    empty_reason = None
-    if strategy == "paper" and not red.closed_form:  # its final resolution decides nothing about reachability
-        step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"
-        empty_reason = (
-            f"no solution with J < 1e-5 mm found by the paper's strategy (its final {step} step "
-            "misses roots off its grid); strategy='precise' finds every solution"
-        )
-    return Block(
-        robot=robot,
-        poses=poses.copy(),
-        bounds=(
-            np.array([0, pose_idx.size], dtype=np.intp)
-            if len(poses) == 1
-            else np.searchsorted(pose_idx[order], np.arange(len(poses) + 1)).astype(np.intp)
-        ),
-        q=q[order],
-        error=err_paper[order],
-        error_geodesic=err_geo[order],
-        within_limits=inside[order],
-        multiplicity=mult[order].astype(np.intp),
-        families=families,
-        n_reachable=n_reachable.astype(np.intp),
-        empty_reason=empty_reason,
-    )
+    return pose_idx, q, err_paper, err_geo, mult, inside, keep
 
 
 def _errors(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array, Array]:

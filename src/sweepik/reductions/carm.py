@@ -229,7 +229,9 @@ class CArmD1(_CArmBase):
     def search_range(self, poses: Array) -> Array:
         L = self.L1 + self.L2
         Pz = poses[:, 2, 3]
-        return np.stack([Pz - L, Pz + L], axis=-1)
+        out = np.empty((poses.shape[0], 2))
+        out[:, 0], out[:, 1] = Pz - L, Pz + L
+        return out
 
     def special_solutions(self, poses: Array) -> Array | None:
         """Wrist on joint 2's axis (Px = 0, d1 = Pz): u = 0, theta34 from the elbow, theta2 from the

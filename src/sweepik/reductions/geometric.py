@@ -35,7 +35,7 @@ import math
 from typing import Any, NamedTuple
 
 import numpy as np
-from numba import float64, int64, njit, types
+from numba import float64, int64, njit
 from numba.extending import register_jitable
 from numpy.typing import NDArray
 

@@ -10,6 +10,7 @@ addresses of compiled code (``address_of``), so it is compiled once for every re
 from __future__ import annotations
 
 import math
+from functools import cache
 from typing import Any
 
 from .._jit import internal
@@ -184,13 +185,22 @@ def owned_kernel(reduction: Any, name: str) -> Any:
     """``reduction.<name>`` (an optional kernel: ``kernel_residuals``, ``kernel_configurations``) if the class that
     sets ``kernel`` sets it too (as a class attribute, or declares it for its instances to set), else None: a
     subclass with its own ``kernel`` must not get its parent's all-branch kernels."""
-    mro = type(reduction).__mro__
-    owner = next((c for c in mro if "kernel" in vars(c)), None)
-    if owner is None or name not in vars(owner):
+    declared, default = _declared_kernel(reduction.__class__, name)
+    if not declared:
         return None
     # read from the class (a compiled function stored as a class attribute would bind to the instance), unless
     # the instance set its own
-    return vars(reduction).get(name, vars(owner)[name])
+    return vars(reduction).get(name, default)
+
+
+@cache
+def _declared_kernel(cls: type, name: str) -> tuple[bool, Any]:
+    """Whether the class of ``cls``'s MRO that sets ``kernel`` sets ``name`` too, and its value there (a property of
+    the class: cached, as every solve asks)."""
+    owner = next((c for c in cls.__mro__ if "kernel" in vars(c)), None)
+    if owner is None or name not in vars(owner):
+        return False, None
+    return True, vars(owner)[name]
 
 
 _ADDRESSES: dict[Any, int] = {}
