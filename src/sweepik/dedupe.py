@@ -90,19 +90,21 @@ def settle(
     err_geo: Array,
     err_paper: Array,
     pose_idx: NDArray[np.intp],
+    n_poses: int,
     thresholds: tuple[float, float, float, float],
     reach: Array,
-) -> tuple[NDArray[np.intp], Array, NDArray[np.bool_], NDArray[np.bool_]] | None:
-    """The solver's steps from candidates to final ones, in one compiled pass, for a chunk where none of its rarer
-    steps is due: ``(rows, w, inside, keep)``, the certified rows of ``q`` (finite, ``err_geo`` within the
-    acceptance) with ``finish``'s wrapped configurations, limit check and duplicate mask, the same values the
-    solver's NumPy steps give. None when a candidate is due a polish (``err_geo`` at most ``thresholds[0]`` and
-    above ``thresholds[1]``, or ``err_paper`` above ``thresholds[2]``), when a certified one lies outside the limits
-    by at most ``reach`` (per joint: the solver tries it at the limit), or without Numba. ``thresholds``: (polish
-    below, polish above, polish above on the paper's J, acceptance), absolute."""
+) -> tuple[NDArray[np.bool_], NDArray[np.intp], Array, NDArray[np.bool_], NDArray[np.bool_]] | None:
+    """The solver's steps from candidates to final ones in one compiled pass, for the poses (of ``n_poses``) where
+    none of its rarer steps is due: ``(due, rows, w, inside, keep)``. ``due (n_poses,)`` marks the poses left to the
+    solver's steps: a candidate is due a polish (``err_geo`` at most ``thresholds[0]`` and above ``thresholds[1]``,
+    or ``err_paper`` above ``thresholds[2]``), or a certified one lies outside the limits by at most ``reach`` (per
+    joint: the solver tries it at the limit). Of the other poses, ``rows`` are the certified candidates (finite,
+    ``err_geo`` within ``thresholds[3]``), in order, with ``finish``'s wrapped configurations ``w``, limit check and
+    duplicate mask: the values the solver's NumPy steps give. None without Numba."""
     if not AVAILABLE:
         return None
     K = q.shape[0]
+    due = np.empty(n_poses, dtype=np.bool_)
     rows = np.empty(K, dtype=np.int64)
     w = np.empty((K, robot.n_joints))
     score = np.empty(K)
@@ -123,15 +125,14 @@ def settle(
         reach,
         _tolerance(robot),
         float(robot.length_scale),
+        due,
         rows,
         w,
         score,
         inside,
         keep,
     )
-    if c < 0:
-        return None
-    return rows[:c].astype(np.intp), w[:c], inside[:c], keep[:c]
+    return due, rows[:c].astype(np.intp), w[:c], inside[:c], keep[:c]
 
 
 def merged_multiplicity(
@@ -291,6 +292,10 @@ if AVAILABLE:
                     for j in range(n):
                         d = q[i, j] - q[m, j]
                         if rev[j]:
+                            # (clearly apart modulo 2 pi: the wrap, a costly float modulo, would not change that)
+                            if 2.0 * tol[j] < abs(d) < two_pi - 2.0 * tol[j]:
+                                same = False
+                                break
                             d = math.pi - ((math.pi - d) % two_pi)
                         if not abs(d) <= tol[j]:
                             same = False
@@ -302,17 +307,20 @@ if AVAILABLE:
 
     @lazy_njit(
         (float64[:, ::1], float64[::1], float64[::1], int64[::1], float64[::1], boolean[::1], float64[::1])
-        + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, int64[::1], float64[:, ::1])
-        + (float64[::1], boolean[::1], boolean[::1]),
+        + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, boolean[::1], int64[::1])
+        + (float64[:, ::1], float64[::1], boolean[::1], boolean[::1]),
         cache=True,
     )
     def _settle(
-        q, eg, ep, pose, thr, rev, lower, upper, ltol, beyond, reach, tol, length_scale, idx, w, score, inside, keep
+        q, eg, ep, pose, thr, rev, lower, upper, ltol, beyond, reach, tol, scale, due, idx, w, score, inside, keep
     ):  # pragma: no cover
-        """``settle``'s kernel: 0 and the certified rows (``idx``, their wrapped configurations ``w``, ``score``,
-        ``inside``, ``keep``; their count is returned) when no row needs the solver's rarer steps, else -1."""
+        """``settle``'s kernel: marks the poses due the solver's rarer steps (``due``, one entry per pose, set here);
+        of the other poses, the certified rows (``idx``, their wrapped configurations ``w``, ``score``, ``inside``,
+        ``keep``; their count is returned)."""
         polish_below, polish_above, polish_paper_above, accept = thr[0], thr[1], thr[2], thr[3]
         K, n = q.shape
+        for i in range(due.shape[0]):
+            due[i] = False
         c = 0
         for k in range(K):
             finite = True
@@ -323,23 +331,34 @@ if AVAILABLE:
                 continue
             e = eg[k]
             if e <= polish_below and (e > polish_above or ep[k] > polish_paper_above):
-                return -1  # a Newton polish (or, failing it, the fallback reduction) is due
+                due[pose[k]] = True  # a Newton polish (or, failing it, the fallback reduction)
+                continue
             if not e <= accept:
                 continue
             for j in range(n):
                 w[c, j] = q[k, j]
             ok = wrap_inside_row(w[c], rev, lower, upper, ltol, beyond)
             if not ok:
-                near = True  # within reach of the limits: the solver tries it at the limit
+                near = True  # within reach of the limits: tried at the limit
                 for j in range(n):
                     over = max((lower[j] - ltol[j]) - w[c, j], (w[c, j] - upper[j]) - ltol[j])
                     if not over <= reach[j]:
                         near = False
                         break
                 if near:
-                    return -1
+                    due[pose[k]] = True
+                    continue
             idx[c], inside[c] = k, ok
-            score[c] = e if ok else e + length_scale
+            score[c] = e if ok else e + scale
             c += 1
-        _dedupe_rows(pose[idx[:c]], w[:c], score[:c], rev, tol, keep[:c])
-        return c
+        m = 0
+        for a in range(c):  # the rows of poses found due after them are dropped
+            if due[pose[idx[a]]]:
+                continue
+            if m < a:
+                idx[m], inside[m], score[m] = idx[a], inside[a], score[a]
+                for j in range(n):
+                    w[m, j] = w[a, j]
+            m += 1
+        _dedupe_rows(pose[idx[:m]], w[:m], score[:m], rev, tol, keep[:m])
+        return m

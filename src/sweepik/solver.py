@@ -283,16 +283,38 @@ def _solve_chunk(
         fams = {}
     settled = None
     if strategy == "precise" and err_geo is not None and err_paper is not None:
-        # the common case in one compiled pass (None when a candidate needs polishing, the fallback or a limit snap)
+        # in one compiled pass, but for the poses due a polish, the fallback or a limit snap (few)
         ls = robot.length_scale
         bounds = (POLISH_BELOW_REL * ls, POLISH_ABOVE_REL * ls, POLISH_PAPER_ABOVE_REL * ls, ACCEPT_TOL_REL * ls)
-        settled = settle(robot, q, err_geo, err_paper, pose_idx, bounds, _snap_reach(robot))
-        if settled is not None:
-            rows, q, inside, keep = settled
-            pose_idx, err_paper, err_geo, mult = pose_idx[rows], err_paper[rows], err_geo[rows], mult[rows]
+        settled = settle(robot, q, err_geo, err_paper, pose_idx, len(poses), bounds, _snap_reach(robot))
     if settled is None:
         pose_idx, q, err_paper, err_geo, mult, inside, keep = _settle_stepwise(
             robot, red, poses, strategy, limits, n_samples, use_fallback, pose_idx, q, mult, err_geo, err_paper
+        )
+    else:
+        assert err_geo is not None and err_paper is not None
+        due, rows, w, inside, keep = settled
+        parts = [(pose_idx[rows], w, err_paper[rows], err_geo[rows], mult[rows], inside, keep)]
+        if due.any():  # (these poses' rows, by the steps; the rows of a pose stay in order, and together)
+            sub = np.nonzero(due[pose_idx])[0]
+            parts.append(
+                _settle_stepwise(
+                    robot,
+                    red,
+                    poses,
+                    strategy,
+                    limits,
+                    n_samples,
+                    use_fallback,
+                    pose_idx[sub],
+                    q[sub],
+                    mult[sub],
+                    err_geo[sub],
+                    err_paper[sub],
+                )  # fmt: skip
+            )
+        pose_idx, q, err_paper, err_geo, mult, inside, keep = (
+            parts[0] if len(parts) == 1 else [np.concatenate(c) for c in zip(*parts, strict=True)]
         )
     assert err_geo is not None and err_paper is not None  # (both paths set them)
     if closed and not keep.all():  # branches of the closed form that meet: one solution, a multiple root
