@@ -120,6 +120,34 @@ def test_all_branch_kernel_is_bitwise_the_branch_kernel() -> None:
     assert fastsweep._kernel_residuals(OwnKernel(CARM)) is None
 
 
+def test_carm_d1_hints_kernel_is_bitwise_sample_hints() -> None:
+    """carm-d1's compiled hints (with them the engine builds a pose's samples in one pass) are exactly what
+    ``sample_hints`` gives: where Px is tiny (snapped to 0 in the kernel parameters, not in the hints), where the
+    wrist is out of every rail position's reach (NaN), and on random poses. A subclass that overrides
+    ``sample_hints`` is not bypassed by the kernel."""
+    from sweepik.reductions import kernels
+
+    red = sweepik.get_reduction(CARM, "carm-d1")
+    chain = CARM.fk(_stress(300, seed=12))
+    chain[:10, 0, 3] = [0.0, -0.0, 1e-14, -1e-14, 1e-9, 3e-12, -3e-12, 1e-300, 5.0, -5.0]
+    chain[10:20, :2, 3] *= 50.0  # out of reach of the outer circle
+    params = red.kernel_params(chain)
+    assert params[2, 0] == 0.0 and params[2, 17] == 1e-14  # (the snap, and the value as given)
+    ref = red.sample_hints(chain)
+    assert np.isnan(ref[10:20, :4]).all()
+    out = np.empty(kernels.N_D1_HINTS)
+    for i in range(len(chain)):
+        kernels.carm_d1_hints(params[i], out)
+        np.testing.assert_array_equal(out, ref[i])
+    assert fastsweep._hints_kernel(red) is kernels.carm_d1_hints
+
+    class OwnHints(sweepik.CArmD1):
+        def sample_hints(self, poses: np.ndarray) -> np.ndarray:
+            return super().sample_hints(poses)[:, :5]
+
+    assert fastsweep._hints_kernel(OwnHints(CARM)) is None
+
+
 def _pair_reductions() -> list[sweepik.GeometricReduction]:
     """Every pair plan (swept theta*) of the bundled swept arms and of the C-Arm (its four plans: three position
     cases, a prismatic and two revolute theta*)."""

@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 from . import parallel
 from . import sweep as _ref
 from ._jit import internal, unowned
+from .reductions.base import overridden_below_kernel
 from .reductions.kernels import address_of, lazy_njit, owned_kernel
 from .robot import Robot
 
@@ -411,7 +412,7 @@ if AVAILABLE:
 
     from numba import float64, int64
 
-    from .reductions.kernels import RESIDUALS_SIG, as_residual, as_residuals
+    from .reductions.kernels import RESIDUALS_SIG, as_hints, as_residual, as_residuals
 
     #: The engine's entry signature: the residual enters as the address of a compiled function
     #: (``kernels.address_of``), so the engine is compiled once (and cached) for every reduction.
@@ -601,48 +602,93 @@ if AVAILABLE:
     @njit(cache=True, nogil=True)
     def _merge_grid(lo, hi, s, hints, out, start, stop):
         """``sweep.merge_grid`` for poses ``start .. stop - 1`` into ``out (N, n + H)``, element by element (the same
-        arithmetic, so the same samples): the hints (``H`` columns) are few, so an insertion sort of each row, whose
-        uniform part is sorted already, costs little."""
-        n, H = s.shape[0], hints.shape[1]
-        M = n + H
+        arithmetic, so the same samples)."""
         for i in range(start, stop):
-            g = out[i]
-            a, w = lo[i], hi[i] - lo[i]
-            for k in range(n):
-                g[k] = a + w * s[k]
-            for k in range(H):
-                h = hints[i, k]
-                g[n + k] = h if (math.isfinite(h) and h >= a and h <= hi[i]) else a + w * ((k + 0.5) / (n - 1))
-            for m in range(n, M):
-                v = g[m]
-                j = m - 1
-                while j >= 0 and g[j] > v:
-                    g[j + 1] = g[j]
-                    j -= 1
-                g[j + 1] = v
-            # runs of equal samples spread towards the next distinct one
-            m = 1
-            while m < M:
-                if g[m] > g[m - 1]:
-                    m += 1
-                    continue
-                s0 = m - 1
-                e0 = m
-                while e0 < M and not g[e0] > g[e0 - 1]:
-                    e0 += 1
-                if e0 < M:
-                    base = g[s0]
-                    for j in range(m, e0):
-                        g[j] = base + (g[e0] - base) * (j - s0) / (e0 - s0)
-                m = e0 + 1
+            _merge_row(lo[i], hi[i], s, hints[i], out[i])
+
+    @njit(cache=True, nogil=True)
+    def _hinted_grid(hints, params, ends, periodic, lo, hi, s, out, start, stop):
+        """``sample_grid`` for poses ``start .. stop - 1`` of a reduction with a hints kernel (its address
+        ``hints``): the pose's hints, then ``ends`` (theta*'s limits, for a non-periodic theta*), wrapped into
+        [-pi, pi] for a periodic one, as ``sweep.grid_hints``; merged as ``_merge_grid``."""
+        fn = as_hints(hints)
+        H = out.shape[1] - s.shape[0]
+        nh = H - ends.shape[0]
+        row = np.empty(H)
+        for i in range(start, stop):
+            fn(params[i], row[:nh])
+            for k in range(ends.shape[0]):
+                row[nh + k] = ends[k]
+            if periodic:
+                for k in range(H):
+                    row[k] = math.pi - ((math.pi - row[k]) % (2.0 * math.pi))
+            _merge_row(lo[i], hi[i], s, row, out[i])
+
+    @internal
+    def _merge_row(a, b, s, hints, g):
+        """One pose's samples ``g (n + H,)`` on ``[a, b]``: the unit grid ``s (n,)`` and the hints ``(H,)`` inside
+        it (else a spare midpoint), sorted, runs of equal samples spread. The hints are few, so an insertion sort of
+        the row, whose uniform part is sorted already, costs little."""
+        n, H = s.shape[0], hints.shape[0]
+        M = n + H
+        w = b - a
+        for k in range(n):
+            g[k] = a + w * s[k]
+        for k in range(H):
+            h = hints[k]
+            g[n + k] = h if (math.isfinite(h) and h >= a and h <= b) else a + w * ((k + 0.5) / (n - 1))
+        for m in range(n, M):
+            v = g[m]
+            j = m - 1
+            while j >= 0 and g[j] > v:
+                g[j + 1] = g[j]
+                j -= 1
+            g[j + 1] = v
+        # runs of equal samples spread towards the next distinct one
+        m = 1
+        while m < M:
+            if g[m] > g[m - 1]:
+                m += 1
+                continue
+            s0 = m - 1
+            e0 = m
+            while e0 < M and not g[e0] > g[e0 - 1]:
+                e0 += 1
+            if e0 < M:
+                base = g[s0]
+                for j in range(m, e0):
+                    g[j] = base + (g[e0] - base) * (j - s0) / (e0 - s0)
+            m = e0 + 1
 
 
-def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
-    """:func:`sweepik.sweep.sample_grid`, the merge compiled (for a single pose its NumPy steps cost ~80 us)."""
+def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None) -> Array:
+    """:func:`sweepik.sweep.sample_grid`, the merge compiled (for a single pose its NumPy steps cost ~80 us), and
+    the hints too where the reduction has a hints kernel (``Reduction.kernel_hints``; ``params``: its
+    ``kernel_params(poses)``, if at hand)."""
+    hints_kernel = _hints_kernel(reduction) if AVAILABLE else None
+    N = poses.shape[0]
+    if hints_kernel is not None:
+        red = reduction
+        j = red.free_joint
+        ends = np.zeros(0) if red.periodic else np.array([red.robot.lower[j], red.robot.upper[j]], dtype=np.float64)
+        out = np.empty((N, n_samples + red.n_kernel_hints + ends.size))
+        parallel.run(
+            _hinted_grid,
+            N,
+            PARALLEL_MIN * 16,
+            address_of(hints_kernel),
+            np.ascontiguousarray(red.kernel_params(poses) if params is None else params, dtype=np.float64),
+            ends,
+            bool(red.periodic),
+            np.ascontiguousarray(lo, dtype=np.float64),
+            np.ascontiguousarray(hi, dtype=np.float64),
+            _ref._unit_grid(n_samples),
+            out,
+        )
+        return out
     hints = _ref.grid_hints(reduction, poses)
     if not AVAILABLE:
         return _ref.merge_grid(lo, hi, n_samples, hints)
-    N = poses.shape[0]
     if hints is None:
         hints = np.empty((N, 0))
     out = np.empty((N, n_samples + hints.shape[1]))
@@ -659,6 +705,15 @@ def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -
     return out
 
 
+def _hints_kernel(reduction):
+    """``reduction.kernel_hints`` where it belongs to the reduction's ``kernel`` and no subclass below overrides
+    ``sample_hints`` (the kernel would bypass it)."""
+    kernel = owned_kernel(reduction, "kernel_hints")
+    if kernel is None or overridden_below_kernel(type(reduction), ("sample_hints",)):
+        return None
+    return kernel
+
+
 def _kernel_residuals(reduction):
     """``reduction.kernel_residuals`` where it belongs to the reduction's ``kernel`` (``kernels.owned_kernel``)."""
     return owned_kernel(reduction, "kernel_residuals")
@@ -667,8 +722,8 @@ def _kernel_residuals(reduction):
 def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
     """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
     Poses whose candidate or family buffers overflow are redone by the NumPy engine."""
-    theta = sample_grid(reduction, poses, lo, hi, n_samples)
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
+    theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
     out_b = np.empty((N, MAX_CAND), dtype=np.int64)

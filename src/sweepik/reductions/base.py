@@ -36,13 +36,13 @@ IntArray = NDArray[np.intp]
 
 
 @cache
-def _kernel_not_overridden(cls: type) -> bool:
-    """No class of ``cls``'s MRO below the one that sets ``kernel`` overrides ``residual`` or ``solve_rest`` (a
-    property of the class: cached, as a solve asks for it several times)."""
+def overridden_below_kernel(cls: type, names: tuple[str, ...]) -> bool:
+    """A class of ``cls``'s MRO below the one that sets ``kernel`` defines one of ``names`` (a Python method that the
+    compiled kernels would silently bypass). A property of the class: cached, as a solve asks for it several times."""
     mro = cls.__mro__
     owner = next(c for c in mro if "kernel" in vars(c))
     below = mro[: mro.index(owner)]
-    return not any(name in vars(c) for c in below for name in ("residual", "solve_rest"))
+    return any(name in vars(c) for c in below for name in names)
 
 
 class Reduction(ABC):
@@ -78,6 +78,13 @@ class Reduction(ABC):
     #: for bit what ``kernel[1]`` gives branch by branch (NaN rows where a branch does not exist). A closed form's
     #: certification uses it (every branch is a candidate); ignored unless set by the class that sets ``kernel``.
     kernel_configurations: Any = None
+    #: Optional compiled kernel ``hints(params, out)`` (signature ``reductions.kernels.HINTS_SIG``) writing a pose's
+    #: ``sample_hints`` into ``out (n_kernel_hints,)``, value for value: the engine then builds a pose's samples in
+    #: one compiled pass (for a single pose, the NumPy steps of ``sample_hints`` cost more than its search). Ignored
+    #: unless set by the class that sets ``kernel``, with ``n_kernel_hints``, and unless a subclass below that class
+    #: overrides ``sample_hints``.
+    kernel_hints: Any = None
+    n_kernel_hints: int = 0
     #: No sweep: every branch of ``solve_rest`` (at any theta*) is a candidate (a closed-form decomposition).
     closed_form: bool = False
     #: Classes of branches whose residuals are identical (they differ in the configuration only, e.g. by a
@@ -97,7 +104,7 @@ class Reduction(ABC):
         Python must not silently run its parent's compiled kernel)."""
         if self.kernel is None:
             return False
-        return _kernel_not_overridden(type(self))
+        return not overridden_below_kernel(type(self), ("residual", "solve_rest"))
 
     def kernel_params(self, poses: Array) -> Array:
         """Per-pose parameters ``(N, P)`` of the compiled kernels (only with ``kernel``)."""

@@ -39,8 +39,8 @@ DISC_TOL = 1e-12
 BLIND_PX_REL = 1e-2
 BLIND_COS = 2e-2
 #: Number of extra samples placed across the narrow window |Pz - d1| ~ |Px| where theta2 swings by pi.
-_SWING_SAMPLES = 16
-_TAN_SWING = np.tan(np.linspace(-np.pi / 2, np.pi / 2, _SWING_SAMPLES + 2)[1:-1])
+_SWING_SAMPLES = kernels.SWING_SAMPLES
+_TAN_SWING = kernels.TAN_SWING
 
 
 def carm_lengths(robot: Robot) -> tuple[float, float]:
@@ -81,7 +81,7 @@ class _CArmBase(Reduction):
         self.px_snap = PX_SNAP_REL * (self.L1 + self.L2)
 
     def kernel_params(self, poses: Array) -> Array:
-        """``(N, 17)``: Px, Py, Pz, z (3), L1, L2, R (9, row-major) for the compiled kernels (reductions/kernels.py)."""
+        """``(N, 18)``: the rows of ``kernels.N_PARAMS`` for the compiled kernels (reductions/kernels.py)."""
         N = poses.shape[0]
         out = np.empty((N, kernels.N_PARAMS))
         out[:, 0:3] = poses[:, :3, 3]
@@ -89,6 +89,7 @@ class _CArmBase(Reduction):
         out[:, 3:6] = poses[:, :3, 2]
         out[:, 6], out[:, 7] = self.L1, self.L2
         out[:, 8:17] = poses[:, :3, :3].reshape(N, 9)
+        out[:, 17] = poses[:, 0, 3]
         return out
 
     def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
@@ -167,6 +168,8 @@ class CArmD1(_CArmBase):
     name = "carm-d1"
     kernel = (kernels.carm_d1_residual, kernels.carm_d1_configuration)
     kernel_residuals = kernels.carm_d1_residuals
+    kernel_hints = kernels.carm_d1_hints
+    n_kernel_hints = kernels.N_D1_HINTS
     fallback = "carm-theta2"
     blind_spots = "d1 = Pz with Px = 0 (wrist on joint 2's axis): solved separately as a special slice"
 

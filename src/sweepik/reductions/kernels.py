@@ -13,6 +13,8 @@ import math
 from functools import cache
 from typing import Any
 
+import numpy as np
+
 from .._jit import internal
 
 _njit: Any
@@ -24,8 +26,16 @@ except ImportError:  # pragma: no cover - without numba the NumPy engine is used
 #: Same as carm.DISC_TOL (kept here so that this module has no import cycle with carm.py).
 DISC_TOL = 1e-12
 
-#: Row layout of ``kernel_params`` for both C-Arm reductions: Px, Py, Pz, z (3), L1, L2, R (9, row-major).
-N_PARAMS = 17
+#: Row layout of ``kernel_params`` for both C-Arm reductions: Px, Py, Pz, z (3), L1, L2, R (9, row-major), and Px
+#: as given (the first Px is snapped to 0 when tiny, ``carm.PX_SNAP_REL``; the sample hints take it as given).
+N_PARAMS = 18
+#: Samples placed across the narrow window |Pz - d1| ~ |Px| where theta2 swings by pi (carm-d1's hints), at
+#: d1 = Pz - |Px| tan(a) for angles a evenly inside (-pi/2, pi/2).
+SWING_SAMPLES = 16
+TAN_SWING = np.tan(np.linspace(-np.pi / 2, np.pi / 2, SWING_SAMPLES + 2)[1:-1])
+#: Hints per pose of carm-d1 (``CArmD1.sample_hints``): the rail positions where the wrist comes within reach and
+#: leaves it (outer and inner circle), Pz, and the swing window.
+N_D1_HINTS = 5 + SWING_SAMPLES
 
 
 def _elbow(u: float, Py: float, eps: float, L1: float, L2: float) -> tuple[float, float]:
@@ -117,6 +127,8 @@ if _njit is not None:
     #: ``configurations(params, theta, out)``: every branch's configuration at theta* into ``out (n_branches, n)``
     #: (optional, see ``Reduction.kernel_configurations``).
     CONFIGURATIONS_SIG = void(float64[::1], float64, float64[:, ::1])
+    #: ``hints(params, out)``: a reduction's sample hints of one pose (optional, see ``Reduction.kernel_hints``).
+    HINTS_SIG = void(float64[::1], float64[::1])
     _elbow = internal(_elbow)
     _d1_position = internal(_d1_position)
     _elbow_residual = internal(_elbow_residual)
@@ -227,6 +239,7 @@ as_residual: Any = None
 as_residuals: Any = None
 as_configuration: Any = None
 as_configurations: Any = None
+as_hints: Any = None
 if _njit is not None:
     from .._jit import function_at
 
@@ -235,6 +248,7 @@ if _njit is not None:
     as_residuals = function_at(RESIDUALS_SIG)
     as_configuration = function_at(CONFIGURATION_SIG)
     as_configurations = function_at(CONFIGURATIONS_SIG)
+    as_hints = function_at(HINTS_SIG)
 
 
 def _carm_configuration(p, x: float, b: int, out, rail: bool) -> None:
@@ -284,7 +298,23 @@ def _carm_theta2_configuration(p, x: float, b: int, out) -> None:
     _carm_configuration(p, x, b, out, False)
 
 
+def _carm_d1_hints(p, out) -> None:
+    """carm-d1's sample hints of one pose into ``out (N_D1_HINTS,)``, value for value as ``CArmD1.sample_hints``
+    (NaN where no rail position brings the wrist onto a circle)."""
+    Px, Py, Pz, L1, L2 = p[17], p[1], p[2], p[6], p[7]
+    q2 = Px * Px + Py * Py
+    for k in range(2):
+        r = ((L1 + L2) ** 2 if k == 0 else (L1 - L2) ** 2) - q2
+        t = math.sqrt(r) if r >= 0.0 else math.nan
+        out[2 * k], out[2 * k + 1] = Pz - t, Pz + t
+    out[4] = Pz
+    for m in range(SWING_SAMPLES):
+        out[5 + m] = Pz - abs(Px) * TAN_SWING[m]
+
+
+carm_d1_hints: Any = _carm_d1_hints
 if _njit is not None:
+    carm_d1_hints = LazyKernel(_carm_d1_hints, HINTS_SIG, cache=True)
     _carm_configuration = internal(_carm_configuration)
     carm_d1_configuration = LazyKernel(_carm_d1_configuration, CONFIGURATION_SIG, cache=True)
     carm_theta2_configuration = LazyKernel(_carm_theta2_configuration, CONFIGURATION_SIG, cache=True)
