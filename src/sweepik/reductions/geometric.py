@@ -702,14 +702,20 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
             for i in range(start, stop):
                 p = params[i]
                 out[i] = False
-                for b in range(int(p[_POS_BRANCHES])):
-                    arm = _arm(p, 0.0, b // 2, b % 2, case, free, rev)
-                    m0, m1, m2, m3 = arm[0] if b % 2 == 0 else arm[1]
-                    if _missing(m0, m1, m2, m3) or not (in_domain(arm[2]) and in_domain(arm[3])):
-                        continue
-                    v = _back(p, m0, m1, m2, m3, _mat(p, h5))
-                    if norm(cross(v, h3)) < WRIST_SINGULAR:
-                        out[i] = True
+                nb = int(p[_POS_BRANCHES])
+                both = BOTH + 0 * nb  # (a run-time value: see position.place)
+                for b1 in range((nb + 1) // 2):
+                    # the two branches of a first step share its work (as in ``wrists``, the same values)
+                    arm = _arm(p, 0.0, b1, both, case, free, rev)
+                    for j in range(2):
+                        if 2 * b1 + j >= nb:
+                            break
+                        m0, m1, m2, m3 = arm[0] if j == 0 else arm[1]
+                        if _missing(m0, m1, m2, m3) or not (in_domain(arm[2]) and in_domain(arm[3])):
+                            continue
+                        v = _back(p, m0, m1, m2, m3, _mat(p, h5))
+                        if norm(cross(v, h3)) < WRIST_SINGULAR:
+                            out[i] = True
 
         ck = _CASE_KERNELS[key] = CaseKernels(
             LazyKernel(residual, RESIDUAL_SIG, cache=True),
