@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from . import parallel
 from .fastsweep import AVAILABLE
 from .solutions import joint_distance
 
@@ -34,6 +35,8 @@ __all__ = ["finish", "settle", "wrap_inside", "limit_args", "merged_multiplicity
 DEDUPE_ANGLE = 1e-6
 #: ... and every prismatic joint within this times the arm's length scale.
 DEDUPE_LENGTH_REL = 1e-8
+#: ``settle`` runs on several threads from this many candidates on (fewer: a thread hand-off costs more).
+_PARALLEL_ROWS = 4096
 
 
 @lru_cache(maxsize=64)
@@ -104,18 +107,31 @@ def settle(
     if not AVAILABLE:
         return None
     K = q.shape[0]
-    due = np.empty(n_poses, dtype=np.bool_)
+    pose = pose_idx.astype(np.int64)
+    # parts of whole poses for the threads: a batch's candidates are mostly in pose order (a closed form's always)
+    nt = parallel.threads() if K >= _PARALLEL_ROWS else 1
+    if nt > 1 and bool(np.all(pose[1:] >= pose[:-1])):
+        m = nt * parallel.PARTS_PER_THREAD
+        cuts = np.searchsorted(pose, pose[(np.arange(1, m) * K) // m])
+        parts = np.unique(np.concatenate([[0], cuts, [K]])).astype(np.int64)
+    else:
+        parts = np.array([0, K], dtype=np.int64)
+    counts = np.zeros(parts.size - 1, dtype=np.int64)
+    due = np.zeros(n_poses, dtype=np.bool_)
     rows = np.empty(K, dtype=np.int64)
     w = np.empty((K, robot.n_joints))
     score = np.empty(K)
     inside = np.empty(K, dtype=np.bool_)
     keep = np.empty(K, dtype=np.bool_)
     rev, lower, upper, ltol, beyond = limit_args(robot)
-    c = _settle(
+    parallel.run(
+        _settle,
+        parts.size - 1,
+        2,
         np.ascontiguousarray(q, dtype=np.float64),
         np.ascontiguousarray(err_geo, dtype=np.float64),
         np.ascontiguousarray(err_paper, dtype=np.float64),
-        pose_idx.astype(np.int64),
+        pose,
         np.array(thresholds, dtype=np.float64),
         rev,
         lower,
@@ -131,8 +147,14 @@ def settle(
         score,
         inside,
         keep,
+        parts,
+        counts,
     )
-    return due, rows[:c].astype(np.intp), w[:c], inside[:c], keep[:c]
+    if counts.size == 1:
+        c = int(counts[0])
+        return due, rows[:c].astype(np.intp), w[:c], inside[:c], keep[:c]
+    sel = np.concatenate([np.arange(a, a + c) for a, c in zip(parts[:-1], counts, strict=True)])
+    return due, rows[sel].astype(np.intp), w[sel], inside[sel], keep[sel]
 
 
 def merged_multiplicity(
@@ -308,57 +330,60 @@ if AVAILABLE:
     @lazy_njit(
         (float64[:, ::1], float64[::1], float64[::1], int64[::1], float64[::1], boolean[::1], float64[::1])
         + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, boolean[::1], int64[::1])
-        + (float64[:, ::1], float64[::1], boolean[::1], boolean[::1]),
+        + (float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64[::1], int64[::1], int64, int64),
         cache=True,
+        nogil=True,
     )
     def _settle(
-        q, eg, ep, pose, thr, rev, lower, upper, ltol, beyond, reach, tol, scale, due, idx, w, score, inside, keep
-    ):  # pragma: no cover
-        """``settle``'s kernel: marks the poses due the solver's rarer steps (``due``, one entry per pose, set here);
+        q, eg, ep, pose, thr, rev, lower, upper, ltol, beyond, reach, tol, scale,
+        due, idx, w, score, inside, keep, parts, counts, start, stop,
+    ):  # pragma: no cover  # fmt: skip
+        """``settle``'s kernel for parts ``start .. stop - 1`` (rows ``parts[p] .. parts[p + 1] - 1``; a pose's rows
+        lie in one part): marks the poses due the solver's rarer steps (``due``, one entry per pose, False on entry);
         of the other poses, the certified rows (``idx``, their wrapped configurations ``w``, ``score``, ``inside``,
-        ``keep``; their count is returned)."""
+        ``keep``), written from the part's first row on, ``counts[p]`` of them."""
         polish_below, polish_above, polish_paper_above, accept = thr[0], thr[1], thr[2], thr[3]
-        K, n = q.shape
-        for i in range(due.shape[0]):
-            due[i] = False
-        c = 0
-        for k in range(K):
-            finite = True
-            for j in range(n):
-                if not math.isfinite(q[k, j]):
-                    finite = False
-            if not finite:
-                continue
-            e = eg[k]
-            if e <= polish_below and (e > polish_above or ep[k] > polish_paper_above):
-                due[pose[k]] = True  # a Newton polish (or, failing it, the fallback reduction)
-                continue
-            if not e <= accept:
-                continue
-            for j in range(n):
-                w[c, j] = q[k, j]
-            ok = wrap_inside_row(w[c], rev, lower, upper, ltol, beyond)
-            if not ok:
-                near = True  # within reach of the limits: tried at the limit
+        n = q.shape[1]
+        for part in range(start, stop):
+            lo, hi = parts[part], parts[part + 1]
+            c = lo
+            for k in range(lo, hi):
+                finite = True
                 for j in range(n):
-                    over = max((lower[j] - ltol[j]) - w[c, j], (w[c, j] - upper[j]) - ltol[j])
-                    if not over <= reach[j]:
-                        near = False
-                        break
-                if near:
-                    due[pose[k]] = True
+                    if not math.isfinite(q[k, j]):
+                        finite = False
+                if not finite:
                     continue
-            idx[c], inside[c] = k, ok
-            score[c] = e if ok else e + scale
-            c += 1
-        m = 0
-        for a in range(c):  # the rows of poses found due after them are dropped
-            if due[pose[idx[a]]]:
-                continue
-            if m < a:
-                idx[m], inside[m], score[m] = idx[a], inside[a], score[a]
+                e = eg[k]
+                if e <= polish_below and (e > polish_above or ep[k] > polish_paper_above):
+                    due[pose[k]] = True  # a Newton polish (or, failing it, the fallback reduction)
+                    continue
+                if not e <= accept:
+                    continue
                 for j in range(n):
-                    w[m, j] = w[a, j]
-            m += 1
-        _dedupe_rows(pose[idx[:m]], w[:m], score[:m], rev, tol, keep[:m])
-        return m
+                    w[c, j] = q[k, j]
+                ok = wrap_inside_row(w[c], rev, lower, upper, ltol, beyond)
+                if not ok:
+                    near = True  # within reach of the limits: tried at the limit
+                    for j in range(n):
+                        over = max((lower[j] - ltol[j]) - w[c, j], (w[c, j] - upper[j]) - ltol[j])
+                        if not over <= reach[j]:
+                            near = False
+                            break
+                    if near:
+                        due[pose[k]] = True
+                        continue
+                idx[c], inside[c] = k, ok
+                score[c] = e if ok else e + scale
+                c += 1
+            m = lo
+            for a in range(lo, c):  # the rows of poses found due after them are dropped
+                if due[pose[idx[a]]]:
+                    continue
+                if m < a:
+                    idx[m], inside[m], score[m] = idx[a], inside[a], score[a]
+                    for j in range(n):
+                        w[m, j] = w[a, j]
+                m += 1
+            _dedupe_rows(pose[idx[lo:m]], w[lo:m], score[lo:m], rev, tol, keep[lo:m])
+            counts[part] = m - lo
