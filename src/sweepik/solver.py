@@ -749,21 +749,21 @@ def _iter_checked(
             progress("solve", min(s + chunk_size, total), total)
 
 
-def _solve_checked(
+def _solve_one(
     robot: Robot,
     P: Array,
     reduction: str | Reduction | None,
     strategy: str,
     limits: bool,
     n_samples: int,
-    chunk_size: int = CHUNK,
     free_joint: int | str | None = None,
     locked: object = None,
-) -> list[Solutions]:
+) -> Solutions:
+    """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly."""
     held = _held(robot, locked)
     arm = robot if held is None else held.arm
-    prepared = _prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
-    return list(_iter_checked(arm, P, *prepared, None, held))
+    red, strategy, limits, n_samples, _ = _prepare(arm, P, reduction, strategy, limits, n_samples, 1, free_joint, held)
+    return _expanded(_solve_chunk(arm, red, P, strategy, limits, n_samples), held).solutions(0)
 
 
 def solve(
@@ -818,4 +818,4 @@ def solve(
     P = check_poses(pose, "pose")
     if P.shape != (4, 4):
         raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
-    return _solve_checked(robot, P[None], reduction, strategy, limits, n_samples, CHUNK, free_joint, locked)[0]
+    return _solve_one(robot, P[None], reduction, strategy, limits, n_samples, free_joint, locked)
