@@ -66,3 +66,41 @@ def test_a_continuum_of_tens_of_thousands_of_points_collapses_in_bounded_memory(
     q[-5:] = np.random.default_rng(0).uniform(-3, 3, (5, 6))
     keep = collapse_continua(robot, np.zeros(t.size, dtype=np.intp), q)
     assert keep.sum() == 6 and np.all(keep[-5:])
+
+
+@pytest.mark.parametrize(
+    ("name", "reduction"), [("ur5", None), ("puma560", None), ("carm", "carm-d1"), ("fanuc_crx10ia", None)]
+)
+def test_one_pass_settling_equals_the_solver_steps(
+    name: str, reduction: str | None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``solve_many`` with the compiled settling pass (``dedupe.settle``: the poses due a polish, the fallback or a
+    snap onto a limit left to the solver's steps, the others settled at once, in parts on the batch threads) gives
+    bit for bit what the steps alone give: batches with singular wrists, solutions at a joint limit, random poses,
+    with and without limits."""
+    from sweepik import solver
+
+    robot = sweepik.load_robot(name)
+    rng = np.random.default_rng(2)
+    q = rng.uniform(robot.lower, robot.upper, size=(700, robot.n_joints))
+    q[:100, 4] = 0.0  # a singular wrist (polish, the fallback)
+    q[100:200, 1] = robot.upper[1]  # at a limit (solutions just beyond it are snapped)
+    q[200:250, 2] = robot.lower[2]
+    poses = robot.fk(q)
+    due = []
+    real = dedupe.settle
+
+    def counting(*args, **kwargs):
+        out = real(*args, **kwargs)
+        due.append(0 if out is None else int(out[0].sum()))
+        return out
+
+    monkeypatch.setattr(solver, "settle", counting)
+    got = [sweepik.solve_many(robot, poses, reduction=reduction, limits=lim) for lim in (True, False)]
+    assert sum(due) > 0, "no pose was due the solver's steps: the mixed case is not exercised"
+    monkeypatch.setattr(solver, "settle", lambda *args, **kwargs: None)
+    ref = [sweepik.solve_many(robot, poses, reduction=reduction, limits=lim) for lim in (True, False)]
+    for a, b in zip(got, ref, strict=True):
+        for column in ("offsets", "q", "error", "error_geodesic", "within_limits", "multiplicity", "n_reachable"):
+            np.testing.assert_array_equal(getattr(a, column), getattr(b, column), err_msg=column)
+        assert {i: len(f) for i, f in a.families.items()} == {i: len(f) for i, f in b.families.items()}
