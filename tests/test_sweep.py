@@ -148,6 +148,36 @@ def test_carm_d1_hints_kernel_is_bitwise_sample_hints() -> None:
     assert fastsweep._hints_kernel(OwnHints(CARM)) is None
 
 
+def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
+    """A reduction's own hints kernel over a revolute theta* (hints beyond +-pi, NaN, on the grid, repeated): the
+    compiled samples are the reference's, the hints wrapped into [-pi, pi] the same way."""
+    import numba
+
+    from sweepik import solver, sweep
+    from sweepik.reductions import kernels
+
+    values = np.array([0.3, 4.0, -7.5, np.nan, np.pi, -np.pi, 0.3, 1e3])
+
+    def hints_row(p, out):
+        for k in range(values.size):
+            out[k] = values[k] + 0.0 * p[0]
+
+    class OwnHints(sweepik.CArmTheta2):
+        kernel = sweepik.CArmTheta2.kernel
+        kernel_hints = numba.njit(kernels.HINTS_SIG)(hints_row)
+        n_kernel_hints = values.size
+
+        def sample_hints(self, poses: np.ndarray) -> np.ndarray:
+            return np.broadcast_to(values, (poses.shape[0], values.size)).copy()
+
+    red = OwnHints(CARM)
+    assert red.periodic and fastsweep._hints_kernel(red) is OwnHints.kernel_hints
+    chain = CARM.fk(_stress(50, seed=13))
+    lo, hi = solver._theta_range(CARM, red, chain)
+    ref = sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
+    np.testing.assert_array_equal(fastsweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES), ref)
+
+
 def _pair_reductions() -> list[sweepik.GeometricReduction]:
     """Every pair plan (swept theta*) of the bundled swept arms and of the C-Arm (its four plans: three position
     cases, a prismatic and two revolute theta*)."""
