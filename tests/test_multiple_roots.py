@@ -173,6 +173,25 @@ def test_reduction_refuses_lengths_it_cannot_solve(joint: int, field: str, value
         solve(robot, robot.fk(np.array([500.0, 0.3, 0.2, -0.4, 0.5, 0.1])))
 
 
+@pytest.mark.parametrize("reduction", ["carm-d1", "carm-theta2"])
+def test_equal_links_with_the_wrist_on_the_elbow_axis_solve_as_the_automatic_decomposition(reduction: str) -> None:
+    """L1 = L2 (another C-Arm): with Px = Py = 0 the samples reach the wrist on joint 3's axis (rho = 0), where the
+    closed-form elbow divides 0 by 0. The kernels give NaN there, as the NumPy reference does (no exception, no
+    spurious root), and the solutions are those of the automatic decomposition, each reproducing the pose."""
+    data = _carm_variant(3, "a", 400.0)
+    data["joints"][4]["d"] = 400.0
+    robot = robot_from_dict(data, "equal.toml")
+    T0 = robot.fk(np.array([800.0, 0.3, 0.2, -0.4, 0.5, 0.1]))
+    for z in (900.0, 1200.0, 400.0):
+        T = T0.copy()
+        T[:3, 3] = [0.0, 0.0, z]
+        got, ref = solve(robot, T, reduction=reduction, limits=False), solve(robot, T, reduction="auto", limits=False)
+        assert len(got) == len(ref) > 0
+        for q in ref.q:
+            assert joint_distance(robot, got.q, q).max(axis=-1).min() <= 1e-6
+        assert np.all(pose_error_geodesic(robot.fk(got.q), T, 100.0) <= 2e-13 * robot.length_scale)
+
+
 def test_huge_rail_limits_solve_every_pose(rng: np.random.Generator) -> None:
     robot = robot_from_dict(_carm_variant(0, "limits", [-1e300, 1e300]), "rail.toml")
     assert robot.length_scale < 1e5  # tolerances do not grow with the rail

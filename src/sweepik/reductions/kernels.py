@@ -43,7 +43,8 @@ def _elbow(u: float, Py: float, eps: float, L1: float, L2: float) -> tuple[float
     rho2 = u * u + Py * Py
     k = (rho2 + L2 * L2 - L1 * L1) / (2.0 * L2)
     disc = rho2 - k * k
-    if disc < -DISC_TOL * (L1 + L2) ** 2:
+    if disc < -DISC_TOL * (L1 + L2) ** 2 or not rho2 > 0.0:
+        # (rho2 = 0, the wrist on joint 3's axis, is inside the domain only when L1 = L2: there NumPy's 0 / 0 is NaN)
         return math.nan, math.nan
     s = eps * math.sqrt(max(disc, 0.0))
     return (k * u - s * Py) / rho2, (k * Py + s * u) / rho2
@@ -82,14 +83,14 @@ def _carm_d1_all(p, d1: float, out) -> None:
     Px, Py, Pz, zx, zy, zz, L1, L2 = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
     t = Pz - d1
     r = math.hypot(Px, t)
-    if not r > 0.0:  # the wrist on joint 2's axis: branch by branch
+    # _elbow: u * u = r * r for both signs
+    rho2 = r * r + Py * Py
+    if not (r > 0.0 and rho2 > 0.0):  # the wrist on joint 2's axis (or r * r below the floats): branch by branch
         for b in range(4):
             out[b] = _carm_d1(p, d1, b)
         return
     # _d1_position: c2 = sigma Px / r, s2 = sigma t / r, u = sigma r; c2 zx + s2 zz = sigma a
     a = Px / r * zx + t / r * zz
-    # _elbow: u * u = r * r for both signs
-    rho2 = r * r + Py * Py
     k = (rho2 + L2 * L2 - L1 * L1) / (2.0 * L2)
     disc = rho2 - k * k
     if disc < -DISC_TOL * (L1 + L2) ** 2:
