@@ -78,8 +78,10 @@ def test_one_pass_settling_equals_the_solver_steps(
     snap onto a limit left to the solver's steps, the others settled at once, in parts on the batch threads) gives
     bit for bit what the steps alone give: batches with singular wrists, solutions at a joint limit, random poses,
     with and without limits."""
-    from sweepik import solver
+    from sweepik import parallel, solver
 
+    monkeypatch.setattr(parallel, "threads", lambda: 3)  # parts on threads, whatever the machine's cores
+    monkeypatch.setattr(dedupe, "_PARALLEL_ROWS", 64)
     robot = sweepik.load_robot(name)
     rng = np.random.default_rng(2)
     q = rng.uniform(robot.lower, robot.upper, size=(700, robot.n_joints))
@@ -90,17 +92,23 @@ def test_one_pass_settling_equals_the_solver_steps(
     due = []
     real = dedupe.settle
 
+    settled = []
+
     def counting(*args, **kwargs):
         out = real(*args, **kwargs)
         due.append(0 if out is None else int(out[0].sum()))
+        settled.append(0 if out is None else out[1].size)
         return out
 
     monkeypatch.setattr(solver, "settle", counting)
     got = [sweepik.solve_many(robot, poses, reduction=reduction, limits=lim) for lim in (True, False)]
     assert sum(due) > 0, "no pose was due the solver's steps: the mixed case is not exercised"
+    assert sum(settled) > 0, "no candidate was settled in one pass"
     monkeypatch.setattr(solver, "settle", lambda *args, **kwargs: None)
     ref = [sweepik.solve_many(robot, poses, reduction=reduction, limits=lim) for lim in (True, False)]
     for a, b in zip(got, ref, strict=True):
         for column in ("offsets", "q", "error", "error_geodesic", "within_limits", "multiplicity", "n_reachable"):
             np.testing.assert_array_equal(getattr(a, column), getattr(b, column), err_msg=column)
-        assert {i: len(f) for i, f in a.families.items()} == {i: len(f) for i, f in b.families.items()}
+        assert a.families.keys() == b.families.keys()
+        for i, fams in a.families.items():
+            assert [(f.branch, f.interval) for f in fams] == [(f.branch, f.interval) for f in b.families[i]]

@@ -178,6 +178,48 @@ def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
     np.testing.assert_array_equal(fastsweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES), ref)
 
 
+def test_a_kernel_of_the_wrong_signature_is_refused_and_one_without_is_compiled_for_the_engine() -> None:
+    """A reduction's kernel is called through its address: one compiled for another signature (here a float32
+    result) would read its arguments wrong and is refused with a clear error; a plain Python function too. A Numba
+    function not yet compiled for the engine's signature is compiled for it and used."""
+    import numba
+
+    from sweepik.reductions import kernels
+
+    pose = CARM.fk(np.array([800.0, 0.3, 0.2, -0.4, 0.5, 0.1]))
+
+    @numba.njit("float32(float64[::1], float64, int64)")
+    def wrong(p, x, b):
+        return 0.0
+
+    @numba.njit
+    def lazy(p, x, b):
+        return kernels._carm_d1(p, x, b)
+
+    class Wrong(sweepik.CArmD1):
+        kernel = (wrong, kernels.carm_d1_configuration)
+
+    class Plain(sweepik.CArmD1):
+        kernel = (lambda p, x, b: 0.0, kernels.carm_d1_configuration)
+
+    class Lazy(sweepik.CArmD1):
+        kernel = (lazy, kernels.carm_d1_configuration)
+
+    for red, match in ((Wrong(CARM), "compiled for"), (Plain(CARM), "must be a Numba function")):
+        with pytest.raises(sweepik.UnknownOptionError, match=match):
+            sweepik.solve(CARM, pose, reduction=red)
+    got, ref = sweepik.solve(CARM, pose, reduction=Lazy(CARM)), sweepik.solve(CARM, pose, reduction="carm-d1")
+    np.testing.assert_array_equal(got.q, ref.q)
+    assert len(ref) > 0
+
+    class Uncounted(sweepik.CArmD1):
+        kernel = sweepik.CArmD1.kernel
+        kernel_hints = kernels.carm_d1_hints
+
+    with pytest.raises(sweepik.UnknownOptionError, match="n_kernel_hints"):
+        sweepik.solve(CARM, pose, reduction=Uncounted(CARM))
+
+
 def _pair_reductions() -> list[sweepik.GeometricReduction]:
     """Every pair plan (swept theta*) of the bundled swept arms and of the C-Arm (its four plans: three position
     cases, a prismatic and two revolute theta*)."""

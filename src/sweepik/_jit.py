@@ -3,7 +3,7 @@ it imports nothing of sweepik)."""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Final
 
 _njit: Any
 try:
@@ -11,17 +11,22 @@ try:
 except ImportError:  # pragma: no cover - without numba the NumPy engine is used
     _njit = None
 
-__all__ = ["internal", "unowned", "function_at"]
+__all__ = ["internal", "unowned", "function_at", "ERROR_MODEL"]
+
+#: Numba's error model for every compiled function of sweepik: IEEE results for a division by zero (inf, NaN), as
+#: the NumPy reference engine gives them, rather than a ZeroDivisionError raised from deep inside a kernel (which
+#: would abort a whole batch where the NumPy engine gives a NaN sample or a candidate that fails certification).
+ERROR_MODEL: Final = "numpy"
 
 
 def internal(fn: Any) -> Any:
-    """``numba.njit(cache=True)`` for a function that only compiled code calls: compiled without the wrappers that
-    let Python and C call it (``no_cpython_wrapper``, ``no_cfunc_wrapper``), which cost ~0.05 s each on a fresh
-    install. Calling it from Python fails. Its Python function must not be compiled by another dispatcher too (Numba's
-    disk cache keys on the function and the signature, not on these options)."""
+    """``numba.njit(cache=True, error_model=ERROR_MODEL)`` for a function that only compiled code calls: compiled
+    without the wrappers that let Python and C call it (``no_cpython_wrapper``, ``no_cfunc_wrapper``), which cost
+    ~0.05 s each on a fresh install. Calling it from Python fails. Its Python function must not be compiled by
+    another dispatcher too (Numba's disk cache keys on the function and the signature, not on these options)."""
     if _njit is None:  # pragma: no cover
         return fn
-    return _njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)(fn)
+    return _njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model=ERROR_MODEL)(fn)
 
 
 unowned: Any = None

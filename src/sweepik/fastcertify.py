@@ -37,7 +37,7 @@ _MAX_FLOAT = float(np.finfo(np.float64).max)
 if AVAILABLE:
     from numba import float64, int64, types
 
-    from .reductions.kernels import as_configuration, as_configurations
+    from .reductions.kernels import CONFIGURATION_SIG, CONFIGURATIONS_SIG, as_configuration, as_configurations
 
     #: A reduction's configuration kernel (all-branch kernel: ``_CFGS``) enters as its address (``address_of``).
     _CFG = _CFGS = int64
@@ -185,7 +185,7 @@ if AVAILABLE:
         last = -1
         for k in range(start, stop):
             i = pose[k]
-            if i != last:  # (a pose's candidates are consecutive)
+            if i != last:  # (a pose's candidates are mostly consecutive: the angles are redone when it changes)
                 zd[0], last = 0.0, i
             cfg(params[i], theta[k], branch[k], q[k])
             _certify_row(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper)
@@ -353,7 +353,7 @@ def dip_search(robot, red, chain: Array, pose, branch, a: Array, b: Array, best_
         _dip_search,
         K,
         PARALLEL_MIN,
-        address_of(red.kernel[1]),
+        address_of(red.kernel[1], CONFIGURATION_SIG),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
         pose.astype(np.int64),
         branch.astype(np.int64),
@@ -499,7 +499,7 @@ def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Arra
         _bisect_members,
         a.size,
         PARALLEL_MIN,
-        address_of(red.kernel[1]),
+        address_of(red.kernel[1], CONFIGURATION_SIG),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
         _writable(world),
         *args,
@@ -515,7 +515,7 @@ def certify_every_branch(robot, red, chain: Array, world: Array, params: Array |
     with its all-branch configuration kernel (``owned_kernel(red, "kernel_configurations")``, which must exist):
     ``(q (N n_branches, n), geodesic errors, paper errors)``, as :func:`certify` gives them branch by branch."""
     N, nb = chain.shape[0], red.n_branches
-    cfgs = address_of(owned_kernel(red, "kernel_configurations"))
+    cfgs = address_of(owned_kernel(red, "kernel_configurations"), CONFIGURATIONS_SIG)
     return _run(_certify_every_branch, N, 2 * PARALLEL_MIN, N * nb, robot, red, chain, world, params, cfgs, int(nb))
 
 
@@ -523,7 +523,7 @@ def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, 
     """Configurations ``(K, n)``, geodesic errors and paper errors ``(K,)`` of the candidates
     (inf errors where the branch does not exist)."""
     K = pose.shape[0]
-    cfg = address_of(red.kernel[1])
+    cfg = address_of(red.kernel[1], CONFIGURATION_SIG)
     ids = (pose.astype(np.int64), theta.astype(np.float64), branch.astype(np.int64))
     return _run(_certify, K, 16 * PARALLEL_MIN, K, robot, red, chain, world, params, cfg, *ids)
 
@@ -566,7 +566,7 @@ def configurations(robot: Robot, red: Reduction, chain: Array, pose: IntArray, t
     q = np.empty((pose.shape[0], robot.n_joints))
     assert red.kernel is not None  # callers check red.uses_kernel
     _configurations(
-        address_of(red.kernel[1]),
+        address_of(red.kernel[1], CONFIGURATION_SIG),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
         pose.astype(np.int64),
         theta.astype(np.float64),

@@ -26,7 +26,8 @@ from numpy.typing import NDArray
 
 from . import parallel
 from . import sweep as _ref
-from ._jit import internal, unowned
+from ._jit import ERROR_MODEL, internal, unowned
+from .errors import UnknownOptionError
 from .reductions.base import overridden_below_kernel
 from .reductions.kernels import address_of, lazy_njit, owned_kernel
 from .robot import Robot
@@ -412,7 +413,7 @@ if AVAILABLE:
 
     from numba import float64, int64
 
-    from .reductions.kernels import RESIDUALS_SIG, as_hints, as_residual, as_residuals
+    from .reductions.kernels import HINTS_SIG, RESIDUAL_SIG, RESIDUALS_SIG, as_hints, as_residual, as_residuals
 
     #: The engine's entry signature: the residual enters as the address of a compiled function
     #: (``kernels.address_of``), so the engine is compiled once (and cached) for every reduction.
@@ -599,14 +600,14 @@ if AVAILABLE:
 
 if AVAILABLE:
 
-    @njit(cache=True, nogil=True)
+    @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
     def _merge_grid(lo, hi, s, hints, out, start, stop):
         """``sweep.merge_grid`` for poses ``start .. stop - 1`` into ``out (N, n + H)``, element by element (the same
         arithmetic, so the same samples)."""
         for i in range(start, stop):
             _merge_row(lo[i], hi[i], s, hints[i], out[i])
 
-    @njit(cache=True, nogil=True)
+    @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
     def _hinted_grid(hints, params, ends, periodic, lo, hi, s, out, start, stop):
         """``sample_grid`` for poses ``start .. stop - 1`` of a reduction with a hints kernel (its address
         ``hints``): the pose's hints, then ``ends`` (theta*'s limits, for a non-periodic theta*), wrapped into
@@ -676,7 +677,7 @@ def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, p
             _hinted_grid,
             N,
             PARALLEL_MIN * 16,
-            address_of(hints_kernel),
+            address_of(hints_kernel, HINTS_SIG),
             np.ascontiguousarray(red.kernel_params(poses) if params is None else params, dtype=np.float64),
             ends,
             bool(red.periodic),
@@ -711,6 +712,12 @@ def _hints_kernel(reduction):
     kernel = owned_kernel(reduction, "kernel_hints")
     if kernel is None or overridden_below_kernel(type(reduction), ("sample_hints",)):
         return None
+    n = owned_kernel(reduction, "n_kernel_hints")
+    if not (isinstance(n, int) and n >= 1):
+        raise UnknownOptionError(
+            f"reduction {reduction.name!r} sets kernel_hints but not n_kernel_hints (the number of hints it writes, "
+            f"a positive int), got {n!r}"
+        )
     return kernel
 
 
@@ -738,8 +745,8 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         _search,
         N,
         PARALLEL_MIN,
-        address_of(reduction.kernel[0]),
-        address_of(_no_residuals if res_all is None else res_all),
+        address_of(reduction.kernel[0], RESIDUAL_SIG),
+        address_of(_no_residuals if res_all is None else res_all, RESIDUALS_SIG),
         0 if res_all is None else reduction.n_branches,
         params,
         np.ascontiguousarray(theta),
@@ -791,7 +798,7 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
 
 if AVAILABLE:
 
-    @njit(cache=True, nogil=True)
+    @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
     def _fk(a, alpha, d, theta, rev, base, q, out, start, stop):
         """Flange poses ``out[k]`` of configurations ``q[k]``, k = ``start .. stop - 1``, of a modified-DH chain
         (world frame, tool not applied). Element by element: slice assignments compile their shape checks and

@@ -347,8 +347,8 @@ def _solve_chunk(
         families, pose_idx, q, err_paper, err_geo, inside, mult = _with_families(
             robot, red, fams, fallback, pose_idx, q, err_paper, err_geo, inside, mult
         )
-    # (already in pose order, as a closed form's candidates and most sweeps' are -- one pose's always: no
-    # reordering copies)
+    # (mostly in pose order already, as a closed form's candidates and most sweeps' are, unless some poses went
+    # through the stepwise path: their rows come last; one pose's always: no reordering copies)
     in_order = len(poses) == 1 or bool(np.all(pose_idx[1:] >= pose_idx[:-1]))
     order = slice(None) if in_order else np.argsort(pose_idx, kind="stable")
     empty_reason = None

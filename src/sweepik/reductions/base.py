@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..robot import Robot
+from .kernels import kernel_owner
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.intp]
@@ -40,8 +41,7 @@ def overridden_below_kernel(cls: type, names: tuple[str, ...]) -> bool:
     """A class of ``cls``'s MRO below the one that sets ``kernel`` defines one of ``names`` (a Python method that the
     compiled kernels would silently bypass). A property of the class: cached, as a solve asks for it several times."""
     mro = cls.__mro__
-    owner = next(c for c in mro if "kernel" in vars(c))
-    below = mro[: mro.index(owner)]
+    below = mro[: mro.index(kernel_owner(cls))]
     return any(name in vars(c) for c in below for name in names)
 
 

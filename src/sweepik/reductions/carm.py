@@ -81,7 +81,7 @@ class _CArmBase(Reduction):
         self.px_snap = PX_SNAP_REL * (self.L1 + self.L2)
 
     def kernel_params(self, poses: Array) -> Array:
-        """``(N, 18)``: the rows of ``kernels.N_PARAMS`` for the compiled kernels (reductions/kernels.py)."""
+        """``(N, 18)``: the columns laid out at ``kernels.N_PARAMS``, for the compiled kernels (kernels.py)."""
         N = poses.shape[0]
         out = np.empty((N, kernels.N_PARAMS))
         out[:, 0:3] = poses[:, :3, 3]

@@ -40,7 +40,7 @@ from numba.extending import register_jitable
 from numpy.typing import NDArray
 
 from .. import parallel
-from .._jit import internal
+from .._jit import ERROR_MODEL, internal
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
 from .kernels import (
@@ -390,7 +390,7 @@ SWING_DEPTH = 2.0
 SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
 def _swing(amp, amps, params, lo, hi, n, periodic, ks, out, start, stop):
     """Swing hints of poses ``start .. stop - 1`` (``swing_hints``). ``amp``: the address of ``amplitude``
     (``kernels.address_of``: called, not linked in: Numba re-optimises everything a compiled function links, and the
@@ -466,8 +466,8 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
         _swing,
         params.shape[0],
         PARALLEL_MIN,
-        address_of(amplitude),
-        address_of(amplitudes),
+        address_of(amplitude, RESIDUAL_SIG),
+        address_of(amplitudes, RESIDUALS_SIG),
         params,
         lo,
         hi,
@@ -519,12 +519,12 @@ def _configure(cfg, params, pose, theta, branch, out):
 
 def evaluate(res, params, pose, theta, branch, out):
     """``out[k] = res(params[pose[k]], theta[k], branch[k])`` (vectorised residual for the NumPy engine)."""
-    _evaluate(address_of(res), params, pose, theta, branch, out)
+    _evaluate(address_of(res, RESIDUAL_SIG), params, pose, theta, branch, out)
 
 
 def configure(cfg, params, pose, theta, branch, out):
     """``cfg(params[pose[k]], theta[k], branch[k], out[k])`` for every k."""
-    _configure(address_of(cfg), params, pose, theta, branch, out)
+    _configure(address_of(cfg, CONFIGURATION_SIG), params, pose, theta, branch, out)
 
 
 #: A closed form's wrist is singular (joint 6's target axis along joint 4's, or along the parallel axes: a continuum
@@ -534,7 +534,7 @@ def configure(cfg, params, pose, theta, branch, out):
 WRIST_SINGULAR = 1e-6
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
 def parallel_singular(params, out, start, stop):
     """``out[i]`` for poses ``start .. stop - 1``: some exact branch of joint 1 leaves pose i with joint 6's axis
     along the parallel axes (joint 6 and the sum of joints 2-4 then turn about one direction: a continuum)."""
@@ -727,6 +727,6 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
             LazyKernel(amplitudes, RESIDUALS_SIG, cache=True),
             LazyKernel(wrist, CONFIGURATION_SIG, cache=True),
             LazyKernel(wrists, CONFIGURATIONS_SIG, cache=True),
-            njit(cache=True, nogil=True)(singular),
+            njit(cache=True, nogil=True, error_model=ERROR_MODEL)(singular),
         )
     return ck

@@ -15,7 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from .._jit import internal
+from .._jit import ERROR_MODEL, internal
+from ..errors import UnknownOptionError
 
 _njit: Any
 try:
@@ -148,7 +149,7 @@ class LazyKernel:
     def __init__(self, fn: Any, sig: Any, **options: Any) -> None:
         self._shared = fn if hasattr(fn, "overloads") else None
         self.py_func = fn if self._shared is None else fn.py_func
-        self._sig, self._options = sig, options
+        self._sig, self._options = sig, {"error_model": ERROR_MODEL, **options}
         self._dispatcher: Any = None
 
     @property
@@ -185,7 +186,7 @@ carm_d1_residuals: Any
 carm_d1_configuration: Any
 carm_theta2_configuration: Any
 if _njit is not None:
-    _carm_d1 = _njit(cache=True)(_carm_d1)  # compiled code (_carm_d1_all) calls the dispatcher
+    _carm_d1 = _njit(cache=True, error_model=ERROR_MODEL)(_carm_d1)  # compiled code (_carm_d1_all) calls the dispatcher
     carm_d1_residual = LazyKernel(_carm_d1, RESIDUAL_SIG)  # (its overload for the engine's signature)
     carm_theta2_residual = LazyKernel(_carm_theta2, RESIDUAL_SIG, cache=True)
     carm_d1_residuals = LazyKernel(_carm_d1_all, RESIDUALS_SIG, cache=True)
@@ -195,44 +196,56 @@ else:  # pragma: no cover
 
 
 def owned_kernel(reduction: Any, name: str) -> Any:
-    """``reduction.<name>`` (an optional kernel: ``kernel_residuals``, ``kernel_configurations``) if the class that
-    sets ``kernel`` sets it too (as a class attribute, or declares it for its instances to set), else None: a
-    subclass with its own ``kernel`` must not get its parent's all-branch kernels."""
-    declared, default = _declared_kernel(reduction.__class__, name)
-    if not declared:
+    """``reduction.<name>`` (an optional kernel: ``kernel_residuals``, ``kernel_configurations``, ``kernel_hints``) if
+    the class that sets ``kernel`` sets it too (as a class attribute, or declares it for its instances to set), else
+    None: a subclass with its own ``kernel`` must not get its parent's all-branch kernels."""
+    owner = kernel_owner(reduction.__class__)
+    if owner is None or name not in vars(owner):
         return None
     # read from the class (a compiled function stored as a class attribute would bind to the instance), unless
     # the instance set its own
-    return vars(reduction).get(name, default)
+    return vars(reduction).get(name, vars(owner)[name])
 
 
 @cache
-def _declared_kernel(cls: type, name: str) -> tuple[bool, Any]:
-    """Whether the class of ``cls``'s MRO that sets ``kernel`` sets ``name`` too, and its value there (a property of
-    the class: cached, as every solve asks)."""
-    owner = next((c for c in cls.__mro__ if "kernel" in vars(c)), None)
-    if owner is None or name not in vars(owner):
-        return False, None
-    return True, vars(owner)[name]
+def kernel_owner(cls: type) -> type | None:
+    """The class of ``cls``'s MRO that sets ``kernel`` (None: none does). Cached: every solve asks."""
+    return next((c for c in cls.__mro__ if "kernel" in vars(c)), None)
 
 
-_ADDRESSES: dict[Any, int] = {}
+_ADDRESSES: dict[Any, tuple[int, Any, set[int]]] = {}
 
 
-def address_of(fn: Any) -> int:
-    """The address of ``fn``'s compiled entry point (``fn`` compiled with exactly one explicit signature: a
-    :class:`LazyKernel` or a dispatcher), for an engine kernel to call it through ``as_residual`` & co.
+def address_of(fn: Any, sig: Any) -> int:
+    """The address of ``fn``'s compiled entry point, for an engine kernel to call it through ``as_residual`` & co.
     (``_jit.function_at``): an int costs nothing to pass, where a first-class function argument costs two Python
-    calls per kernel call. Compiles ``fn`` (or loads it from the cache) on first use; one lookup per function."""
-    address = _ADDRESSES.get(fn)
-    if address is None:
+    calls per kernel call. ``fn`` is a :class:`LazyKernel` or a Numba dispatcher, compiled (here, if need be) for
+    ``sig`` (one of this module's ``*_SIG``), return type included: called through its address, a function of another
+    signature would read its arguments wrong (UnknownOptionError). Compiles ``fn`` or loads it from the cache on
+    first use."""
+    known = _ADDRESSES.get(fn)
+    if known is None:
         if isinstance(fn, LazyKernel):
-            disp, sig = fn.dispatcher, fn.signature
+            disp, own = fn.dispatcher, fn.signature
         else:
-            disp = fn
-            (sig,) = disp.nopython_signatures
-        cres = disp.overloads[sig.args]
-        address = _ADDRESSES[fn] = int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+            if not hasattr(fn, "overloads"):
+                raise UnknownOptionError(f"a reduction's kernel must be a Numba function ({sig}), got {fn!r}")
+            if tuple(sig.args) not in fn.overloads:
+                try:  # (a dispatcher without this signature yet: compiled for it, where it may be)
+                    fn.compile(tuple(sig.args))
+                except Exception as exc:
+                    raise UnknownOptionError(
+                        f"a reduction's kernel {fn!r} cannot be compiled for the engine's signature {sig}: {exc}"
+                    ) from None
+            disp, own = fn, fn.overloads[tuple(sig.args)].signature
+        cres = disp.overloads[own.args]
+        address = int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+        known = _ADDRESSES[fn] = (address, own, set())
+    address, own, checked = known
+    if id(sig) not in checked:  # (the engine's signatures are module constants: compared once each)
+        if own.args != sig.args or own.return_type != sig.return_type:
+            raise UnknownOptionError(f"a reduction's kernel {fn!r} is compiled for {own}, the engine calls it as {sig}")
+        checked.add(id(sig))
     return address
 
 

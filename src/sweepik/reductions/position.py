@@ -41,7 +41,7 @@ import math
 from numba import njit, types
 from numba.extending import overload
 
-from .._jit import internal
+from .._jit import ERROR_MODEL, internal
 from ..subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
 from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
@@ -62,7 +62,7 @@ BRANCHES = {
 }
 
 
-@njit(cache=True)
+@njit(cache=True, error_model=ERROR_MODEL)
 def motion(rev, x):
     """A joint value as a *motion* ``(cos, sin, travel)``: ``(cos x, sin x, 0)`` for a revolute joint,
     ``(1, 0, x)`` for a prismatic one. Kernels rotate by cosines and sines and never need the angle itself."""
@@ -113,7 +113,7 @@ def _turn(h, rev, m, v):
     return v
 
 
-@njit(cache=True)
+@njit(cache=True, error_model=ERROR_MODEL)
 def reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, t):
     """The three-joint problem left when joint ``f`` (0-3) of the first four is fixed at the motion ``x``.
 

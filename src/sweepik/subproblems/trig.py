@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from .._jit import internal
+from .._jit import ERROR_MODEL, internal
 
 __all__ = ["trig2_roots", "trig2"]
 
@@ -40,7 +40,7 @@ SAME_ROOT = 1e-6
 DOUBLE_FLAT = 1e-14
 
 
-@njit(cache=True)
+@njit(cache=True, error_model=ERROR_MODEL)
 def trig2(a0, a1, b1, a2, b2, theta):
     """``f(theta)`` and ``f'(theta)``."""
     c, s = math.cos(theta), math.sin(theta)
@@ -98,7 +98,7 @@ def _companion_roots(c, m):
     return w
 
 
-@njit(cache=True)
+@njit(cache=True, error_model=ERROR_MODEL)
 def trig2_roots(a0, a1, b1, a2, b2):
     """Roots ``(4,)`` (NaN-padded, ascending) of ``a0 + a1 cos t + b1 sin t + a2 cos 2t + b2 sin 2t`` in (-pi, pi],
     and their count. An identically zero ``f`` (every angle a root) gives count -1."""
