@@ -297,22 +297,8 @@ def _solve_chunk(
         parts = [(pose_idx[rows], w, err_paper[rows], err_geo[rows], mult[rows], inside, keep)]
         if due.any():  # (these poses' rows, by the steps; the rows of a pose stay in order, and together)
             sub = np.nonzero(due[pose_idx])[0]
-            parts.append(
-                _settle_stepwise(
-                    robot,
-                    red,
-                    poses,
-                    strategy,
-                    limits,
-                    n_samples,
-                    use_fallback,
-                    pose_idx[sub],
-                    q[sub],
-                    mult[sub],
-                    err_geo[sub],
-                    err_paper[sub],
-                )  # fmt: skip
-            )
+            rest = (pose_idx[sub], q[sub], mult[sub], err_geo[sub], err_paper[sub])
+            parts.append(_settle_stepwise(robot, red, poses, strategy, limits, n_samples, use_fallback, *rest))
         pose_idx, q, err_paper, err_geo, mult, inside, keep = (
             parts[0] if len(parts) == 1 else [np.concatenate(c) for c in zip(*parts, strict=True)]
         )
