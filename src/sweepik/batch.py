@@ -64,18 +64,20 @@ class Block:
             return f"out of joint limits: {self.n_reachable[i]} solution(s) reach the pose but violate the limits"
         return UNREACHABLE
 
-    def solutions(self, i: int) -> Solutions:
-        """The :class:`Solutions` of pose ``i`` (arrays copied: the block stays as it is)."""
+    def solutions(self, i: int, copy: bool = True) -> Solutions:
+        """The :class:`Solutions` of pose ``i``: arrays copied (the block stays as it is), or views of the block's
+        (``copy=False``, for a block made for this one result)."""
         s, e = int(self.bounds[i]), int(self.bounds[i + 1])
+        take = np.copy if copy else np.asarray
         return Solutions(
-            q=self.q[s:e].copy(),
-            error=self.error[s:e].copy(),
-            error_geodesic=self.error_geodesic[s:e].copy(),
-            within_limits=self.within_limits[s:e].copy(),
-            multiplicity=self.multiplicity[s:e].copy(),
+            q=take(self.q[s:e]),
+            error=take(self.error[s:e]),
+            error_geodesic=take(self.error_geodesic[s:e]),
+            within_limits=take(self.within_limits[s:e]),
+            multiplicity=take(self.multiplicity[s:e]),
             families=self.families.get(i, ()),
             reason=self.reason(i),
-            pose=self.poses[i].copy(),
+            pose=take(self.poses[i]),
             robot=self.robot,
         )
 

@@ -749,7 +749,7 @@ def _solve_one(
     held = _held(robot, locked)
     arm = robot if held is None else held.arm
     red, strategy, limits, n_samples, _ = _prepare(arm, P, reduction, strategy, limits, n_samples, 1, free_joint, held)
-    return _expanded(_solve_chunk(arm, red, P, strategy, limits, n_samples), held).solutions(0)
+    return _expanded(_solve_chunk(arm, red, P, strategy, limits, n_samples), held).solutions(0, copy=False)
 
 
 def solve(

@@ -85,7 +85,7 @@ class _CArmBase(Reduction):
         N = poses.shape[0]
         out = np.empty((N, kernels.N_PARAMS))
         out[:, 0:3] = poses[:, :3, 3]
-        out[:, 0] = np.where(np.abs(out[:, 0]) <= self.px_snap, 0.0, out[:, 0])
+        np.copyto(out[:, 0], 0.0, where=np.abs(out[:, 0]) <= self.px_snap)
         out[:, 3:6] = poses[:, :3, 2]
         out[:, 6], out[:, 7] = self.L1, self.L2
         out[:, 8:17] = poses[:, :3, :3].reshape(N, 9)
