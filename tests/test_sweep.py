@@ -178,6 +178,7 @@ def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
     np.testing.assert_array_equal(fastsweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES), ref)
 
 
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="the compiled engine calls kernels by address")
 def test_a_kernel_of_the_wrong_signature_is_refused_and_one_without_is_compiled_for_the_engine() -> None:
     """A reduction's kernel is called through its address: one compiled for another signature (here a float32
     result) would read its arguments wrong and is refused with a clear error; a plain Python function too. A Numba
