@@ -149,7 +149,9 @@ class LazyKernel:
     def __init__(self, fn: Any, sig: Any, **options: Any) -> None:
         self._shared = fn if hasattr(fn, "overloads") else None
         self.py_func = fn if self._shared is None else fn.py_func
-        self._sig, self._options = sig, {"error_model": ERROR_MODEL, **options}
+        # (no C wrapper: the engine calls a kernel by its address with Numba's own convention, Python through the
+        # CPython wrapper; a C wrapper costs ~0.05 s of compilation each)
+        self._sig, self._options = sig, {"error_model": ERROR_MODEL, "no_cfunc_wrapper": True, **options}
         self._dispatcher: Any = None
 
     @property
@@ -186,7 +188,7 @@ carm_d1_residuals: Any
 carm_d1_configuration: Any
 carm_theta2_configuration: Any
 if _njit is not None:
-    _carm_d1 = _njit(cache=True, error_model=ERROR_MODEL)(_carm_d1)  # compiled code (_carm_d1_all) calls the dispatcher
+    _carm_d1 = _njit(cache=True, error_model=ERROR_MODEL, no_cfunc_wrapper=True)(_carm_d1)  # (_carm_d1_all calls it)
     carm_d1_residual = LazyKernel(_carm_d1, RESIDUAL_SIG)  # (its overload for the engine's signature)
     carm_theta2_residual = LazyKernel(_carm_theta2, RESIDUAL_SIG, cache=True)
     carm_d1_residuals = LazyKernel(_carm_d1_all, RESIDUALS_SIG, cache=True)
