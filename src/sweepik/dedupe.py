@@ -352,6 +352,7 @@ if AVAILABLE:
                 for j in range(n):
                     if not math.isfinite(q[k, j]):
                         finite = False
+                        break
                 if not finite:
                     continue
                 e = eg[k]

@@ -669,8 +669,7 @@ def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, p
     hints_kernel = _hints_kernel(reduction) if AVAILABLE else None
     N = poses.shape[0]
     if hints_kernel is not None:
-        red = reduction
-        j = red.free_joint
+        red, j = reduction, reduction.free_joint
         ends = np.zeros(0) if red.periodic else np.array([red.robot.lower[j], red.robot.upper[j]], dtype=np.float64)
         out = np.empty((N, n_samples + red.n_kernel_hints + ends.size))
         parallel.run(

@@ -128,6 +128,14 @@ SNAP_REACH = 1e-4
 SNAP_ITERATIONS = 4
 
 
+def _settle_bounds(robot: Robot) -> tuple[float, float, float, float]:
+    """The precise strategy's thresholds, absolute (times the arm's length scale): polish below, polish above, polish
+    above on the paper's J, acceptance (``POLISH_BELOW_REL`` ... ``ACCEPT_TOL_REL``); the stepwise path and
+    ``dedupe.settle`` take the same values."""
+    ls = robot.length_scale
+    return POLISH_BELOW_REL * ls, POLISH_ABOVE_REL * ls, POLISH_PAPER_ABOVE_REL * ls, ACCEPT_TOL_REL * ls
+
+
 @lru_cache(maxsize=64)
 def _snap_reach(robot: Robot) -> Array:
     """``SNAP_REACH`` per joint (times the length scale for a prismatic one)."""
@@ -284,8 +292,7 @@ def _solve_chunk(
     settled = None
     if strategy == "precise" and err_geo is not None and err_paper is not None:
         # in one compiled pass, but for the poses due a polish, the fallback or a limit snap (few)
-        ls = robot.length_scale
-        bounds = (POLISH_BELOW_REL * ls, POLISH_ABOVE_REL * ls, POLISH_PAPER_ABOVE_REL * ls, ACCEPT_TOL_REL * ls)
+        bounds = _settle_bounds(robot)
         settled = settle(robot, q, err_geo, err_paper, pose_idx, len(poses), bounds, _snap_reach(robot))
     if settled is None:
         pose_idx, q, err_paper, err_geo, mult, inside, keep = _settle_stepwise(
@@ -443,34 +450,27 @@ def _settle_stepwise(
             err_geo, err_paper = err_geo[finite], err_paper[finite]
     if err_geo is None or err_paper is None:
         err_geo, err_paper = _errors(robot, q, poses[pose_idx], weight)
+    below, above, paper_above, accept = _settle_bounds(robot)
     if strategy == "precise":
-        scale = robot.length_scale
-        near = np.nonzero(
-            (err_geo <= POLISH_BELOW_REL * scale)
-            & ((err_geo > POLISH_ABOVE_REL * scale) | (err_paper > POLISH_PAPER_ABOVE_REL * scale))
-        )[0]
+        near = np.nonzero((err_geo <= below) & ((err_geo > above) | (err_paper > paper_above)))[0]
         if near.size:
             target = poses[pose_idx[near]]
-            polished = polish(robot, q[near], target, weight, floor=POLISH_ABOVE_REL * scale)
+            polished = polish(robot, q[near], target, weight, floor=above)
             eg, ep = _errors(robot, polished, target, weight)
             # at a singular configuration the step can drift along the near-null space: never out of the limits
             # for a configuration that was inside them and already certified
-            drift = (
-                (err_geo[near] <= ACCEPT_TOL_REL * scale)
-                & robot.within_limits(q[near])
-                & ~robot.within_limits(polished)
-            )
+            drift = (err_geo[near] <= accept) & robot.within_limits(q[near]) & ~robot.within_limits(polished)
             take = np.nonzero(~drift)[0]
             q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
     if strategy == "precise":
-        certified = err_geo <= ACCEPT_TOL_REL * robot.length_scale
+        certified = err_geo <= accept
     else:
         certified = err_paper < PAPER_ACCEPT_MM / mm_per_unit(robot.length_unit)
     rescue = np.zeros(0, dtype=np.intp)
     if strategy == "precise" and use_fallback and red.fallback is not None:
         # a candidate that polishing could not certify (error between rounding level and 1e-6 of the arm):
         # the reduction's closed form is ill-conditioned there; the fallback reduction solves the pose too
-        miss = ~certified & (err_geo <= POLISH_BELOW_REL * robot.length_scale)
+        miss = ~certified & (err_geo <= below)
         if miss.any():
             rescue = np.unique(pose_idx[miss])
     pose_idx, q, err_paper, err_geo = pose_idx[certified], q[certified], err_paper[certified], err_geo[certified]
