@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import math
 import os
+import weakref
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -666,20 +668,18 @@ def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, p
     """:func:`sweepik.sweep.sample_grid`, the merge compiled (for a single pose its NumPy steps cost ~80 us), and
     the hints too where the reduction has a hints kernel (``Reduction.kernel_hints``; ``params``: its
     ``kernel_params(poses)``, if at hand)."""
-    hints_kernel = _hints_kernel(reduction) if AVAILABLE else None
+    plan = _plan(reduction) if AVAILABLE else None
     N = poses.shape[0]
-    if hints_kernel is not None:
-        red, j = reduction, reduction.free_joint
-        ends = np.zeros(0) if red.periodic else np.array([red.robot.lower[j], red.robot.upper[j]], dtype=np.float64)
-        out = np.empty((N, n_samples + red.n_kernel_hints + ends.size))
+    if plan is not None and plan.hints is not None:
+        out = np.empty((N, n_samples + plan.n_hints + plan.ends.size))
         parallel.run(
             _hinted_grid,
             N,
             PARALLEL_MIN * 16,
-            address_of(hints_kernel, HINTS_SIG),
-            np.ascontiguousarray(red.kernel_params(poses) if params is None else params, dtype=np.float64),
-            ends,
-            bool(red.periodic),
+            plan.hints,
+            np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64),
+            plan.ends,
+            plan.periodic,
             np.ascontiguousarray(lo, dtype=np.float64),
             np.ascontiguousarray(hi, dtype=np.float64),
             _ref._unit_grid(n_samples),
@@ -703,6 +703,52 @@ def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, p
         out,
     )
     return out
+
+
+class _Plan(NamedTuple):
+    """What the engine passes for a reduction besides the poses' rows (``_plan``)."""
+
+    residual: int  # the address of the residual kernel
+    residuals: int  # ... of the all-branch one (``_no_residuals`` where there is none: ``n_all`` is 0)
+    n_all: int
+    branches: NDArray[np.int64]  # the branches searched (writable, as the kernels' signatures take them; unwritten)
+    hints: int | None  # the address of the hints kernel, if any
+    n_hints: int
+    ends: Array  # theta*'s limits, sampled with the hints (none for a periodic theta*)
+    periodic: bool
+
+
+_PLANS: weakref.WeakKeyDictionary[object, _Plan] = weakref.WeakKeyDictionary()
+
+
+def _plan(reduction) -> _Plan:
+    """The reduction's ``_Plan``, worked out on its first search and kept while the reduction lives (a one-pose
+    solve would spend ~10 us a call on it): a reduction's kernels, branches and limits are fixed once it is used."""
+    try:
+        plan = _PLANS.get(reduction)
+    except TypeError:  # (an unhashable reduction: worked out every time)
+        return _make_plan(reduction)
+    if plan is None:
+        plan = _PLANS[reduction] = _make_plan(reduction)
+    return plan
+
+
+def _make_plan(red) -> _Plan:
+    res_all = _kernel_residuals(red)
+    hints = _hints_kernel(red)
+    j = red.free_joint
+    ends = np.zeros(0) if red.periodic else np.array([red.robot.lower[j], red.robot.upper[j]], dtype=np.float64)
+    branches = np.asarray(red.search_branches, dtype=np.int64)
+    return _Plan(
+        residual=address_of(red.kernel[0], RESIDUAL_SIG),
+        residuals=address_of(_no_residuals if res_all is None else res_all, RESIDUALS_SIG),
+        n_all=0 if res_all is None else int(red.n_branches),
+        branches=branches,
+        hints=None if hints is None else address_of(hints, HINTS_SIG),
+        n_hints=0 if hints is None else int(red.n_kernel_hints),
+        ends=ends,
+        periodic=bool(red.periodic),
+    )
 
 
 def _hints_kernel(reduction):
@@ -733,23 +779,23 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
     out_b = np.empty((N, MAX_CAND), dtype=np.int64)
-    out_m = np.ones((N, MAX_CAND), dtype=np.int64)
+    out_m = np.empty((N, MAX_CAND), dtype=np.int64)  # (every slot below a pose's count is written)
     cnt = np.zeros(N, dtype=np.int64)
     fam = np.empty((N, MAX_FAM, 3))
     fcnt = np.zeros(N, dtype=np.int64)
     span = (hi - lo).astype(np.float64)
-    res_all = _kernel_residuals(reduction)
+    plan = _plan(reduction)
     # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
     parallel.run(
         _search,
         N,
         PARALLEL_MIN,
-        address_of(reduction.kernel[0], RESIDUAL_SIG),
-        address_of(_no_residuals if res_all is None else res_all, RESIDUALS_SIG),
-        0 if res_all is None else reduction.n_branches,
+        plan.residual,
+        plan.residuals,
+        plan.n_all,
         params,
         np.ascontiguousarray(theta),
-        np.asarray(reduction.search_branches, dtype=np.int64),
+        plan.branches,
         np.ascontiguousarray(span, dtype=np.float64),
         float(reduction.residual_noise),
         out_t,

@@ -272,19 +272,21 @@ def _solve_chunk(
             q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
             mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp) if sp_mult is None else sp_mult[sp_p, sp_k]])
-        # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
-        if len(spans):
+        fams = {}
+        if len(spans):  # (most sweeps find none)
+            # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
             s_lo, s_hi = np.maximum(spans.lo, lo[spans.pose]), np.minimum(spans.hi, hi[spans.pose])
             keep_span = s_hi > s_lo
             spans = Spans(spans.pose[keep_span], spans.branch[keep_span], s_lo[keep_span], s_hi[keep_span])
-        fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, ACCEPT_TOL_REL * robot.length_scale)
-        if fam_p.size:
-            if err_geo is not None and err_paper is not None:
-                eg_f, ep_f = _errors(robot, fam_q, poses[fam_p], weight)
-                err_geo, err_paper = np.concatenate([err_geo, eg_f]), np.concatenate([err_paper, ep_f])
-            q = np.concatenate([q, fam_q])
-            pose_idx = np.concatenate([pose_idx, fam_p])
-            mult = np.concatenate([mult, np.ones(fam_p.size, dtype=np.intp)])
+            tol = ACCEPT_TOL_REL * robot.length_scale
+            fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, tol)
+            if fam_p.size:
+                if err_geo is not None and err_paper is not None:
+                    eg_f, ep_f = _errors(robot, fam_q, poses[fam_p], weight)
+                    err_geo, err_paper = np.concatenate([err_geo, eg_f]), np.concatenate([err_paper, ep_f])
+                q = np.concatenate([q, fam_q])
+                pose_idx = np.concatenate([pose_idx, fam_p])
+                mult = np.concatenate([mult, np.ones(fam_p.size, dtype=np.intp)])
     else:
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
         mult = np.ones(pose_idx.size, dtype=np.intp)

@@ -129,7 +129,8 @@ class Spans:
 
     @staticmethod
     def empty() -> Spans:
-        return Spans(np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0), np.zeros(0))
+        """No spans (one shared instance, its arrays read-only: most sweeps find none)."""
+        return _NO_SPANS
 
     @staticmethod
     def concat(parts: list[Spans]) -> Spans:
@@ -144,6 +145,16 @@ class Spans:
 
     def __len__(self) -> int:
         return int(self.pose.size)
+
+
+def _no_spans() -> Spans:
+    arrays = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0), np.zeros(0))
+    for a in arrays:
+        a.flags.writeable = False
+    return Spans(*arrays)
+
+
+_NO_SPANS = _no_spans()
 
 
 @lru_cache(maxsize=8)

@@ -84,6 +84,9 @@ class _CArmBase(Reduction):
         """``(N, 18)``: the columns laid out at ``kernels.N_PARAMS``, for the compiled kernels (kernels.py)."""
         N = poses.shape[0]
         out = np.empty((N, kernels.N_PARAMS))
+        if kernels.carm_params is not None:
+            kernels.carm_params(np.asarray(poses, dtype=np.float64), self.L1, self.L2, self.px_snap, out)
+            return out
         out[:, 0:3] = poses[:, :3, 3]
         np.copyto(out[:, 0], 0.0, where=np.abs(out[:, 0]) <= self.px_snap)
         out[:, 3:6] = poses[:, :3, 2]
@@ -212,16 +215,25 @@ class CArmD1(_CArmBase):
         cols = [Pz - t_out, Pz + t_out, Pz - t_in, Pz + t_in, Pz]
         return np.concatenate([np.stack(cols, axis=-1), swing], axis=-1)
 
-    def degenerate(self, poses: Array) -> NDArray[np.bool_]:
+    def _wrist_on_axis(self, poses: Array) -> NDArray[np.bool_] | None:
+        """Poses with the wrist on joint 2's axis, ``|Px| <= 1e-9 (L1 + L2)``; None where none has it (the common
+        case, told for one pose by a float comparison rather than NumPy calls)."""
+        tol = 1e-9 * (self.L1 + self.L2)
+        if poses.shape[0] == 1:
+            return np.ones(1, dtype=bool) if abs(float(poses[0, 0, 3])) <= tol else None
+        near = np.abs(poses[:, 0, 3]) <= tol
+        return near if near.any() else None
+
+    def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
         """Wrist on joint 2's axis (Px = 0) where the orientation does not fix theta2 either (A = B = c = 0 in
         ``special_solutions``, e.g. theta3 = 0, theta4 = -90 deg, theta5 = 0): a continuum along theta2, which a
         d1 sweep cannot describe; carm-theta2 reports it as a family."""
         tol = 1e-9
-        Px, Py, z = poses[:, 0, 3], poses[:, 1, 3], poses[:, :3, 2]
+        near = self._wrist_on_axis(poses)
+        if near is None:
+            return None
+        Py, z = poses[:, 1, 3], poses[:, :3, 2]
         out = np.zeros(poses.shape[0], dtype=bool)
-        near = np.abs(Px) <= tol * (self.L1 + self.L2)
-        if not near.any():
-            return out
         for eps in (1.0, -1.0):
             c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))
             with np.errstate(invalid="ignore"):
@@ -231,16 +243,13 @@ class CArmD1(_CArmBase):
 
     def search_range(self, poses: Array) -> Array:
         L = self.L1 + self.L2
-        Pz = poses[:, 2, 3]
-        out = np.empty((poses.shape[0], 2))
-        out[:, 0], out[:, 1] = Pz - L, Pz + L
-        return out
+        return poses[:, 2, 3, None] + np.array([-L, L])
 
     def special_solutions(self, poses: Array) -> Array | None:
         """Wrist on joint 2's axis (Px = 0, d1 = Pz): u = 0, theta34 from the elbow, theta2 from the
         orientation (``A cos theta2 + B sin theta2 = c``). 4 candidates per pose (NaN where none)."""
-        sel = np.abs(poses[:, 0, 3]) <= 1e-9 * (self.L1 + self.L2)
-        if not sel.any():
+        sel = self._wrist_on_axis(poses)
+        if sel is None:
             return None
         Px, Py, Pz, z, R = _unpack(poses, 0, self.px_snap)
         out = []
@@ -309,7 +318,16 @@ class CArmTheta2(_CArmBase):
             cols += [a, -a, np.pi - a, a - np.pi]
         return np.stack(cols, axis=-1)
 
-    def degenerate(self, poses: Array) -> NDArray[np.bool_]:
+    def _wrist_on_axis(self, poses: Array) -> NDArray[np.bool_] | None:
+        """Poses with the wrist on joint 2's axis, ``|Px| <= 1e-9 (L1 + L2)``; None where none has it (the common
+        case, told for one pose by a float comparison rather than NumPy calls)."""
+        tol = 1e-9 * (self.L1 + self.L2)
+        if poses.shape[0] == 1:
+            return np.ones(1, dtype=bool) if abs(float(poses[0, 0, 3])) <= tol else None
+        near = np.abs(poses[:, 0, 3]) <= tol
+        return near if near.any() else None
+
+    def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
         """Wrist in the plane Px = 0: self-motion families (theta2 = +-90 deg with theta5 = 0) lie in the blind
         spot cos(theta2) = 0, where a theta2 sweep cannot describe them; carm-d1 reports them."""
         return np.asarray(np.abs(poses[:, 0, 3]) <= 1e-9 * (self.L1 + self.L2))
