@@ -386,24 +386,18 @@ def _repeated_pieces(
     if P < 2:
         return dup
     tol = _MEMBER_TOL * np.maximum(1.0, hi - lo)
-    # pairs (i, j), j < i, of the same pose with the same interval (within i's tolerance), pose by pose
+    # pairs (i, j), j < i, of the same pose with the same interval (within i's tolerance): every earlier piece of
+    # each piece's pose, all at once (a pose has a few pieces)
     order = np.argsort(pose, kind="stable")
-    cuts = np.flatnonzero(np.diff(pose[order])) + 1
-    pairs_i, pairs_j = [], []
-    for g in np.split(order, cuts):
-        if g.size < 2:
-            continue
-        same = (
-            (np.abs(lo[g][:, None] - lo[g][None, :]) <= tol[g][:, None])
-            & (np.abs(hi[g][:, None] - hi[g][None, :]) <= tol[g][:, None])
-            & np.tri(g.size, k=-1, dtype=bool)
-        )
-        a, b = np.nonzero(same)
-        pairs_i.append(g[a])
-        pairs_j.append(g[b])
-    if not pairs_i:
+    first = np.searchsorted(pose[order], pose[order], side="left")  # where each piece's pose starts in ``order``
+    earlier = np.arange(P) - first
+    n_pairs = int(earlier.sum())
+    if n_pairs == 0:
         return dup
-    pi, pj = np.concatenate(pairs_i), np.concatenate(pairs_j)
+    step = np.arange(n_pairs) - np.repeat(np.cumsum(earlier) - earlier, earlier)
+    a, b = order[np.repeat(np.arange(P), earlier)], order[np.repeat(first, earlier) + step]
+    same = (np.abs(lo[a] - lo[b]) <= tol[a]) & (np.abs(hi[a] - hi[b]) <= tol[a])
+    pi, pj = a[same], b[same]
     if pi.size == 0:
         return dup
     # every pair's members compared at once (5 points of the interval), then the pairs in order

@@ -553,10 +553,14 @@ def _run(kernel, n, min_parallel, K, robot, red, chain, world, params, cfg, *mid
 
 if AVAILABLE:
 
-    @lazy_njit((_CFG, float64[:, ::1], int64[::1], float64[::1], int64[::1], float64[:, ::1]), cache=True)
-    def _configurations(cfg, params, pose, theta, branch, q):
+    @lazy_njit(
+        (_CFG, float64[:, ::1], int64[::1], float64[::1], int64[::1], float64[:, ::1], int64, int64),
+        cache=True,
+        nogil=True,
+    )
+    def _configurations(cfg, params, pose, theta, branch, q, start, stop):
         cfg = as_configuration(cfg)
-        for k in range(pose.shape[0]):
+        for k in range(start, stop):
             cfg(params[pose[k]], theta[k], branch[k], q[k])
 
 
@@ -565,7 +569,10 @@ def configurations(robot: Robot, red: Reduction, chain: Array, pose: IntArray, t
     ``solve_rest`` for reductions with a kernel; NaN rows where the branch does not exist)."""
     q = np.empty((pose.shape[0], robot.n_joints))
     assert red.kernel is not None  # callers check red.uses_kernel
-    _configurations(
+    parallel.run(
+        _configurations,
+        pose.shape[0],
+        16 * PARALLEL_MIN,
         address_of(red.kernel[1], CONFIGURATION_SIG),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
         pose.astype(np.int64),
