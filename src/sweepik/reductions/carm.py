@@ -95,6 +95,15 @@ class _CArmBase(Reduction):
         out[:, 17] = poses[:, 0, 3]
         return out
 
+    def _wrist_on_axis(self, poses: Array) -> NDArray[np.bool_] | None:
+        """Poses with the wrist on joint 2's axis, ``|Px| <= 1e-9 (L1 + L2)``; None where none has it (the common
+        case, told for one pose by a float comparison rather than NumPy calls)."""
+        tol = 1e-9 * (self.L1 + self.L2)
+        if poses.shape[0] == 1:
+            return np.ones(1, dtype=bool) if abs(float(poses[0, 0, 3])) <= tol else None
+        near = np.abs(poses[:, 0, 3]) <= tol
+        return near if near.any() else None
+
     def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
         """(d1, C2, S2, u, Py, C34, S34, z, R) at theta*; each subclass ties theta2 and d1 its own way."""
         raise NotImplementedError
@@ -215,15 +224,6 @@ class CArmD1(_CArmBase):
         cols = [Pz - t_out, Pz + t_out, Pz - t_in, Pz + t_in, Pz]
         return np.concatenate([np.stack(cols, axis=-1), swing], axis=-1)
 
-    def _wrist_on_axis(self, poses: Array) -> NDArray[np.bool_] | None:
-        """Poses with the wrist on joint 2's axis, ``|Px| <= 1e-9 (L1 + L2)``; None where none has it (the common
-        case, told for one pose by a float comparison rather than NumPy calls)."""
-        tol = 1e-9 * (self.L1 + self.L2)
-        if poses.shape[0] == 1:
-            return np.ones(1, dtype=bool) if abs(float(poses[0, 0, 3])) <= tol else None
-        near = np.abs(poses[:, 0, 3]) <= tol
-        return near if near.any() else None
-
     def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
         """Wrist on joint 2's axis (Px = 0) where the orientation does not fix theta2 either (A = B = c = 0 in
         ``special_solutions``, e.g. theta3 = 0, theta4 = -90 deg, theta5 = 0): a continuum along theta2, which a
@@ -318,19 +318,10 @@ class CArmTheta2(_CArmBase):
             cols += [a, -a, np.pi - a, a - np.pi]
         return np.stack(cols, axis=-1)
 
-    def _wrist_on_axis(self, poses: Array) -> NDArray[np.bool_] | None:
-        """Poses with the wrist on joint 2's axis, ``|Px| <= 1e-9 (L1 + L2)``; None where none has it (the common
-        case, told for one pose by a float comparison rather than NumPy calls)."""
-        tol = 1e-9 * (self.L1 + self.L2)
-        if poses.shape[0] == 1:
-            return np.ones(1, dtype=bool) if abs(float(poses[0, 0, 3])) <= tol else None
-        near = np.abs(poses[:, 0, 3]) <= tol
-        return near if near.any() else None
-
     def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
         """Wrist in the plane Px = 0: self-motion families (theta2 = +-90 deg with theta5 = 0) lie in the blind
         spot cos(theta2) = 0, where a theta2 sweep cannot describe them; carm-d1 reports them."""
-        return np.asarray(np.abs(poses[:, 0, 3]) <= 1e-9 * (self.L1 + self.L2))
+        return self._wrist_on_axis(poses)
 
     def special_solutions(self, poses: Array) -> tuple[Array, IntArray] | None:
         """Solutions near the blind spot cos(theta2) = 0, found with the d1 reduction (with their multiplicity).
