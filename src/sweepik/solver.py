@@ -231,7 +231,7 @@ def _solve_chunk(
         lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
     weight = orientation_weight(robot.length_unit)
     spans = Spans.empty()
-    fams: dict[int, list[Family]]
+    fams: dict[int, list[Family]] = {}  # (poses with self-motion families: few)
     compiled = red.uses_kernel and fastsweep.AVAILABLE
     err_geo = err_paper = None
     if strategy == "precise" or closed:
@@ -272,7 +272,6 @@ def _solve_chunk(
             q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
             mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp) if sp_mult is None else sp_mult[sp_p, sp_k]])
-        fams = {}
         if len(spans):  # (most sweeps find none)
             # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
             s_lo, s_hi = np.maximum(spans.lo, lo[spans.pose]), np.minimum(spans.hi, hi[spans.pose])
@@ -290,7 +289,6 @@ def _solve_chunk(
     else:
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
         mult = np.ones(pose_idx.size, dtype=np.intp)
-        fams = {}
     settled = None
     if strategy == "precise" and err_geo is not None and err_paper is not None:
         # in one compiled pass, but for the poses due a polish, the fallback or a limit snap (few)
