@@ -92,3 +92,18 @@ def test_read_only_poses(name: str, tmp_path) -> None:
     a, b = sweepik.solve_many(robot, mapped), sweepik.solve_many(robot, poses)
     np.testing.assert_array_equal(a.q, b.q)
     np.testing.assert_array_equal(sweepik.solve(robot, mapped[0]).q, b[0].q)
+
+
+@pytest.mark.parametrize("name", ["carm", "ur5"])
+def test_chunks_solved_side_by_side_change_nothing(name):
+    """Several chunks are solved two at a time on threads (parallel.in_order): the same columns as one chunk, and
+    iter_solve yields the same solutions in the same order."""
+    robot = sweepik.load_robot(name)
+    T = _poses(robot, np.random.default_rng(11), 150)
+    one = sweepik.solve_many(robot, T)
+    many = sweepik.solve_many(robot, T, chunk_size=7)
+    for col in ("offsets", "q", "error", "multiplicity", "within_limits"):
+        assert np.array_equal(getattr(one, col), getattr(many, col)), col
+    streamed = list(sweepik.iter_solve(robot, T, chunk_size=7))
+    assert len(streamed) == len(T)
+    assert all(np.array_equal(s.q, one[i].q) for i, s in enumerate(streamed))

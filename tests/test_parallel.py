@@ -51,3 +51,47 @@ def test_numba_thread_setting_is_honoured():
         assert seen == [(0, 500, threading.get_ident())] and np.all(out == 1)
     finally:
         numba.set_num_threads(before)
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 5])
+def test_in_order_yields_every_result_in_order(n):
+    seen: list[int] = []
+
+    def work(k):
+        seen.append(threading.get_ident())
+        return k * k
+
+    assert list(parallel.in_order(work, range(n))) == [k * k for k in range(n)]
+    if n < 2 or parallel.threads() == 1:
+        assert all(t == threading.get_ident() for t in seen)  # (nothing to overlap: in the calling thread)
+
+
+def test_in_order_raises_where_the_result_is_due():
+    def work(k):
+        if k == 3:
+            raise ValueError("chunk 3")
+        return k
+
+    results = parallel.in_order(work, range(6))
+    assert [next(results) for _ in range(3)] == [0, 1, 2]
+    with pytest.raises(ValueError, match="chunk 3"):
+        next(results)
+
+
+def test_in_order_threads_see_the_callers_setting():
+    n = parallel.threads()
+    assert list(parallel.in_order(lambda _: parallel.threads(), range(4))) == [n] * 4
+    assert parallel.threads() == n  # (the setting is the chunk threads' own)
+
+
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="Numba's thread setting")
+def test_in_order_with_one_thread_runs_in_the_calling_thread():
+    import numba
+
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        idents = list(parallel.in_order(lambda _: threading.get_ident(), range(4)))
+        assert idents == [threading.get_ident()] * 4
+    finally:
+        numba.set_num_threads(before)

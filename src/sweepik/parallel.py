@@ -8,16 +8,23 @@ function whose module re-optimises everything it calls (about 10 s of the first 
 
 The number of threads is Numba's: ``NUMBA_NUM_THREADS`` (default: the number of cores), or what
 ``numba.set_num_threads`` set in the calling thread (a Dask task pins its kernels to one thread that way).
+
+A batch solved in chunks runs them two at a time (``in_order``): one chunk's Python steps (holding the GIL) then
+overlap the other's compiled kernels, which would otherwise leave a core idle between kernels.
 """
 
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
-from typing import Any
+from typing import Any, TypeVar
 
-__all__ = ["run", "threads"]
+__all__ = ["in_order", "run", "threads"]
+
+T = TypeVar("T")
+R = TypeVar("R")
 
 #: Parts per thread a batch is split into: threads that finish early take the next part (the items of a batch
 #: differ in cost), while each part stays large enough that handing it to a thread (~50 us) costs little.
@@ -26,6 +33,11 @@ PARTS_PER_THREAD = 4
 _pool: ThreadPoolExecutor | None = None
 _pool_size = 0
 _pool_lock = threading.Lock()
+#: Chunks of a batch in flight at once (``in_order``): two keep both cores busy; each holds a chunk's work arrays.
+IN_FLIGHT = 2
+_chunk_pool: ThreadPoolExecutor | None = None
+#: The caller's thread setting, seen by ``threads()`` in a chunk's thread (Numba's setting is per thread).
+_local = threading.local()
 
 
 def threads() -> int:
@@ -38,6 +50,9 @@ def threads() -> int:
 
     # numba.get_num_threads() starts Numba's own thread pool (~60 ms) to read a setting that only
     # numba.set_num_threads changes, and set_num_threads starts that pool itself
+    inherited = getattr(_local, "threads", None)
+    if inherited is not None:
+        return int(inherited)
     if not getattr(parallel, "_is_initialized", True):
         return int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
     return int(numba.get_num_threads())
@@ -69,3 +84,48 @@ def run(kernel: Callable[..., Any], n: int, min_parallel: int, *args: Any) -> No
     futures: list[Future[Any]] = [pool.submit(fn, *args, bounds[k], bounds[k + 1]) for k in range(parts)]
     for f in futures:
         f.result()  # (re-raises a kernel's exception)
+
+
+def _chunk_executor() -> ThreadPoolExecutor:
+    global _chunk_pool
+    with _pool_lock:
+        if _chunk_pool is None:  # (its own pool: a chunk waits on the kernel pool's threads, never on its own)
+            _chunk_pool = ThreadPoolExecutor(max_workers=IN_FLIGHT, thread_name_prefix="sweepik-chunk")
+        return _chunk_pool
+
+
+def _with_threads(n: int, fn: Callable[[T], R], item: T) -> R:
+    _local.threads = n
+    try:
+        return fn(item)
+    finally:
+        _local.threads = None
+
+
+def in_order(fn: Callable[[T], R], items: Sequence[T]) -> Iterator[R]:
+    """``fn(item)`` for each item, yielded in order. With two items or more and more than one thread allowed
+    (``threads()``), ``IN_FLIGHT`` items are worked on at once in background threads, each seeing the caller's
+    thread setting, and the next one is queued while a result is awaited. ``fn`` must be safe to run in two threads
+    at once. An exception of ``fn`` is raised where its item's result is due; items not started when the caller
+    stops are dropped."""
+    nt = threads()
+    if nt <= 1 or len(items) < 2:  # (in the calling thread: nothing to overlap)
+        yield from map(fn, items)
+        return
+    pool = _chunk_executor()
+    it = iter(items)
+    pending: deque[Future[R]] = deque()
+    try:
+        for item in it:
+            pending.append(pool.submit(_with_threads, nt, fn, item))
+            if len(pending) >= IN_FLIGHT:
+                break
+        while pending:
+            first = pending.popleft()
+            for item in it:  # (the next item starts before this one's result is handed on)
+                pending.append(pool.submit(_with_threads, nt, fn, item))
+                break
+            yield first.result()
+    finally:
+        for f in pending:
+            f.cancel()

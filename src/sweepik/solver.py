@@ -15,7 +15,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import fastcertify, fastsweep
+from . import fastcertify, fastsweep, parallel
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch
 from .dedupe import finish, merged_multiplicity, settle, wrap_inside
@@ -569,7 +569,7 @@ def solve_many(
     held = _held(robot, locked)
     arm = robot if held is None else held.arm
     red, strat, lim, ns, cs = _prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
-    blocks = [_solve_chunk(arm, red, P[s : s + cs], strat, lim, ns) for s in range(0, P.shape[0], cs)]
+    blocks = parallel.in_order(lambda s: _solve_chunk(arm, red, P[s : s + cs], strat, lim, ns), range(0, len(P), cs))
     return SolutionBatch(robot, [_expanded(b, held) for b in blocks])
 
 
@@ -587,8 +587,9 @@ def iter_solve(
     locked: Mapping[Any, float] | None = None,
 ) -> Iterator[Solutions]:
     """The solutions of each pose in ``poses (N, 4, 4)``, yielded one pose after the other as
-    :func:`solve_many` computes them, a chunk of poses at a time: only one chunk's results are alive at once,
-    so memory stays bounded whatever ``N`` (for streaming millions of poses to a file).
+    :func:`solve_many` computes them, a chunk of poses at a time: only a few chunks' results are alive at once
+    (the one being yielded and the next ones being solved, see ``parallel.in_order``), so memory stays bounded
+    whatever ``N`` (for streaming millions of poses to a file).
 
     Arguments are checked when it is called, before the first solution is asked for. ``progress(stage, done,
     total)``, if given, is called with stage ``"solve"`` before the first chunk and after each one.
@@ -729,8 +730,12 @@ def _iter_checked(
     total = P.shape[0]
     if progress is not None:
         progress("solve", 0, total)
-    for s in range(0, total, chunk_size):
-        yield from _expanded(_solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples), held)
+    starts = range(0, total, chunk_size)
+    blocks = parallel.in_order(
+        lambda s: _solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples), starts
+    )
+    for s, block in zip(starts, blocks, strict=True):
+        yield from _expanded(block, held)
         if progress is not None:
             progress("solve", min(s + chunk_size, total), total)
 
