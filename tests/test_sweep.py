@@ -406,3 +406,22 @@ def test_compiled_sample_grid_is_the_numpy_one() -> None:
     poses = np.broadcast_to(np.eye(4), (N, 4, 4))
     ref = sweep.sample_grid(red, poses, lo, hi, n)
     np.testing.assert_array_equal(fastsweep.sample_grid(red, poses, lo, hi, n), ref)
+
+
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+def test_margins_made_per_call_share_their_pair_plans_engine_plan() -> None:
+    """The generic sweeps' margins are a reduction made afresh for each solve: the engine's plan of them (kernels,
+    branches, limits) is worked out once per pair plan (``plan_key``), and is the one a fresh plan would be."""
+    from sweepik.reductions.generic import _Margins
+
+    robot = load_robot("fanuc_crx10ia")
+    red = sweepik.get_reduction(robot, "auto")
+    m1, m2 = _Margins(red, np.zeros((1, 0))), _Margins(red, np.zeros((2, 0)))
+    assert fastsweep._plan(m1) is fastsweep._plan(m2)
+    fresh = fastsweep._make_plan(m2)
+    got = fastsweep._plan(m2)
+    assert (got.residual, got.residuals, got.n_all, got.hints) == (fresh.residual, fresh.residuals, fresh.n_all, None)
+    assert np.array_equal(got.branches, fresh.branches) and np.array_equal(got.ends, fresh.ends)
+    other = sweepik.get_reduction(load_robot("kinova_jaco2"), "auto")
+    if not other.closed_form:
+        assert fastsweep._plan(_Margins(other, np.zeros((1, 0)))) is not fastsweep._plan(m1)

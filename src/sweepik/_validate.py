@@ -187,19 +187,22 @@ def _gram_deviation_det(R: NDArray[np.float64]) -> tuple[NDArray[np.float64], ND
 def _one_pose_ok(arr: NDArray[np.float64]) -> bool:
     """One pose ``(4, 4)`` passes every check of ``check_poses`` (the same tests in scalar arithmetic; a pose that
     fails goes through those checks for their message)."""
-    m = arr.tolist()
-    if not all(math.isfinite(v) for row in m for v in row):
+    (a, b, c, x), (d, e, f, y), (g, h, k, z), (r0, r1, r2, r3) = arr.tolist()
+    # (a sum is finite only if every term is; one that overflows merely sends the pose to the full checks)
+    if not math.isfinite(a + b + c + x + d + e + f + y + g + h + k + z + r0 + r1 + r2 + r3):
         return False
-    if max(abs(m[3][0]), abs(m[3][1]), abs(m[3][2]), abs(m[3][3] - 1.0)) > ORTHONORMAL_TOL:
+    if max(abs(r0), abs(r1), abs(r2), abs(r3 - 1.0)) > ORTHONORMAL_TOL:
         return False
-    if max(abs(m[0][3]), abs(m[1][3]), abs(m[2][3])) > MAX_TRANSLATION:
+    if max(abs(x), abs(y), abs(z)) > MAX_TRANSLATION:
         return False
-    dev = 0.0
-    for i in range(3):
-        for j in range(i, 3):
-            g = m[0][i] * m[0][j] + m[1][i] * m[1][j] + m[2][i] * m[2][j]
-            dev = max(dev, abs(g - (1.0 if i == j else 0.0)))
-    (a, b, c), (d, e, f), (g, h, k) = m[0][:3], m[1][:3], m[2][:3]
+    dev = max(  # the columns' dot products against the identity's
+        abs(a * a + d * d + g * g - 1.0),
+        abs(b * b + e * e + h * h - 1.0),
+        abs(c * c + f * f + k * k - 1.0),
+        abs(a * b + d * e + g * h),
+        abs(a * c + d * f + g * k),
+        abs(b * c + e * f + h * k),
+    )
     det = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g)
     return dev <= ORTHONORMAL_TOL and abs(det - 1.0) <= ORTHONORMAL_TOL
 

@@ -724,12 +724,14 @@ _PLANS: weakref.WeakKeyDictionary[object, _Plan] = weakref.WeakKeyDictionary()
 def _plan(reduction) -> _Plan:
     """The reduction's ``_Plan``, worked out on its first search and kept while the reduction lives (a one-pose
     solve would spend ~10 us a call on it): a reduction's kernels, branches and limits are fixed once it is used."""
+    # (a reduction made afresh for each call, as the generic sweeps' margins, names a lasting ``plan_key``)
+    key = getattr(reduction, "plan_key", reduction)
     try:
-        plan = _PLANS.get(reduction)
+        plan = _PLANS.get(key)
     except TypeError:  # (an unhashable reduction: worked out every time)
         return _make_plan(reduction)
     if plan is None:
-        plan = _PLANS[reduction] = _make_plan(reduction)
+        plan = _PLANS[key] = _make_plan(reduction)
     return plan
 
 

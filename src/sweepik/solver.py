@@ -318,8 +318,9 @@ def _solve_chunk(
     n_reachable = np.bincount(pose_idx[keep], minlength=len(poses))
     if limits:
         keep &= inside
-    pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
-    mult = mult[keep]
+    if not keep.all():  # (often all of them: a single pose's candidates are then used as they are)
+        pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
+        mult = mult[keep]
     fallback: dict[int, Solutions] = {}
     if strategy == "precise" and use_fallback and red.fallback is not None:
         deg = red.degenerate(chain)

@@ -187,6 +187,9 @@ class CArmD1(_CArmBase):
 
     def __init__(self, robot: Robot) -> None:
         super().__init__(robot, free_joint=0, n_branches=4)
+        L = self.L1 + self.L2
+        self._reach = np.array([-L, L])  # (read only: shared by every search range)
+        self._reach.flags.writeable = False
 
     def _signs(self, ndim: int, branch: IntArray | None) -> tuple[Array, Array]:
         if branch is None:
@@ -203,7 +206,7 @@ class CArmD1(_CArmBase):
         sigma, eps = self._signs(theta.ndim, branch)
         d1 = theta[..., None] if branch is None else theta
         t = Pz - d1
-        r = np.hypot(Px, t)
+        r = np.sqrt(Px * Px + t * t)  # (as the kernels: kernels._d1_position)
         safe = r > 0
         rr = np.where(safe, r, 1.0)
         c2 = np.where(safe, sigma * Px / rr, sigma)
@@ -242,8 +245,7 @@ class CArmD1(_CArmBase):
         return out
 
     def search_range(self, poses: Array) -> Array:
-        L = self.L1 + self.L2
-        return poses[:, 2, 3, None] + np.array([-L, L])
+        return poses[:, 2, 3, None] + self._reach
 
     def special_solutions(self, poses: Array) -> Array | None:
         """Wrist on joint 2's axis (Px = 0, d1 = Pz): u = 0, theta34 from the elbow, theta2 from the

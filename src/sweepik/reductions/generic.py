@@ -120,6 +120,7 @@ class GeometricReduction(Reduction):
     def __init__(self, robot: Robot, plan: Plan) -> None:
         super().__init__(robot, plan.free_joint, plan.branches)
         self.plan = plan
+        self._margins_key = _PlanKey()  # (see _Margins)
         self.name = f"{plan.family}-{robot.joint_names[plan.free_joint]}" if plan.family == "pair" else "closed-form"
         self.closed_form = plan.closed_form
         chain = robot.chain.reversed() if plan.reversed else robot.chain
@@ -299,8 +300,9 @@ class GeometricReduction(Reduction):
         lo, hi = self._range(poses)
         swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
         ks = np.asarray(self._steps[1], dtype=np.int64)
+        params = self.kernel_params(poses)
         geometric.swing_hints(
-            self.kernel_params(poses),
+            params,
             lo,
             hi,
             N_SAMPLES,
@@ -312,7 +314,7 @@ class GeometricReduction(Reduction):
         )
         keep = np.any(np.isfinite(swings), axis=0)
         swings = swings[:, keep]
-        theta = np.concatenate([_Margins(self, swings).zeros(poses, lo, hi), swings], axis=1)
+        theta = np.concatenate([_Margins(self, swings).zeros(poses, lo, hi, params), swings], axis=1)
         keep = np.any(np.isfinite(theta), axis=0)
         return theta[:, keep] if keep.any() else None
 
@@ -418,6 +420,13 @@ def _classes(f: Array) -> list[list[int]]:
     return classes
 
 
+class _PlanKey:
+    """A pair plan's key to the engine's cached plan of its margins (``fastsweep._plan``): a fresh ``_Margins``
+    is made for each call, so the plan cannot be kept with it."""
+
+    __slots__ = ("__weakref__",)
+
+
 class _Margins(Reduction):
     """The margins ``1 - c^2`` of a pair plan's branch domains, as a residual with three branches (the first
     step's, and the second step's on either branch of the first), so that the sweep finds their zeros."""
@@ -434,6 +443,8 @@ class _Margins(Reduction):
         super().__init__(red.robot, red.free_joint, 3)
         self.red = red
         self.swings = swings
+        # the engine's plan (kernels, branches, limits) is the pair plan's, not the call's: kept with the plan
+        self.plan_key = red._margins_key
         self.kernel = (red._case_kernels.pair_margin, red._case_kernels.pair_configuration)
         self.kernel_residuals = red._case_kernels.pair_margins
 
@@ -450,13 +461,14 @@ class _Margins(Reduction):
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         raise NotImplementedError("margins have no configurations")
 
-    def zeros(self, poses: Array, lo: Array, hi: Array) -> Array:
-        """Zeros ``(N, K)`` (NaN-padded) of every margin over theta*'s sweep range ``[lo, hi]``."""
+    def zeros(self, poses: Array, lo: Array, hi: Array, params: Array | None = None) -> Array:
+        """Zeros ``(N, K)`` (NaN-padded) of every margin over theta*'s sweep range ``[lo, hi]`` (``params``: the pair
+        plan's ``kernel_params(poses)``, if at hand)."""
         from .. import fastsweep, sweep  # local: the engine imports the reductions
 
         N = poses.shape[0]
         if fastsweep.AVAILABLE:
-            cand, _ = fastsweep.search(self, poses, lo, hi, sweep.N_SAMPLES)
+            cand, _ = fastsweep.search(self, poses, lo, hi, sweep.N_SAMPLES, params)
         else:
             cand, _ = sweep.find_candidates(self, poses, lo, hi, sweep.N_SAMPLES)
         if N == 1:
