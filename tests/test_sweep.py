@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 
 import sweepik
 from sweepik import fastsweep, load_robot, solve_many
+from sweepik.bench import grid_configurations
 from sweepik.rootfind import find_roots
 from sweepik.solutions import joint_distance
 
@@ -338,8 +341,8 @@ def test_closed_form_all_branch_configurations_are_bitwise_the_one_branch_ones(
     ("name", "reduction"), [("carm", "carm-d1"), ("carm", "auto"), ("ur5", "auto"), ("xarm6", None)]
 )
 def test_compiled_family_steps_are_the_numpy_ones(name: str, reduction: str | None) -> None:
-    """The family pieces' compiled steps give the NumPy steps' values bit for bit: the cut bisection
-    (``fastcertify.bisect_members`` against ``families._members_ok`` step by step, with and without limits) and
+    """The family pieces' compiled steps give the NumPy steps' values bit for bit: the cut location
+    (``fastcertify.locate_cuts`` against ``families._locate_cuts``, with and without limits) and
     the golden-section search for limit dips (``fastcertify.dip_search`` against ``families._golden_dips``,
     including members that do not exist, NaN limit excess, and the common stop of all dips)."""
     from sweepik import families, fastcertify, solver
@@ -361,14 +364,11 @@ def test_compiled_family_steps_are_the_numpy_ones(name: str, reduction: str | No
     b = a + (hi - lo)[pose] * rng.uniform(-0.1, 0.1, K)
     tol = solver.ACCEPT_TOL_REL * robot.length_scale
     for limits in (True, False):
-        got = fastcertify.bisect_members(robot, red, chain, world, pose, branch, a, b, 12, limits, tol)
-        ra, rb = a.copy(), b.copy()
-        for _ in range(12):
-            mid = 0.5 * (ra + rb)
-            on = families._members_ok(robot, red, chain, world, pose, branch, mid[:, None], limits, tol)[:, 0]
-            ra, rb = np.where(on, mid, ra), np.where(on, rb, mid)
-        np.testing.assert_array_equal(got[0], ra)
-        np.testing.assert_array_equal(got[1], rb)
+        for steps in (12, 32):
+            got = fastcertify.locate_cuts(robot, red, chain, world, pose, branch, a, b, steps, limits, tol)
+            ref = families._locate_cuts(robot, red, chain, world, pose, branch, a, b, steps, limits, tol)
+            np.testing.assert_array_equal(got[0], ref[0])
+            np.testing.assert_array_equal(got[1], ref[1])
     best_x = 0.5 * (a + b)
     best_e = np.full(K, 10.0 * robot.length_scale)
     ref = families._golden_dips(robot, red, chain, pose, branch, a, b, best_x, best_e)
@@ -425,3 +425,61 @@ def test_margins_made_per_call_share_their_pair_plans_engine_plan() -> None:
     other = sweepik.get_reduction(load_robot("kinova_jaco2"), "auto")
     if not other.closed_form:
         assert fastsweep._plan(_Margins(other, np.zeros((1, 0)))) is not fastsweep._plan(m1)
+
+
+def _captured_cuts(monkeypatch: pytest.MonkeyPatch, solve: Any) -> list[tuple[Any, ...]]:
+    """The arguments of every cut location a solve asks for (compiled or NumPy)."""
+    from sweepik import families, fastcertify
+
+    seen: list[tuple[Any, ...]] = []
+    compiled, reference = fastcertify.locate_cuts, families._locate_cuts
+
+    def spy_compiled(*args: Any) -> Any:
+        seen.append(args)
+        return compiled(*args)
+
+    def spy_reference(*args: Any) -> Any:
+        seen.append(args)
+        return reference(*args)
+
+    monkeypatch.setattr(fastcertify, "locate_cuts", spy_compiled)
+    monkeypatch.setattr(families, "_locate_cuts", spy_reference)
+    solve()
+    monkeypatch.undo()
+    return seen
+
+
+@pytest.mark.parametrize("name", ["carm", "kuka_iiwa14"])
+def test_family_cuts_are_where_bisection_puts_them(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The family pieces' ends (``families._locate_cuts``: false position on the limit excess, bisection elsewhere)
+    on real cuts, with and without limits: the end stays a certified member and the point past it is not, the
+    bracket is as narrow as asked, and the end is where 60 plain bisections of ``_members_ok`` put it."""
+    from sweepik import families
+
+    robot = load_robot(name)
+    if name == "carm":
+        P = robot.fk(grid_configurations(include_singular=True)[6840:6880])
+        kw: dict[str, Any] = {}
+    else:  # (A3 locked, the wrist singular: families cut by the limits of the other joints)
+        q = np.random.default_rng(0).uniform(robot.lower, robot.upper, size=(12, 7))
+        q[:, 2], q[:, 5] = 0.3, 0.0
+        P, kw = robot.fk(q), {"locked": {"A3": 0.3}}
+    calls = []
+    for limits in (True, False):
+        calls += _captured_cuts(monkeypatch, lambda lim=limits: sweepik.solve_many(robot, P, limits=lim, **kw))
+    assert any(c[9] for c in calls) and sum(c[6].size for c in calls) >= 10
+    for arm, red, chain, world, pose, branch, a, b, steps, limits, tol in calls:
+        got_a, got_b = families._locate_cuts(arm, red, chain, world, pose, branch, a, b, steps, limits, tol)
+
+        def ok(x: np.ndarray) -> np.ndarray:
+            return families._members_ok(arm, red, chain, world, pose, branch, x[:, None], limits, tol)[:, 0]  # noqa: B023
+
+        assert ok(got_a).all() and not ok(got_b).any()
+        target = np.ldexp(np.abs(b - a), -steps)
+        assert np.all(np.abs(got_b - got_a) <= target * (1 + 1e-9))
+        ra, rb = np.array(a), np.array(b)
+        for _ in range(60):
+            mid = 0.5 * (ra + rb)
+            on = ok(mid)
+            ra, rb = np.where(on, mid, ra), np.where(on, rb, mid)
+        assert np.all(np.abs(got_a - ra) <= 2.0 * target), np.max(np.abs(got_a - ra) / target)

@@ -227,7 +227,7 @@ if AVAILABLE:
         cache=True,
         nogil=True,
     )
-    def _bisect_members(
+    def _locate_cuts(
         cfg,
         params,
         world,
@@ -251,27 +251,78 @@ if AVAILABLE:
         start,
         stop,
     ):
-        """Cuts ``start .. stop - 1``: ``steps`` bisections of ``[a[k], b[k]]`` (``a`` a certified family member,
+        """Cuts ``start .. stop - 1``: ``families._locate_cuts`` step for step (``a`` a certified family member,
         ``b`` not), ``a`` and ``b`` updated in place."""
         cfg = as_configuration(cfg)
-        q = np.empty((1, H.shape[0]))
+        n = H.shape[0]
+        q = np.empty((1, n))
         eg = np.empty(1)
         ep = np.empty(1)
         zd = np.empty(4)
+        ga, gb, gx = np.empty(n), np.empty(n), np.empty(n)  # each joint's limit excess at a, b and the new point
         for k in range(start, stop):
-            i = pose[k]
+            i, br = pose[k], branch[k]
             zd[0] = 0.0
-            for _ in range(steps):
-                mid = 0.5 * (a[k] + b[k])
-                cfg(params[i], mid, branch[k], q[0])
-                _certify_row(H, P, rev, R_end, weight, q, world[i], zd, 0, eg, ep)
-                on = eg[0] <= tol  # (inf where the member does not exist)
-                if on and limits:
-                    on = wrap_inside_row(q[0], jrev, lower, upper, ltol, beyond)
+            ak, bk = a[k], b[k]
+            target = math.ldexp(abs(bk - ak), -steps)
+            for j in range(n):
+                ga[j] = gb[j] = math.nan
+            if limits:
+                _member(cfg, params[i], ak, br, q, world[i], zd, eg, ep, H, P, rev, R_end, weight, tol, limits,
+                        jrev, lower, upper, ltol, beyond, ga)  # fmt: skip
+                _member(cfg, params[i], bk, br, q, world[i], zd, eg, ep, H, P, rev, R_end, weight, tol, limits,
+                        jrev, lower, upper, ltol, beyond, gb)  # fmt: skip
+            w1 = w2 = w3 = math.inf  # the bracket's widths 1, 2 and 3 steps ago
+            side = 0
+            for _ in range(3 * steps + 3):
+                w = abs(bk - ak)
+                if w <= target:
+                    break
+                t = 0.5
+                js = 0  # the joint furthest outside its limits at b (the first of equals)
+                for j in range(1, n):
+                    if gb[j] > gb[js]:
+                        js = j
+                if ga[js] <= 0.0 and gb[js] > 0.0 and w <= 0.5 * w3:  # (NaN: no interpolation)
+                    tmin = 0.5 * target / w
+                    t = min(max(ga[js] / (ga[js] - gb[js]), tmin), 1.0 - tmin)
+                x = ak + t * (bk - ak)
+                on = _member(cfg, params[i], x, br, q, world[i], zd, eg, ep, H, P, rev, R_end, weight, tol, limits,
+                             jrev, lower, upper, ltol, beyond, gx)  # fmt: skip
                 if on:
-                    a[k] = mid
+                    ak = x
+                    for j in range(n):
+                        ga[j] = gx[j]
+                        if side == 1:
+                            gb[j] = 0.5 * gb[j]
+                    side = 1
                 else:
-                    b[k] = mid
+                    bk = x
+                    for j in range(n):
+                        gb[j] = gx[j]
+                        if side == -1:
+                            ga[j] = 0.5 * ga[j]
+                    side = -1
+                w3, w2, w1 = w2, w1, w
+            a[k], b[k] = ak, bk
+
+    @internal
+    def _member(
+        cfg, p, x, br, q, Td, zd, eg, ep, H, P, rev, R_end, weight, tol, limits, jrev, lower, upper, ltol, beyond, ex
+    ):
+        """Whether the family member at ``x`` is certified and, with ``limits``, inside them; each joint's limit
+        excess into ``ex``, as ``families._members_ok`` with ``excess`` (NaN where it is not certified or without
+        limits)."""
+        cfg(p, x, br, q[0])
+        _certify_row(H, P, rev, R_end, weight, q, Td, zd, 0, eg, ep)
+        on = eg[0] <= tol  # (inf where the member does not exist)
+        for j in range(ex.shape[0]):
+            ex[j] = math.nan
+        if on and limits:
+            on = wrap_inside_row(q[0], jrev, lower, upper, ltol, beyond)
+            for j in range(ex.shape[0]):
+                ex[j] = max((lower[j] - ltol[j]) - q[0, j], q[0, j] - (upper[j] + ltol[j]))
+        return on
 
     @internal
     def _limit_excess_row(q, jrev, lower, upper, ltol, beyond):
@@ -488,15 +539,14 @@ def tool_poses(robot, q: Array, target: Array | None = None, weight: float = 1.0
     return out, err
 
 
-def bisect_members(robot, red, chain: Array, world: Array, pose, branch, a: Array, b: Array, steps: int, limits, tol):
-    """``steps`` bisections of each ``[a, b]`` between a family member that is a certified solution (FK error
-    within ``tol`` and, with ``limits``, inside the joint limits) and one that is not, as
-    ``families._members_ok`` decides: the last certified points ``a`` (new arrays; ``b`` too)."""
+def locate_cuts(robot, red, chain: Array, world: Array, pose, branch, a: Array, b: Array, steps: int, limits, tol):
+    """``families._locate_cuts`` compiled, value for value: the last certified points ``a`` and the first others
+    ``b`` (new arrays)."""
     a, b = np.array(a, dtype=np.float64), np.array(b, dtype=np.float64)
     args = (pose.astype(np.int64), branch.astype(np.int64), a, b, int(steps), bool(limits), float(tol))
     geometry = chain_args(robot)
     parallel.run(
-        _bisect_members,
+        _locate_cuts,
         a.size,
         PARALLEL_MIN,
         address_of(red.kernel[1], CONFIGURATION_SIG),
