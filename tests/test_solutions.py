@@ -51,3 +51,23 @@ def test_families_with_limits_stay_inside_the_limits(name: str, lock: str | None
             assert robot.within_limits(members).all(), (q.tolist(), fam.interval)
             checked += 1
     assert checked >= 30
+
+
+def test_family_member_at_a_removable_singular_point_is_a_solution() -> None:
+    """A C-Arm family along the rail can pass d1 = Pz with the wrist on joint 2's axis, where carm-d1's closed form
+    breaks down (u = 0: theta2 undefined): ``Family.at`` there still gives a solution (the member next to the point,
+    whose limit the solution there is), as everywhere else in the interval."""
+    robot = sweepik.load_robot("carm")
+    checked = 0
+    for d1, t2, t6 in [(500.0, 90.0, -60.0), (500.0, 90.0, 0.0), (1500.0, -90.0, 30.0), (200.0, 90.0, 60.0)]:
+        q = np.array([d1, np.radians(t2), 0.0, 0.0, 0.0, np.radians(t6)])
+        T = robot.fk(q)
+        for fam in sweepik.solve(robot, T).families:
+            lo, hi = fam.interval
+            pz = float(fam.chain_pose[2, 3])
+            if not lo < pz < hi or abs(fam.chain_pose[0, 3]) > 1e-9:
+                continue
+            members = fam.at(np.array([pz, lo, 0.5 * (lo + hi), hi]))
+            np.testing.assert_allclose(robot.fk(members), np.broadcast_to(T, (4, 4, 4)), atol=1e-9)
+            checked += 1
+    assert checked >= 2

@@ -33,6 +33,42 @@ def family_members(
     return red.solve_rest(chain[pose], theta[:, None], branch[:, None])[:, 0]
 
 
+#: Where the branch's closed form breaks down at an isolated theta* of a family (a removable singular point, e.g. the
+#: C-Arm's wrist crossing joint 2's axis, d1 = Pz), ``certified_members`` gives the member this far away (relative
+#: to the interval): the branch is continuous on either side, and the solution at the point is their limit.
+_NUDGE_REL = 2.0**-30
+
+
+def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Array, lo: float, hi: float) -> Array:
+    """Members ``(K, n)`` at ``theta (K,)`` (inside ``[lo, hi]``) of one family (chain pose ``(4, 4)``, branch),
+    each certified by FK: one that is not is replaced by the member ``_NUDGE_REL (hi - lo)`` further in, or back
+    (if neither is a solution, it is left as it is)."""
+    robot = red.robot
+    tol = 2e-13 * robot.length_scale  # (solver.ACCEPT_TOL_REL: the solver's own acceptance of a solution)
+    weight = orientation_weight(robot.length_unit)
+
+    def members(x: Array) -> tuple[Array, NDArray[np.bool_]]:
+        pose, branches = np.zeros(x.size, np.intp), np.full(x.size, branch, dtype=np.intp)
+        q = family_members(robot, red, chain_pose[None], pose, branches, x)
+        flange = fastsweep.flange_poses(robot, np.nan_to_num(q))
+        err = pose_error_geodesic(robot.T_base_world @ flange, chain_pose, weight)
+        return q, np.all(np.isfinite(q), axis=-1) & (err <= tol)
+
+    q, ok = members(theta)
+    if ok.all():
+        return q
+    bad = np.nonzero(~ok)[0]
+    step = _NUDGE_REL * max(hi - lo, 1.0)
+    for sign in (1.0, -1.0):
+        x = np.clip(theta[bad] + sign * step, lo, hi)
+        qn, okn = members(x)
+        q[bad[okn]] = qn[okn]
+        bad = bad[~okn]
+        if bad.size == 0:
+            break
+    return q
+
+
 @overload
 def _members_ok(
     robot: Robot,

@@ -111,20 +111,20 @@ class Family:
     held: HeldJoints | None = field(default=None, repr=False)
 
     def at(self, theta: ArrayLike) -> Array:
-        """Member configuration(s) ``(n,)`` (or ``(..., n)``) at theta* value(s) inside ``interval``."""
+        """Member configuration(s) ``(n,)`` (or ``(..., n)``) at theta* value(s) inside ``interval``. Each is a
+        solution of the pose: at an isolated theta* where the reduction's closed form breaks down (the C-Arm's
+        wrist crossing joint 2's axis), the member ~1e-9 of the interval away is given, the solution there being
+        its limit."""
         th = np.asarray(theta, dtype=np.float64)
         lo, hi = self.interval
         tol = _FAMILY_EDGE_TOL * max(hi - lo, 1.0)
         if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
             raise SweepikError(f"theta* = {th.tolist()} is outside the family's interval [{lo:.12g}, {hi:.12g}]")
         flat = np.clip(th.reshape(-1), lo, hi)
-        from .families import family_members  # local import: families imports this module
+        from .families import certified_members  # local import: families imports this module
 
         red = self.reduction
-        q = family_members(
-            red.robot, red, self.chain_pose[None], np.zeros(flat.size, np.intp), np.full(flat.size, self.branch), flat
-        )
-        q = red.robot.wrap(q)
+        q = red.robot.wrap(certified_members(red, self.chain_pose, self.branch, flat, lo, hi))
         if self.held is not None:
             q = self.held.expand(q)
         return q.reshape(*th.shape, -1)
