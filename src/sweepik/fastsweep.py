@@ -299,12 +299,14 @@ if AVAILABLE:
             fc = f[j]
             if math.isnan(fm) or math.isnan(fc) or math.isnan(fp):
                 continue
+            # (the cheap tests first: a local minimum of |f| without a sign change is rare, its curvature dearer)
+            if not (abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0):
+                continue
             hl, hr = th[j] - tm, tp - th[j]
             if not (hl > 0 and hr > 0):
                 continue
             ddj = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr)
-            may_touch = abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2
-            if abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0 and may_touch:
+            if abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2:  # (it may touch zero)
                 _extremum(res, p, b, tm, th[j], tp, fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
         for j in range(M):  # samples next to a domain edge (or at the range ends, level 0)
             if not valid[j]:
