@@ -95,3 +95,16 @@ def test_in_order_with_one_thread_runs_in_the_calling_thread():
         assert idents == [threading.get_ident()] * 4
     finally:
         numba.set_num_threads(before)
+
+
+def test_in_order_nested_in_a_chunk_runs_in_that_chunks_thread():
+    """A chunk that itself solves in chunks (``fn`` calling ``in_order``) must not wait on the pool it runs on."""
+
+    def inner(k):
+        return threading.get_ident()
+
+    def outer(k):
+        me = threading.get_ident()
+        return all(t == me for t in parallel.in_order(inner, range(3)))
+
+    assert all(parallel.in_order(outer, range(4)))

@@ -43,8 +43,10 @@ def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Arr
     """Members ``(K, n)`` at ``theta (K,)`` (inside ``[lo, hi]``) of one family (chain pose ``(4, 4)``, branch),
     each certified by FK: one that is not is replaced by the member ``_NUDGE_REL (hi - lo)`` further in, or back
     (if neither is a solution, it is left as it is)."""
+    from .solver import ACCEPT_TOL_REL  # local: the solver imports this module
+
     robot = red.robot
-    tol = 2e-13 * robot.length_scale  # (solver.ACCEPT_TOL_REL: the solver's own acceptance of a solution)
+    tol = ACCEPT_TOL_REL * robot.length_scale  # (the solver's own acceptance of a solution)
     weight = orientation_weight(robot.length_unit)
 
     def members(x: Array) -> tuple[Array, NDArray[np.bool_]]:

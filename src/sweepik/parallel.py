@@ -41,7 +41,8 @@ _local = threading.local()
 
 
 def threads() -> int:
-    """Threads a batch kernel may use in the calling thread (Numba's setting, see the module docstring)."""
+    """Threads a batch kernel may use in the calling thread (Numba's setting, see the module docstring; in a chunk's
+    thread of ``in_order``, its caller's)."""
     try:
         import numba
         from numba.np.ufunc import parallel
@@ -105,11 +106,12 @@ def _with_threads(n: int, fn: Callable[[T], R], item: T) -> R:
 def in_order(fn: Callable[[T], R], items: Sequence[T]) -> Iterator[R]:
     """``fn(item)`` for each item, yielded in order. With two items or more and more than one thread allowed
     (``threads()``), ``IN_FLIGHT`` items are worked on at once in background threads, each seeing the caller's
-    thread setting, and the next one is queued while a result is awaited. ``fn`` must be safe to run in two threads
-    at once. An exception of ``fn`` is raised where its item's result is due; items not started when the caller
-    stops are dropped."""
+    thread setting, and the next one is queued while a result is awaited (called from one of those threads, it
+    runs in that thread). ``fn`` must be safe to run in two threads at once. An exception of ``fn`` is raised where
+    its item's result is due; items not started when the caller stops are dropped."""
     nt = threads()
-    if nt <= 1 or len(items) < 2:  # (in the calling thread: nothing to overlap)
+    # (in the calling thread: nothing to overlap, or a chunk's own thread, which must not wait on its own pool)
+    if nt <= 1 or len(items) < 2 or getattr(_local, "threads", None) is not None:
         yield from map(fn, items)
         return
     pool = _chunk_executor()
