@@ -123,6 +123,40 @@ def test_all_branch_kernel_is_bitwise_the_branch_kernel() -> None:
     assert fastsweep._kernel_residuals(OwnKernel(CARM)) is None
 
 
+def test_carm_d1_twin_branches_have_the_same_residual_bit_for_bit() -> None:
+    """carm-d1 declares branches (sigma, eps) and (-sigma, -eps) twins (the engine searches one of each pair and
+    hands its roots to the other): their residuals agree bit for bit, in the NumPy reference and in the kernels,
+    also with the wrist on joint 2's axis (r = 0), outside the elbow's domain (NaN) and at range ends; their
+    configurations differ."""
+    red = sweepik.get_reduction(CARM, "carm-d1")
+    assert red.twins == ((0, 3), (1, 2)) and red.search_branches == [0, 1]
+    q = _stress(300, seed=12)
+    q[:20, 0], q[:20, 1] = 800.0, 0.0  # the wrist on joint 2's axis at d1 = Pz
+    chain = CARM.fk(q)
+    lo, hi = red.search_range(chain).T
+    rng = np.random.default_rng(8)
+    theta = np.concatenate([lo[:, None] + (hi - lo)[:, None] * rng.random((len(q), 30)), chain[:, 2, 3, None],
+                            lo[:, None], hi[:, None]], axis=1)  # fmt: skip
+    f = red.residual(chain, theta)
+    assert np.isnan(f).any() and np.isfinite(f).any()
+    for a, b in red.twins:
+        np.testing.assert_array_equal(f[..., a], f[..., b])
+        cfg_a = red.solve_rest(chain, theta, np.full(theta.shape, a))
+        cfg_b = red.solve_rest(chain, theta, np.full(theta.shape, b))
+        both = np.all(np.isfinite(cfg_a), axis=-1) & np.all(np.isfinite(cfg_b), axis=-1)
+        assert both.any() and np.all(np.any(cfg_a[both] != cfg_b[both], axis=-1))
+    if fastsweep.AVAILABLE:
+        from sweepik.reductions import kernels
+
+        params = red.kernel_params(chain)
+        for i in range(0, len(q), 7):
+            for th in theta[i]:
+                for a, b in red.twins:
+                    fa = kernels.carm_d1_residual(params[i], float(th), a)
+                    fb = kernels.carm_d1_residual(params[i], float(th), b)
+                    assert fa == fb or (np.isnan(fa) and np.isnan(fb))
+
+
 def test_carm_d1_hints_kernel_is_bitwise_sample_hints() -> None:
     """carm-d1's compiled hints (with them the engine builds a pose's samples in one pass) are exactly what
     ``sample_hints`` gives: where Px is tiny (snapped to 0 in the kernel parameters, not in the hints), where the

@@ -178,12 +178,15 @@ def _twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candid
         return cand, spans
     c_rows, c_branch = _twin_rows(red, cand.branch)
     s_rows, s_branch = _twin_rows(red, spans.branch)
+    pose = np.concatenate([cand.pose, cand.pose[c_rows]])
+    # in pose order again, as the search gave them (certification and settling run on parts of whole poses)
+    order = np.argsort(pose, kind="stable") if pose.size > 1 and pose[0] != pose[-1] else slice(None)
     return (
         Candidates(
-            np.concatenate([cand.pose, cand.pose[c_rows]]),
-            np.concatenate([cand.branch, c_branch]),
-            np.concatenate([cand.theta, cand.theta[c_rows]]),
-            np.concatenate([cand.mult, cand.mult[c_rows]]),
+            pose[order],
+            np.concatenate([cand.branch, c_branch])[order],
+            np.concatenate([cand.theta, cand.theta[c_rows]])[order],
+            np.concatenate([cand.mult, cand.mult[c_rows]])[order],
         ),
         Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])]),
     )

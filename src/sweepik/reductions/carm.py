@@ -178,6 +178,10 @@ class CArmD1(_CArmBase):
     """
 
     name = "carm-d1"
+    #: Branches (sigma, eps) and (-sigma, -eps) have the same residual, bit for bit: c2, s2, u and the elbow's root
+    #: change sign together, so C34 does too and S34 does not, and the residual's products keep their values (IEEE
+    #: arithmetic is symmetric under sign changes). Their configurations differ (theta2 by pi, the elbow mirrored).
+    twins = ((0, 3), (1, 2))
     kernel = (kernels.carm_d1_residual, kernels.carm_d1_configuration)
     kernel_residuals = kernels.carm_d1_residuals
     kernel_hints = kernels.carm_d1_hints
