@@ -30,7 +30,7 @@ from .reductions.decompose import not_sweepable
 from .reductions.kernels import owned_kernel
 from .robot import Robot
 from .solutions import Family, Solutions
-from .sweep import N_SAMPLES, Candidates, Spans, find_candidates
+from .sweep import N_SAMPLES, Candidates, Spans, find_candidates, twin_copies
 from .units import mm_per_unit, orientation_weight
 
 __all__ = ["solve", "solve_many", "iter_solve", "STRATEGIES"]
@@ -171,39 +171,6 @@ def _snap_to_limits(
     return w_all, inside
 
 
-def _twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candidates, Spans]:
-    """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
-    branches of the class too: their residuals are the same, their configurations differ."""
-    if not red.twins:
-        return cand, spans
-    c_rows, c_branch = _twin_rows(red, cand.branch)
-    s_rows, s_branch = _twin_rows(red, spans.branch)
-    pose = np.concatenate([cand.pose, cand.pose[c_rows]])
-    # in pose order again, as the search gave them (certification and settling run on parts of whole poses)
-    order = np.argsort(pose, kind="stable") if pose.size > 1 and pose[0] != pose[-1] else slice(None)
-    return (
-        Candidates(
-            pose[order],
-            np.concatenate([cand.branch, c_branch])[order],
-            np.concatenate([cand.theta, cand.theta[c_rows]])[order],
-            np.concatenate([cand.mult, cand.mult[c_rows]])[order],
-        ),
-        Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])]),
-    )
-
-
-def _twin_rows(red: Reduction, branch: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
-    that branch: ``(rows, branches)``."""
-    rows, branches = [np.zeros(0, np.intp)], [np.zeros(0, np.intp)]
-    for cls in red.twins:
-        k = np.nonzero(branch == cls[0])[0]
-        for b in cls[1:]:
-            rows.append(k)
-            branches.append(np.full(k.size, b, dtype=np.intp))
-    return np.concatenate(rows).astype(np.intp), np.concatenate(branches)
-
-
 @lru_cache(maxsize=16)
 def _every_branch(n_poses: int, n_branches: int) -> Candidates:
     """Candidates of a closed form: every branch of every pose (theta* unused: 0). Cached (a chunk's size and a
@@ -252,13 +219,13 @@ def _solve_chunk(
                 q = q[:, 0]
         elif compiled:
             params = red.kernel_params(chain)
-            cand, spans = _twin_copies(red, *fastsweep.search(red, chain, lo, hi, n_samples, params))
+            cand, spans = twin_copies(red, *fastsweep.search(red, chain, lo, hi, n_samples, params))
             cand = _limit_copies(robot, red, cand, hi - lo)
             q, err_geo, err_paper = fastcertify.certify(
                 robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
             )
         else:
-            cand, spans = _twin_copies(red, *find_candidates(red, chain, lo, hi, n_samples))
+            cand, spans = twin_copies(red, *find_candidates(red, chain, lo, hi, n_samples))
             cand = _limit_copies(robot, red, cand, hi - lo)
             q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         pose_idx, mult = cand.pose, cand.mult

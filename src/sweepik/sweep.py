@@ -663,3 +663,36 @@ def find_candidates(
     search.scan(p, b, theta[p], fs, vs, 0)
     cand = search.finish()
     return cand, Spans.concat([spans, search.spans])
+
+
+def twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candidates, Spans]:
+    """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
+    branches of the class too: their residuals are the same, their configurations differ."""
+    if not red.twins:
+        return cand, spans
+    c_rows, c_branch = _twin_rows(red, cand.branch)
+    s_rows, s_branch = _twin_rows(red, spans.branch)
+    pose = np.concatenate([cand.pose, cand.pose[c_rows]])
+    # in pose order again, as the search gave them (certification and settling run on parts of whole poses)
+    order = np.argsort(pose, kind="stable") if pose.size > 1 and pose[0] != pose[-1] else slice(None)
+    return (
+        Candidates(
+            pose[order],
+            np.concatenate([cand.branch, c_branch])[order],
+            np.concatenate([cand.theta, cand.theta[c_rows]])[order],
+            np.concatenate([cand.mult, cand.mult[c_rows]])[order],
+        ),
+        Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])]),
+    )
+
+
+def _twin_rows(red: Reduction, branch: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
+    that branch: ``(rows, branches)``."""
+    rows, branches = [np.zeros(0, np.intp)], [np.zeros(0, np.intp)]
+    for cls in red.twins:
+        k = np.nonzero(branch == cls[0])[0]
+        for b in cls[1:]:
+            rows.append(k)
+            branches.append(np.full(k.size, b, dtype=np.intp))
+    return np.concatenate(rows).astype(np.intp), np.concatenate(branches)

@@ -337,7 +337,7 @@ class CArmTheta2(_CArmBase):
         For poses with |Px| below ``BLIND_PX_REL * (L1 + L2)`` the d1 sweep supplies the solutions with
         |cos(theta2)| <= ``BLIND_COS``; the theta2 sweep supplies all others.
         """
-        from ..sweep import find_candidates  # local import: the engine imports this package
+        from ..sweep import find_candidates, twin_copies  # local import: the engine imports this package
 
         Px = poses[:, 0, 3]
         idx = np.nonzero(np.abs(Px) <= BLIND_PX_REL * (self.L1 + self.L2))[0]
@@ -345,7 +345,7 @@ class CArmTheta2(_CArmBase):
             return None
         d1red = CArmD1(self.robot)
         rng = d1red.search_range(poses[idx])
-        cand, _ = find_candidates(d1red, poses[idx], rng[:, 0], rng[:, 1])
+        cand, _ = twin_copies(d1red, *find_candidates(d1red, poses[idx], rng[:, 0], rng[:, 1]))
         q = d1red.solve_rest(poses[idx][cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
         keep = np.all(np.isfinite(q), axis=-1) & (np.abs(np.cos(q[:, 1])) <= BLIND_COS)
         pose, q, mult = cand.pose[keep], q[keep], cand.mult[keep]
