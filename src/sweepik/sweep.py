@@ -667,32 +667,50 @@ def find_candidates(
 
 def twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candidates, Spans]:
     """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
-    branches of the class too: their residuals are the same, their configurations differ."""
+    branches of the class too: their residuals are the same, their configurations differ. A pose's copies follow
+    its own candidates, poses stay in order."""
     if not red.twins:
         return cand, spans
     c_rows, c_branch = _twin_rows(red, cand.branch)
-    s_rows, s_branch = _twin_rows(red, spans.branch)
     pose = np.concatenate([cand.pose, cand.pose[c_rows]])
     # in pose order again, as the search gave them (certification and settling run on parts of whole poses)
     order = np.argsort(pose, kind="stable") if pose.size > 1 and pose[0] != pose[-1] else slice(None)
-    return (
-        Candidates(
-            pose[order],
-            np.concatenate([cand.branch, c_branch])[order],
-            np.concatenate([cand.theta, cand.theta[c_rows]])[order],
-            np.concatenate([cand.mult, cand.mult[c_rows]])[order],
-        ),
-        Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])]),
+    cand = Candidates(
+        pose[order],
+        np.concatenate([cand.branch, c_branch])[order],
+        np.concatenate([cand.theta, cand.theta[c_rows]])[order],
+        np.concatenate([cand.mult, cand.mult[c_rows]])[order],
     )
+    if len(spans):  # (most sweeps find none)
+        s_rows, s_branch = _twin_rows(red, spans.branch)
+        spans = Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])])
+    return cand, spans
 
 
-def _twin_rows(red: Reduction, branch: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+def _twin_rows(red: Reduction, branch: IntArray) -> tuple[IntArray, IntArray]:
     """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
     that branch: ``(rows, branches)``."""
-    rows, branches = [np.zeros(0, np.intp)], [np.zeros(0, np.intp)]
-    for cls in red.twins:
-        k = np.nonzero(branch == cls[0])[0]
-        for b in cls[1:]:
-            rows.append(k)
-            branches.append(np.full(k.size, b, dtype=np.intp))
+    rows, branches = [], []
+    for twin in _twin_maps(red.twins, red.n_branches):
+        t = twin[branch]
+        k = np.nonzero(t >= 0)[0]
+        rows.append(k)
+        branches.append(t[k])
+    if len(rows) == 1:  # (classes of two: one map)
+        return rows[0], branches[0]
     return np.concatenate(rows).astype(np.intp), np.concatenate(branches)
+
+
+@lru_cache(maxsize=64)
+def _twin_maps(twins: tuple[tuple[int, ...], ...], n_branches: int) -> tuple[IntArray, ...]:
+    """For the d-th other member of the classes of ``twins`` (d = 1, 2, ...): each branch's twin in that place (-1:
+    none), read only."""
+    maps = []
+    for d in range(1, max(len(cls) for cls in twins)):
+        twin = np.full(n_branches, -1, dtype=np.intp)
+        for cls in twins:
+            if len(cls) > d:
+                twin[cls[0]] = cls[d]
+        twin.flags.writeable = False
+        maps.append(twin)
+    return tuple(maps)
