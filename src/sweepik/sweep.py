@@ -691,7 +691,7 @@ def _twin_rows(red: Reduction, branch: IntArray) -> tuple[IntArray, IntArray]:
     """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
     that branch: ``(rows, branches)``."""
     rows, branches = [], []
-    for twin in _twin_maps(red.twins, red.n_branches):
+    for twin in _twin_maps(tuple(tuple(int(b) for b in cls) for cls in red.twins), red.n_branches):
         t = twin[branch]
         k = np.nonzero(t >= 0)[0]
         rows.append(k)
