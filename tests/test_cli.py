@@ -274,3 +274,20 @@ def test_cli_refuses_at_once(argv: list[str], capsys: pytest.CaptureFixture[str]
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_interrupt_is_one_line_and_status_130(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C during a command (here: while a solve prints) ends with one line on stderr and status 130, not a
+    traceback."""
+    import sweepik.cli as cli
+
+    def interrupted(args: object) -> int:
+        print("first pose")
+        raise KeyboardInterrupt
+
+    monkeypatch.setitem(cli._COMMANDS, "fk", (cli._COMMANDS["fk"][0], interrupted))
+    code, out, err = run(capsys, "fk", "carm", "0", "0", "0", "0", "0", "0")
+    assert code == 130 and out == "first pose\n"
+    assert err.strip().splitlines() == ["sweepik: interrupted"]

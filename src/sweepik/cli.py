@@ -42,7 +42,7 @@ from .robot_file import bundled_robots
 __all__ = ["main", "build_parser"]
 
 from .cli_analyze import add_analyze_parser, cmd_analyze, plan_line
-from .cli_batch import add_sample_parser, cmd_sample
+from .cli_batch import EXIT_INTERRUPTED, add_sample_parser, cmd_sample
 from .cli_common import (
     DEFAULT_ROBOT,
     EXIT_IO,
@@ -340,6 +340,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (OSError, UnicodeError) as exc:  # unreadable or undecodable robot file
         _error(str(exc))
         return EXIT_IO
+    except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback (what was printed so far stays printed)
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":  # pragma: no cover
