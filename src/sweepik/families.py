@@ -5,7 +5,6 @@ A piece that shrinks to a point where a family touches the limits becomes an iso
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -47,14 +46,11 @@ def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Arr
 
     robot = red.robot
     tol = ACCEPT_TOL_REL * robot.length_scale  # (the solver's own acceptance of a solution)
-    weight = orientation_weight(robot.length_unit)
 
     def members(x: Array) -> tuple[Array, NDArray[np.bool_]]:
         pose, branches = np.zeros(x.size, np.intp), np.full(x.size, branch, dtype=np.intp)
         q = family_members(robot, red, chain_pose[None], pose, branches, x)
-        flange = fastsweep.flange_poses(robot, np.nan_to_num(q))
-        err = pose_error_geodesic(robot.T_base_world @ flange, chain_pose, weight)
-        return q, np.all(np.isfinite(q), axis=-1) & (err <= tol)
+        return q, _solve_chain(robot, q, chain_pose, tol)
 
     q, ok = members(theta)
     if ok.all():
@@ -71,8 +67,16 @@ def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Arr
     return q
 
 
-@overload
-def _members_ok(
+def _solve_chain(robot: Robot, q: Array, chain: Array, tol: float) -> NDArray[np.bool_]:
+    """``q (..., n)`` are finite and solve the chain poses ``chain`` (broadcast against ``(..., 4, 4)``) within
+    ``tol`` (geodesic error of the flange frame; NumPy)."""
+    qz = np.nan_to_num(q)
+    flange = fastsweep.flange_poses(robot, qz.reshape(-1, qz.shape[-1])).reshape(*qz.shape[:-1], 4, 4)
+    err = pose_error_geodesic(robot.T_base_world @ flange, chain, orientation_weight(robot.length_unit))
+    return np.asarray(np.all(np.isfinite(q), axis=-1) & (err <= tol))
+
+
+def _certified(
     robot: Robot,
     red: Reduction,
     chain: Array,
@@ -80,43 +84,10 @@ def _members_ok(
     pose: NDArray[np.intp],
     branch: NDArray[np.intp],
     theta: Array,
-    limits: bool,
     tol: float,
-    excess: Literal[False] = False,
-) -> NDArray[np.bool_]: ...
-
-
-@overload
-def _members_ok(
-    robot: Robot,
-    red: Reduction,
-    chain: Array,
-    world: Array,
-    pose: NDArray[np.intp],
-    branch: NDArray[np.intp],
-    theta: Array,
-    limits: bool,
-    tol: float,
-    excess: Literal[True],
-) -> tuple[NDArray[np.bool_], Array]: ...
-
-
-def _members_ok(
-    robot: Robot,
-    red: Reduction,
-    chain: Array,
-    world: Array,
-    pose: NDArray[np.intp],
-    branch: NDArray[np.intp],
-    theta: Array,
-    limits: bool,
-    tol: float,
-    excess: bool = False,
-) -> NDArray[np.bool_] | tuple[NDArray[np.bool_], Array]:
-    """``theta (K, M)``: members exist, are certified by FK (error <= ``tol``) and (with limits) lie inside the
-    limits. With ``excess``, also each joint's limit excess ``(K, M, n)`` (``(ok, excess)``): how far its wrapped
-    value lies outside its limits widened by their tolerance (<= 0 inside), NaN where a member is not certified or
-    without ``limits``."""
+) -> tuple[NDArray[np.bool_], Array]:
+    """``theta (K, M)``: whether the members exist and are certified by FK (error <= ``tol``), and the members
+    ``(K, M, n)`` (NaN made 0)."""
     if red.uses_kernel and fastsweep.AVAILABLE:
         # compiled: configuration, FK and error per member (flange frame compared with the chain pose)
         M = theta.shape[1]
@@ -127,19 +98,46 @@ def _members_ok(
         q, err, _ = fastcertify.certify(robot, red, chain, world, flat_p, theta.ravel(), flat_b)
         q = q.reshape(*theta.shape, robot.n_joints)
         ok = np.all(np.isfinite(q), axis=-1) & (err <= tol).reshape(theta.shape)
-        qz = np.nan_to_num(q)
     else:
         q = red.solve_rest(chain[pose], theta, np.broadcast_to(branch[:, None], theta.shape))
-        ok = np.all(np.isfinite(q), axis=-1)
-        qz = np.nan_to_num(q)
-        flange = fastsweep.flange_poses(robot, qz.reshape(-1, qz.shape[-1])).reshape(*qz.shape[:-1], 4, 4)
-        T = robot.T_base_world @ flange
-        ok &= pose_error_geodesic(T, chain[pose][:, None], orientation_weight(robot.length_unit)) <= tol
+        ok = _solve_chain(robot, q, chain[pose][:, None], tol)
+    return ok, np.nan_to_num(q)
+
+
+def _members_ok(
+    robot: Robot,
+    red: Reduction,
+    chain: Array,
+    world: Array,
+    pose: NDArray[np.intp],
+    branch: NDArray[np.intp],
+    theta: Array,
+    limits: bool,
+    tol: float,
+) -> NDArray[np.bool_]:
+    """``theta (K, M)``: members exist, are certified by FK (error <= ``tol``) and (with limits) lie inside the
+    limits."""
+    ok, qz = _certified(robot, red, chain, world, pose, branch, theta, tol)
+    return np.asarray(ok & robot.within_limits(qz)) if limits else ok
+
+
+def _members_excess(
+    robot: Robot,
+    red: Reduction,
+    chain: Array,
+    world: Array,
+    pose: NDArray[np.intp],
+    branch: NDArray[np.intp],
+    theta: Array,
+    limits: bool,
+    tol: float,
+) -> tuple[NDArray[np.bool_], Array]:
+    """``_members_ok``, and each joint's limit excess ``(K, M, n)``: how far its wrapped value lies outside its
+    limits widened by their tolerance (<= 0 inside), NaN where a member is not certified or without ``limits``."""
+    ok, qz = _certified(robot, red, chain, world, pose, branch, theta, tol)
     if not limits:
-        return (ok, np.full(qz.shape, np.nan)) if excess else np.asarray(ok)
+        return ok, np.full(qz.shape, np.nan)
     w, inside = robot.wrapped_within_limits(qz)
-    if not excess:
-        return np.asarray(ok & inside)
     over = np.maximum((robot.lower - robot.limit_tol) - w, w - (robot.upper + robot.limit_tol))
     return ok & inside, np.where(ok[..., None], over, np.nan)
 
@@ -179,7 +177,7 @@ def _locate_cuts(
     target = np.ldexp(np.abs(b - a), -steps)
 
     def member(x: Array, k: NDArray[np.intp]) -> tuple[NDArray[np.bool_], Array]:
-        on, g = _members_ok(robot, red, chain, world, pose[k], branch[k], x[:, None], limits, tol, excess=True)
+        on, g = _members_excess(robot, red, chain, world, pose[k], branch[k], x[:, None], limits, tol)
         return on[:, 0], g[:, 0]
 
     every = np.arange(K)

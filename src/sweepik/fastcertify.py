@@ -311,7 +311,7 @@ if AVAILABLE:
         cfg, p, x, br, q, Td, zd, eg, ep, H, P, rev, R_end, weight, tol, limits, jrev, lower, upper, ltol, beyond, ex
     ):
         """Whether the family member at ``x`` is certified and, with ``limits``, inside them; each joint's limit
-        excess into ``ex``, as ``families._members_ok`` with ``excess`` (NaN where it is not certified or without
+        excess into ``ex``, as ``families._members_excess`` (NaN where it is not certified or without
         limits)."""
         cfg(p, x, br, q[0])
         _certify_row(H, P, rev, R_end, weight, q, Td, zd, 0, eg, ep)
