@@ -40,7 +40,7 @@ from numba.extending import register_jitable
 from numpy.typing import NDArray
 
 from .. import parallel
-from .._jit import ERROR_MODEL, internal
+from .._jit import ERROR_MODEL, inlined
 from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
 from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
 from .kernels import (
@@ -97,7 +97,7 @@ def _h(p, i):
     return _v(p, _H + 3 * i)
 
 
-@internal
+@inlined
 def _mat(p, v):
     """``M v`` for the target orientation ``M`` of the row."""
     m = _M
@@ -108,7 +108,7 @@ def _mat(p, v):
     )
 
 
-@internal
+@inlined
 def _mat_t(p, v):
     """``M^T v``."""
     m = _M
@@ -119,7 +119,7 @@ def _mat_t(p, v):
     )
 
 
-@internal
+@inlined
 def _arm(p, x, b1, b2, case, f, rev):
     """The first four joints with joint ``free`` at ``x``, on branch ``b1`` of the position case's first step and
     ``b2`` of its second (``position.place``: 0, 1, both or neither): ``(A, B, c1, c2, a1, a2)`` with ``A`` the
@@ -158,13 +158,13 @@ def _arm(p, x, b1, b2, case, f, rev):
     return (ma, mb, mc, mx), (na, nb, nc, mx), c1, c2, a1, a2
 
 
-@internal
+@inlined
 def _missing(m0, m1, m2, m3):
     """Some motion is NaN (an unknown case, dependent prismatic directions)."""
     return math.isnan(m0[0] + m0[2] + m1[0] + m1[2] + m2[0] + m2[2] + m3[0] + m3[2])
 
 
-@internal
+@inlined
 def _orientation(p, m, c1, c2):
     """The pair family's residual for the motions ``m`` of the first four joints and the cosines of the position
     case's steps: NaN outside the branch's domain."""
@@ -175,7 +175,7 @@ def _orientation(p, m, c1, c2):
     return dot(_fore(p, m0, m1, m2, m3, h4), _mat(p, h5)) - dot(h4, h5)
 
 
-@internal
+@inlined
 def _back(p, m0, m1, m2, m3, v):
     """``R_04^T v = R_3^T R_2^T R_1^T R_0^T v``: ``v`` seen from frame 4 (joint 0's rotation undone first)."""
     ms = (m0, m1, m2, m3)
@@ -185,7 +185,7 @@ def _back(p, m0, m1, m2, m3, v):
     return v
 
 
-@internal
+@inlined
 def _fore(p, m0, m1, m2, m3, v):
     """``R_04 v``."""
     ms = (m0, m1, m2, m3)
@@ -195,7 +195,7 @@ def _fore(p, m0, m1, m2, m3, v):
     return v
 
 
-@internal
+@inlined
 def _last_two(p, m0, m1, m2, m3, h4, h5):
     """Joints 5 and 6 (indices 4, 5) turning the tool onto the target, given the first four."""
     q4, _ = sp1(h5, _back(p, m0, m1, m2, m3, _mat(p, h5)), h4)
@@ -204,7 +204,7 @@ def _last_two(p, m0, m1, m2, m3, h4, h5):
     return q4, q5
 
 
-@internal
+@inlined
 def _write(p, out, m0, m1, m2, m3, q4, q5):
     """The configuration in the robot's joint order (reversed for a reversed chain)."""
     qs = (
@@ -220,7 +220,7 @@ def _write(p, out, m0, m1, m2, m3, q4, q5):
         out[5 - i if rev else i] = qs[i]
 
 
-@internal
+@inlined
 def _wrist_first(p, m):
     """The wrist family's work shared by a position branch's two wrist branches (motions ``m`` of the first four
     joints): joint 6's target axis seen from frame 4 ``v``, a unit vector normal to joint 6's axis seen from there
@@ -232,7 +232,7 @@ def _wrist_first(p, m):
     return v, be, sp2(v, h5, h3, h4)
 
 
-@internal
+@inlined
 def _wrist_joints(p, m, v, be, s, wb, out):
     """The configuration of wrist branch ``wb`` (0, 1) given ``_wrist_first``'s ``v, be, s``, into ``out``."""
     m0, m1, m2, _ = m
@@ -256,7 +256,7 @@ def _wrist_joints(p, m, v, be, s, wb, out):
 # themselves rather than through a helper: each compiled level re-optimises everything it calls.)
 
 
-@internal
+@inlined
 def _o3(p):
     """Joint 4's point (index 3) at the zero configuration."""
     o = _v(p, _P)
@@ -265,7 +265,7 @@ def _o3(p):
     return o
 
 
-@internal
+@inlined
 def _parallel_g(p, m0, v):
     """``R_0^T M v``: the target orientation seen after joint 1."""
     w = _mat(p, v)
@@ -274,7 +274,7 @@ def _parallel_g(p, m0, v):
     return w
 
 
-@internal
+@inlined
 def _parallel_first(p, branch):
     """The parallel family's first steps: motion of joint 1, ``(cos, sin)`` of joint 5, and cosines ``(c0, c4)``
     (``|c| <= 1`` inside the branch's domain; NaN: no such branch). Joint 5 moves ``W`` (joint 6's point) by
@@ -307,7 +307,7 @@ def _parallel_first(p, branch):
     return m0, m4, c0, c4
 
 
-@internal
+@inlined
 def _parallel_shared(p, branch):
     """The parallel family's work shared by branches ``branch`` and ``branch ^ 1`` (they differ in the planar
     arm's elbow only): ``(ok, m0, m4, c5, s5, cf, sf, d, sp3 of the planar arm)``; ``ok`` False: no such branch."""
@@ -337,7 +337,7 @@ def _parallel_shared(p, branch):
     return True, m0, m4, c5, s5, cf, sf, d, sp3_cs(s3, scale(-1.0, s2), h, norm(d))
 
 
-@internal
+@inlined
 def _parallel_finish(p, shared, elbow, out):
     """The configuration of the branch with planar-arm elbow ``elbow`` (``branch % 2``) from ``_parallel_shared``."""
     ok, m0, m4, c5, s5, cf, sf, d, planar = shared

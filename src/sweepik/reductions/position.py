@@ -41,7 +41,7 @@ import math
 from numba import njit, types
 from numba.extending import overload
 
-from .._jit import ERROR_MODEL, internal
+from .._jit import ERROR_MODEL, inlined
 from ..subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
 from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
@@ -62,7 +62,7 @@ BRANCHES = {
 }
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def motion(rev, x):
     """A joint value as a *motion* ``(cos, sin, travel)``: ``(cos x, sin x, 0)`` for a revolute joint,
     ``(1, 0, x)`` for a prismatic one. Kernels rotate by cosines and sines and never need the angle itself."""
@@ -71,7 +71,7 @@ def motion(rev, x):
     return 1.0, 0.0, x
 
 
-@internal
+@inlined
 def angle(rev, m):
     """The joint value of motion ``m`` (radians or travel)."""
     if rev:
@@ -79,17 +79,17 @@ def angle(rev, m):
     return m[2]
 
 
-@internal
+@inlined
 def _rev(c, s):
     return c, s, 0.0
 
 
-@internal
+@inlined
 def _pris(t):
     return 1.0, 0.0, t
 
 
-@internal
+@inlined
 def move(h, rev, m, v):
     """``T(v)``: ``v`` rotated about ``h`` (revolute) or translated along it (prismatic) by motion ``m``."""
     if rev:
@@ -97,7 +97,7 @@ def move(h, rev, m, v):
     return add(v, scale(m[2], h))
 
 
-@internal
+@inlined
 def move_back(h, rev, m, v):
     """The inverse of ``move``."""
     if rev:
@@ -105,7 +105,7 @@ def move_back(h, rev, m, v):
     return sub(v, scale(m[2], h))
 
 
-@internal
+@inlined
 def _turn(h, rev, m, v):
     """The rotation part of ``move`` (directions)."""
     if rev:
@@ -113,7 +113,7 @@ def _turn(h, rev, m, v):
     return v
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def reduce_chain(h0, h1, h2, h3, r0, r1, r2, r3, s0, s1, s2, s3, s4, f, x, t):
     """The three-joint problem left when joint ``f`` (0-3) of the first four is fixed at the motion ``x``.
 
@@ -146,17 +146,17 @@ NEITHER = 2
 _NO_ANGLE = (math.nan, math.nan)
 
 
-@internal
+@inlined
 def _first(b2):
     return b2 == 0 or b2 == BOTH
 
 
-@internal
+@inlined
 def _second(b2):
     return b2 == 1 or b2 == BOTH
 
 
-@internal
+@inlined
 def _line_cos(disc, d):
     """A line-sphere discriminant as the cosine of a circle subproblem (|c| <= 1 inside the domain)."""
     if d > 0.0:
@@ -164,7 +164,7 @@ def _line_cos(disc, d):
     return 0.0 if disc >= 0.0 else math.inf
 
 
-@internal
+@inlined
 def _ab_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ab_par`` of ``place``: the height along h_a does not depend on qa, qb."""
     c1 = 0.0
@@ -183,7 +183,7 @@ def _ab_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return _rev(ca, sa), _rev(ua, va), mc, _rev(cb, sb), _rev(ub, vb), mc, c1, c2, r1, r2
 
 
-@internal
+@inlined
 def _bc_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``bc_par`` of ``place``: the height along h_b does not depend on qb, qc."""
     c1 = 0.0
@@ -201,7 +201,7 @@ def _bc_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return ma, _rev(ca, sa), _rev(ua, va), ma, _rev(cb, sb), _rev(ub, vb), c1, c2, r1, r2
 
 
-@internal
+@inlined
 def _ab_int(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ab_int`` of ``place``: |W - O| depends on qc only."""
     c1 = 0.0
@@ -220,7 +220,7 @@ def _ab_int(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return _rev(c1a, -s1a), _rev(c2a, s2a), mc, _rev(c1b, -s1b), _rev(c2b, s2b), mc, c1, c2, r1, r2
 
 
-@internal
+@inlined
 def _bc_int(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``bc_int`` of ``place``: |W - O| is fixed; O moves with joint a only."""
     c1 = 0.0
@@ -240,7 +240,7 @@ def _bc_int(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return ma, _rev(c1a, -s1a), _rev(c2a, s2a), ma, _rev(c1b, -s1b), _rev(c2b, s2b), c1, c2, r1, r2
 
 
-@internal
+@inlined
 def _ppp(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ppp`` of ``place`` (one branch: the second outcome repeats the first)."""
     qa, qb, qc = lines3(ha, hb, hc, sub(sub(sub(tp, pab), pbc), pcw))
@@ -248,7 +248,7 @@ def _ppp(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return ma, mb, mc, ma, mb, mc, 0.0, 0.0, math.inf, math.inf
 
 
-@internal
+@inlined
 def _ppr(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ppr`` of ``place``: the height along ha x hb does not depend on qa, qb."""
     n = cross(ha, hb)
@@ -262,7 +262,7 @@ def _ppr(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return _pris(qa), _pris(qb), _rev(ua, va), _pris(qa2), _pris(qb2), _rev(ub, vb), 0.0, c2, math.inf, r2
 
 
-@internal
+@inlined
 def _ac_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``ac_par`` of ``place``: the height along ha fixes the prismatic b."""
     qb = lp4(ha, add(add(pab, pbc), pcw), hb, dot(ha, tp))
@@ -273,7 +273,7 @@ def _ac_par(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return _rev(ca, sa), _pris(qb), _rev(ua, va), _rev(cb, sb), _pris(qb), _rev(ub, vb), 0.0, c2, math.inf, r2
 
 
-@internal
+@inlined
 def _rpp(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Case ``rpp`` of ``place`` (a cylindrical arm's slides after its turn): ``W - o = R_a (p + qb hb + qc hc)``
     with ``p = pab + pbc + pcw``, so the height of ``R_a^T tp`` along ``n = hb x hc`` is ``n . p`` whatever qb, qc:
@@ -318,7 +318,7 @@ def place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
 _CASE_FUNCTIONS = (_ab_par, _bc_par, _ab_int, _bc_int, _ppp, _ppr, _ac_par, _rpp)
 
 
-@internal
+@inlined
 def _no_case(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """An unknown case: NaN motions."""
     nan = (math.nan, math.nan, math.nan)

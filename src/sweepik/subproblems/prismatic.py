@@ -28,13 +28,13 @@ __all__ = ["lp1", "lp3", "lp4", "lines2", "lines3", "PARALLEL_DET"]
 PARALLEL_DET = 1e-12
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def lp1(p1, p2, h):
     t = dot(h, sub(p2, p1))
     return t, norm(sub(add(p1, scale(t, h)), p2))
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def lp3(p1, p2, h, d):
     v = sub(p1, p2)
     w = perp(h, v)
@@ -44,7 +44,7 @@ def lp3(p1, p2, h, d):
     return m + s, m - s, disc
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def lp4(h, p, k, d):
     hk = dot(h, k)
     if hk == 0.0:
@@ -52,7 +52,7 @@ def lp4(h, p, k, d):
     return (d - dot(h, p)) / hk
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def lines2(h1, h2, v):
     a = dot(h1, h2)
     det = 1.0 - a * a
@@ -62,7 +62,7 @@ def lines2(h1, h2, v):
     return (b1 - a * b2) / det, (b2 - a * b1) / det
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def lines3(h1, h2, h3, v):
     det = dot(h1, cross(h2, h3))
     if abs(det) <= PARALLEL_DET:

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .._jit import ERROR_MODEL, internal
+from .._jit import ERROR_MODEL, inlined
 from .trig import trig2_roots
 from .vec import cross, dot, norm, perp, rot, rot_cs, sub
 
@@ -55,13 +55,13 @@ __all__ = [
 DOMAIN_TOL = 1e-12
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def in_domain(c):
     """True when the cosine ``c`` of a two-solution subproblem gives exact (possibly equal) solutions."""
     return abs(c) <= 1.0 + DOMAIN_TOL
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def sp1_cs(p1, p2, k):
     """``(cos, sin)`` of the least-squares ``theta`` with ``R(k, theta) p1 = p2`` ((1, 0) when degenerate)."""
     a = perp(k, p1)
@@ -74,14 +74,14 @@ def sp1_cs(p1, p2, k):
     return x / n, y / n
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def sp1(p1, p2, k):
     """``theta`` with ``R(k, theta) p1 = p2`` (least squares in general) and the residual ``|R p1 - p2|``."""
     c, s = sp1_cs(p1, p2, k)
     return math.atan2(s, c), norm(sub(rot_cs(k, c, s, p1), p2))
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def sp4_cs(h, p, k, d):
     """``sp4`` without angles: ``(cos, sin)`` of both solutions, then ``c`` and ``r``:
     ``cos_a, sin_a, cos_b, sin_b, c, r``. The angles are ``phi +- w`` with ``(cos, sin)(phi) = (A, B) / r`` and
@@ -101,7 +101,7 @@ def sp4_cs(h, p, k, d):
     return cp * c - sp * sw, sp * c + cp * sw, cp * c + sp * sw, sp * c - cp * sw, c, r
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def sp4(h, p, k, d):
     """The two ``theta`` with ``h . R(k, theta) p = d`` (``h`` need not be unit), their cosine ``c`` and the
     amplitude ``r``.
@@ -117,19 +117,19 @@ def sp4(h, p, k, d):
     return math.atan2(sa, ca), math.atan2(sb, cb), c, r
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def sp3_cs(p1, p2, k, d):
     """``sp3`` without angles (as ``sp4_cs``)."""
     return sp4_cs(p2, p1, k, 0.5 * (dot(p1, p1) + dot(p2, p2) - d * d))
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def sp3(p1, p2, k, d):
     """The two ``theta`` with ``|R(k, theta) p1 - p2| = d``, their cosine ``c`` and amplitude ``r`` (as ``sp4``)."""
     return sp4(p2, p1, k, 0.5 * (dot(p1, p1) + dot(p2, p2) - d * d))
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def sp2_cs(p1, p2, k1, k2):
     """``sp2`` without angles: ``c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c, r`` (cosines and sines of the pairs)."""
     c1a, s1a, c1b, s1b, c, r = sp4_cs(k2, p1, k1, dot(k2, p2))
@@ -138,7 +138,7 @@ def sp2_cs(p1, p2, k1, k2):
     return c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, c, r
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def sp2(p1, p2, k1, k2):
     """``(theta1, theta2)`` pairs with ``R(k1, theta1) p1 = R(k2, theta2) p2`` (``k1``, ``k2`` not parallel).
 
@@ -150,7 +150,7 @@ def sp2(p1, p2, k1, k2):
     return math.atan2(s1a, c1a), math.atan2(s2a, c2a), math.atan2(s1b, c1b), math.atan2(s2b, c2b), c, r
 
 
-@internal
+@inlined
 def _trig_terms(h, k, p):
     """``(a_c, a_s, a_0)`` with ``h . R(k, t) p = a_c cos t + a_s sin t + a_0``."""
     return dot(h, perp(k, p)), dot(h, cross(k, p)), dot(h, k) * dot(k, p)
@@ -161,7 +161,7 @@ def _trig_terms(h, k, p):
 SP6_SINGULAR = 1e-12
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=False)
 def sp6(h1, k1, p1, h2, k2, p2, h3, k3, p3, h4, k4, p4, d1, d2):
     """Pairs ``(theta1, theta2)`` with (IK-Geo's SP6, "four circles")::
 
@@ -213,7 +213,7 @@ def sp6(h1, k1, p1, h2, k2, p2, h3, k3, p3, h4, k4, p4, d1, d2):
     return t1, t2, n
 
 
-@njit(cache=True, error_model=ERROR_MODEL)
+@njit(cache=True, error_model=ERROR_MODEL, forceinline=False)
 def sp5(p0, p1, p2, p3, k1, k2, k3):
     """Triples ``(theta1, theta2, theta3)`` with (IK-Geo's SP5, "three circles")::
 

@@ -1,62 +1,61 @@
 """Small 3-vector algebra on tuples ``(x, y, z)`` for compiled scalar code (no array allocation).
 
-Compiled code calls these only: they are compiled without the wrappers that would let Python call them
-(:func:`sweepik._jit.internal`; ~0.05 s less each on a fresh install). The subproblems built on them are callable
-from Python.
+Compiled code calls these only: they are compiled without the wrappers that would let Python call them, and
+inlined into their callers (:func:`sweepik._jit.inlined`). The subproblems built on them are callable from Python.
 """
 
 from __future__ import annotations
 
 import math
 
-from .._jit import internal
+from .._jit import inlined
 
 __all__ = ["add", "sub", "scale", "dot", "cross", "norm", "unit", "rot", "rot_cs", "perp", "along", "orthogonal"]
 
 
-@internal
+@inlined
 def add(a, b):
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
-@internal
+@inlined
 def sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-@internal
+@inlined
 def scale(s, a):
     return (s * a[0], s * a[1], s * a[2])
 
 
-@internal
+@inlined
 def dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@internal
+@inlined
 def cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@internal
+@inlined
 def norm(a):
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
-@internal
+@inlined
 def unit(a):
     n = norm(a)
     return (a[0] / n, a[1] / n, a[2] / n)
 
 
-@internal
+@inlined
 def rot(k, theta, v):
     """``v`` rotated by ``theta`` (radians) about the unit axis ``k`` (Rodrigues)."""
     return rot_cs(k, math.cos(theta), math.sin(theta), v)
 
 
-@internal
+@inlined
 def rot_cs(k, c, s, v):
     """``v`` rotated about the unit axis ``k`` by the angle whose cosine and sine are ``c``, ``s``."""
     kv = dot(k, v)
@@ -68,19 +67,19 @@ def rot_cs(k, c, s, v):
     )
 
 
-@internal
+@inlined
 def along(k, v):
     """The component of ``v`` along the unit vector ``k``."""
     return scale(dot(k, v), k)
 
 
-@internal
+@inlined
 def perp(k, v):
     """The component of ``v`` perpendicular to the unit vector ``k``."""
     return sub(v, along(k, v))
 
 
-@internal
+@inlined
 def orthogonal(k):
     """A unit vector perpendicular to the unit vector ``k``."""
     ax, ay, az = abs(k[0]), abs(k[1]), abs(k[2])
