@@ -94,10 +94,11 @@ def test_read_only_poses(name: str, tmp_path) -> None:
     np.testing.assert_array_equal(sweepik.solve(robot, mapped[0]).q, b[0].q)
 
 
-@pytest.mark.parametrize("name", ["carm", "ur5"])
+@pytest.mark.parametrize("name", ["carm", "ur5", "xarm6"])
 def test_chunks_solved_side_by_side_change_nothing(name):
     """Several chunks are solved two at a time on threads (parallel.in_order): the same columns as one chunk, and
-    iter_solve yields the same solutions in the same order."""
+    iter_solve yields the same solutions in the same order. xArm 6 (a generic sweep whose poses differ in their
+    number of sample hints): a pose's samples do not depend on its batch (``fastsweep.sample_grid``)."""
     robot = sweepik.load_robot(name)
     T = _poses(robot, np.random.default_rng(11), 150)
     one = sweepik.solve_many(robot, T)

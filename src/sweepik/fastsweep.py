@@ -129,11 +129,18 @@ if AVAILABLE:
         return (not math.isnan(f)) and abs(f) <= noise
 
     @internal
-    def _center_flat(res, p, x, b, noise, span):
-        """As sweep._Search._center_flat, for one root: (centre, lo, hi, is a family)."""
+    def _center_flat(res, p, x, b, noise, span, probes):
+        """As sweep._Search._center_flat, for one root: (centre, lo, hi, is a family). ``probes (2,)``: the residual
+        at ``x -+ FLAT_PROBE_REL * span`` where the root is not in a flat stretch (the first probes of
+        ``_multiplicity``), else NaN."""
         d0 = FLAT_PROBE_REL * span
-        if not (_small(res, p, x - d0, b, noise) or _small(res, p, x + d0, b, noise)):
-            return x, x, x, False
+        probes[0] = probes[1] = np.nan
+        f0 = res(p, x - d0, b)
+        if not ((not math.isnan(f0)) and abs(f0) <= noise):
+            f1 = res(p, x + d0, b)
+            if not ((not math.isnan(f1)) and abs(f1) <= noise):
+                probes[0], probes[1] = f0, f1
+                return x, x, x, False
         limit = FLAT_MAX_REL * span
         in0, out0 = _flat_grow(res, p, x, b, noise, d0, limit, -1.0)
         in1, out1 = _flat_grow(res, p, x, b, noise, d0, limit, 1.0)
@@ -175,15 +182,17 @@ if AVAILABLE:
         return inner, at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise
 
     @internal
-    def _multiplicity(res, p, x, b, noise, span):
-        """As sweep._Search._multiplicity, for one root."""
+    def _multiplicity(res, p, x, b, noise, span, f_lo, f_hi):
+        """As sweep._Search._multiplicity, for one root; ``f_lo, f_hi``: the residual at its first probes if known
+        (``_center_flat``'s, the same points), else NaN."""
         level = MULT_LEVEL * noise
         limit = FLAT_MAX_REL * span
         total, count = 0.0, 0
         for side in range(2):
             sgn = -1.0 if side == 0 else 1.0
             d = FLAT_PROBE_REL * span
-            f1 = abs(res(p, x + sgn * d, b))
+            known = f_lo if side == 0 else f_hi
+            f1 = abs(known if not math.isnan(known) else res(p, x + sgn * d, b))
             for _ in range(64):
                 if not (f1 < level and d < limit):
                     break
@@ -399,23 +408,28 @@ if AVAILABLE:
         return len(arrays)
 
     @internal
-    def _sort_pairs(keys, values, n):
-        """The first ``n`` pairs ``(keys[k], values[k])`` sorted in place, by key, then by value (insertion sort: a
-        pose has a few dozen candidates at most; ``values`` are never NaN)."""
+    def _sort_pairs(keys, values, carried, n):
+        """The first ``n`` pairs ``(keys[k], values[k])`` sorted in place, by key, then by value, rows ``carried[k]``
+        moving with them (insertion sort: a pose has a few dozen candidates at most; ``values`` are never NaN)."""
         for a in range(1, n):
             kk, vv = keys[a], values[a]
+            c0, c1 = carried[a, 0], carried[a, 1]
             m = a - 1
             while m >= 0 and (keys[m] > kk or (keys[m] == kk and values[m] > vv)):
                 keys[m + 1] = keys[m]
                 values[m + 1] = values[m]
+                carried[m + 1, 0] = carried[m, 0]
+                carried[m + 1, 1] = carried[m, 1]
                 m -= 1
             keys[m + 1] = kk
             values[m + 1] = vv
+            carried[m + 1, 0] = c0
+            carried[m + 1, 1] = c1
 
     _U_UNIFORM_ARR = _U_UNIFORM.copy()
     _U_EDGE_ARR = _U_EDGE.copy()
 
-    from numba import float64, int64
+    from numba import boolean, float64, int64
 
     from .reductions.kernels import HINTS_SIG, RESIDUAL_SIG, RESIDUALS_SIG, as_hints, as_residual, as_residuals
 
@@ -428,6 +442,7 @@ if AVAILABLE:
         float64[:, ::1],
         float64[:, ::1],
         int64[::1],
+        int64[::1],
         float64[::1],
         float64,
         float64[:, ::1],
@@ -436,15 +451,19 @@ if AVAILABLE:
         int64[::1],
         float64[:, :, ::1],
         int64[::1],
+        boolean,
         int64,
         int64,
     )
 
     @lazy_njit(_SEARCH_SIG, cache=True, nogil=True)
     def _search(
-        res, res_all, n_all, params, grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt, start, stop
-    ):
-        """Poses ``start .. stop - 1`` (threads run parts of a batch side by side: :mod:`sweepik.parallel`).
+        res, res_all, n_all, params, grid, n_grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt,
+        multiplicity, start, stop,
+    ):  # fmt: skip
+        """Poses ``start .. stop - 1`` (threads run parts of a batch side by side: :mod:`sweepik.parallel`), pose i's
+        samples the first ``n_grid[i]`` of ``grid[i]`` (``sample_grid``); ``multiplicity`` False: every candidate's
+        is given as 1, not worked out (``search``).
         ``res_all``: every branch's residual at once (``Reduction.kernel_residuals``), used for the uniform samples
         when ``n_all`` (the number of branches it fills) is not 0.
 
@@ -460,7 +479,7 @@ if AVAILABLE:
             unowned(out_m),
         )
         cnt, fam, fcnt, span = unowned(cnt), unowned(fam), unowned(fcnt), unowned(span)
-        M = grid.shape[1]
+        M = grid.shape[1]  # (the most samples of a pose)
         # work arrays, shared by the poses (each pose sets what it reads). Explicit loops rather than np.zeros,
         # np.full, slice copies or np.argsort: each of those adds to the first compilation (docs/performance.md)
         own_c = np.empty(1, dtype=np.int64)
@@ -484,15 +503,17 @@ if AVAILABLE:
         own_edge_ok = np.empty(M, dtype=np.bool_)
         own_f = np.empty(M)
         own_top = np.empty(1, dtype=np.int64)
+        own_probes = np.empty((out_t.shape[1], 2))
         # ... and the work arrays too (their owners are used at the end, ``_alive``: they outlive the views)
         c, stk_t, stk_f, stk_i = unowned(own_c), unowned(own_stk_t), unowned(own_stk_f), unowned(own_stk_i)
         stk_c, no_ctx, wv, wx = unowned(own_stk_c), unowned(own_no_ctx), unowned(own_wv), unowned(own_wx)
         wdd, buf_t, buf_f, buf_c = unowned(own_wdd), unowned(own_buf_t), unowned(own_buf_f), unowned(own_buf_c)
         f_all, edge_f, edge_ok, f = unowned(own_f_all), unowned(own_edge_f), unowned(own_edge_ok), unowned(own_f)
-        top = unowned(own_top)
+        top, probes = unowned(own_top), unowned(own_probes)
         for i in range(start, stop):
             p = params[i]
-            th = grid[i]
+            M = n_grid[i]
+            th = grid[i, :M]
             xtol = XTOL_REL * span[i]
             c[0] = 0
             for j in range(M):
@@ -538,7 +559,7 @@ if AVAILABLE:
                 # compile _scan once more for the literal types of 0 and False)
                 level = top[0]
                 el = er = level > 0
-                seq_t, seq_f, ctx, xe = th, f, no_ctx, np.nan
+                seq_t, seq_f, ctx, xe = th, f[:M], no_ctx, np.nan
                 while True:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
                           c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd, res_all, n_all, edge_f, edge_ok)  # fmt: skip
@@ -556,8 +577,8 @@ if AVAILABLE:
             cnt[i] = c[0]
             n0 = min(c[0], out_t.shape[1])
             w0 = 0
-            for k in range(n0):
-                x, lo, hi, family = _center_flat(res, p, out_t[i, k], out_b[i, k], noise, span[i])
+            for k in range(n0):  # (probes[w0]: candidate w0's probes, written whether or not it is kept)
+                x, lo, hi, family = _center_flat(res, p, out_t[i, k], out_b[i, k], noise, span[i], probes[w0])
                 if family:
                     if fcnt[i] < fam.shape[1]:
                         fam[i, fcnt[i], 0] = lo
@@ -576,7 +597,7 @@ if AVAILABLE:
             if n > 1:
                 ts = out_t[i]
                 bs = out_b[i]
-                _sort_pairs(bs, ts, n)
+                _sort_pairs(bs, ts, probes, n)
                 w = 0  # (written in place: w <= s, and only entries from s on are read after a write)
                 s = 0
                 while s < n:
@@ -589,13 +610,21 @@ if AVAILABLE:
                         e += 1
                     out_t[i, w] = 0.5 * (ts[s] + ts[e])  # a cluster is one root (families were set apart)
                     out_b[i, w] = bs[s]
+                    # (a cluster's centre is a new point: its probes are not known)
+                    probes[w, 0] = probes[s, 0] if e == s else np.nan
+                    probes[w, 1] = probes[s, 1] if e == s else np.nan
                     w += 1
                     s = e + 1
                 cnt[i] = w if c[0] <= out_t.shape[1] else c[0]
             for k in range(min(cnt[i], out_t.shape[1])):
-                out_m[i, k] = _multiplicity(res, p, out_t[i, k], out_b[i, k], noise, span[i])
+                if multiplicity:
+                    out_m[i, k] = _multiplicity(
+                        res, p, out_t[i, k], out_b[i, k], noise, span[i], probes[k, 0], probes[k, 1]
+                    )
+                else:
+                    out_m[i, k] = 1
         _alive(own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx, own_wdd)
-        _alive(own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top)
+        _alive(own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top, own_probes)
 
     @lazy_njit(RESIDUALS_SIG, cache=True)
     def _no_residuals(params, theta, out):  # pragma: no cover - never called (n_all = 0)
@@ -605,17 +634,18 @@ if AVAILABLE:
 if AVAILABLE:
 
     @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
-    def _merge_grid(lo, hi, s, hints, out, start, stop):
-        """``sweep.merge_grid`` for poses ``start .. stop - 1`` into ``out (N, n + H)``, element by element (the same
-        arithmetic, so the same samples)."""
+    def _merge_grid(lo, hi, s, hints, out, count, start, stop):
+        """``sweep.merge_grid`` for poses ``start .. stop - 1`` into ``out (N, n + H)`` and ``count (N,)``, element by
+        element (the same arithmetic), but for the NaN hints: none of a pose's samples (see ``sample_grid``)."""
         for i in range(start, stop):
-            _merge_row(lo[i], hi[i], s, hints[i], out[i])
+            count[i] = _merge_row(lo[i], hi[i], s, hints[i], out[i], True)
 
     @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
     def _hinted_grid(hints, params, ends, periodic, lo, hi, s, out, start, stop):
         """``sample_grid`` for poses ``start .. stop - 1`` of a reduction with a hints kernel (its address
         ``hints``): the pose's hints, then ``ends`` (theta*'s limits, for a non-periodic theta*), wrapped into
-        [-pi, pi] for a periodic one, as ``sweep.grid_hints``; merged as ``_merge_grid``."""
+        [-pi, pi] for a periodic one, as ``sweep.grid_hints``; merged as ``sweep.merge_grid`` (a kernel writes as
+        many hints for every pose: a NaN one is a spare sample, as in the reference)."""
         fn = as_hints(hints)
         H = out.shape[1] - s.shape[0]
         nh = H - ends.shape[0]
@@ -627,21 +657,28 @@ if AVAILABLE:
             if periodic:
                 for k in range(H):
                     row[k] = math.pi - ((math.pi - row[k]) % (2.0 * math.pi))
-            _merge_row(lo[i], hi[i], s, row, out[i])
+            _merge_row(lo[i], hi[i], s, row, out[i], False)
 
     @internal
-    def _merge_row(a, b, s, hints, g):
+    def _merge_row(a, b, s, hints, g, drop_nan):
         """One pose's samples ``g (n + H,)`` on ``[a, b]``: the unit grid ``s (n,)`` and the hints ``(H,)`` inside
-        it (else a spare midpoint), sorted, runs of equal samples spread. The hints are few, so an insertion sort of
-        the row, whose uniform part is sorted already, costs little."""
+        it (else a spare midpoint; none for a NaN hint with ``drop_nan``), sorted, runs of equal samples spread.
+        Returns their number; the row's entries past it are NaN. The hints are few, so an insertion sort of the
+        row, whose uniform part is sorted already, costs little."""
         n, H = s.shape[0], hints.shape[0]
-        M = n + H
         w = b - a
         for k in range(n):
             g[k] = a + w * s[k]
+        M = n
         for k in range(H):
             h = hints[k]
-            g[n + k] = h if (math.isfinite(h) and h >= a and h <= b) else a + w * ((k + 0.5) / (n - 1))
+            if drop_nan and math.isnan(h):
+                continue
+            # (the spare's place from the hint's rank among the pose's own, as the reference's for the pose alone)
+            g[M] = h if (math.isfinite(h) and h >= a and h <= b) else a + w * ((M - n + 0.5) / (n - 1))
+            M += 1
+        for m in range(M, n + H):
+            g[m] = np.nan
         for m in range(n, M):
             v = g[m]
             j = m - 1
@@ -664,12 +701,22 @@ if AVAILABLE:
                 for j in range(m, e0):
                     g[j] = base + (g[e0] - base) * (j - s0) / (e0 - s0)
             m = e0 + 1
+        return M
 
 
-def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None) -> Array:
+def sample_grid(
+    reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None
+) -> tuple[Array, NDArray[np.int64]]:
     """:func:`sweepik.sweep.sample_grid`, the merge compiled (for a single pose its NumPy steps cost ~80 us), and
     the hints too where the reduction has a hints kernel (``Reduction.kernel_hints``; ``params``: its
-    ``kernel_params(poses)``, if at hand)."""
+    ``kernel_params(poses)``, if at hand). Returns ``(grid (N, M), count (N,))``: pose i's samples are the first
+    ``count[i]`` of its row.
+
+    A NaN hint of ``sample_hints`` adds no sample here, where the reference turns it into a spare midpoint of the
+    uniform grid (its rows must be as long as the longest): the rows of a reduction whose hints differ in number
+    between poses (the generic sweeps) then hold what the pose's own hints ask for, whatever the batch, and a
+    batch costs no more samples per pose than a single pose (xArm 6: 64 + 12 instead of 64 + 78). Without Numba,
+    the reference's grid and its full width."""
     plan = _plan(reduction) if AVAILABLE else None
     N = poses.shape[0]
     if plan is not None and plan.hints is not None:
@@ -687,13 +734,15 @@ def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, p
             _ref._unit_grid(n_samples),
             out,
         )
-        return out
+        return out, np.full(N, out.shape[1], dtype=np.int64)
     hints = _ref.grid_hints(reduction, poses)
     if not AVAILABLE:
-        return _ref.merge_grid(lo, hi, n_samples, hints)
+        grid = _ref.merge_grid(lo, hi, n_samples, hints)
+        return grid, np.full(N, grid.shape[1], dtype=np.int64)
     if hints is None:
         hints = np.empty((N, 0))
     out = np.empty((N, n_samples + hints.shape[1]))
+    count = np.empty(N, dtype=np.int64)
     parallel.run(
         _merge_grid,
         N,
@@ -703,8 +752,9 @@ def sample_grid(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, p
         _ref._unit_grid(n_samples),
         np.ascontiguousarray(hints, dtype=np.float64),
         out,
+        count,
     )
-    return out
+    return out, count
 
 
 class _Plan(NamedTuple):
@@ -775,11 +825,20 @@ def _kernel_residuals(reduction):
     return owned_kernel(reduction, "kernel_residuals")
 
 
-def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None):
+def search(
+    reduction,
+    poses: Array,
+    lo: Array,
+    hi: Array,
+    n_samples: int,
+    params: Array | None = None,
+    multiplicity: bool = True,
+):
     """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
-    Poses whose candidate or family buffers overflow are redone by the NumPy engine."""
+    Poses whose candidate or family buffers overflow are redone by the NumPy engine. ``multiplicity`` False: the
+    candidates' multiplicities are not wanted (each is given as 1; ~4 residuals a candidate less)."""
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
-    theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
+    theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
     out_b = np.empty((N, MAX_CAND), dtype=np.int64)
@@ -799,6 +858,7 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         plan.n_all,
         params,
         np.ascontiguousarray(theta),
+        n_theta,
         plan.branches,
         np.ascontiguousarray(span, dtype=np.float64),
         float(reduction.residual_noise),
@@ -808,6 +868,7 @@ def search(reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params
         cnt,
         fam,
         fcnt,
+        multiplicity,
     )
     if N == 1 and cnt[0] <= MAX_CAND and fcnt[0] == 0:  # (a single pose: the general bookkeeping costs ~40 us)
         k0 = int(cnt[0])

@@ -478,9 +478,9 @@ MAX_SAMPLES = 100_000
 #: Largest ``chunk_size`` accepted (any larger value behaves like this one).
 MAX_CHUNK = 2**31
 #: Pose-samples per chunk (chunk x ``n_samples``): a larger ``n_samples`` runs in smaller chunks, so memory stays
-#: that of the defaults (2048 poses x 64 samples). Chunking changes no solution (on arms whose sample hints depend
-#: on the batch, e.g. the generic sweeps, some move by rounding, ~1e-13: a pose's grid takes a spare sample for each
-#: hint another pose of its batch has).
+#: that of the defaults (2048 poses x 64 samples). Chunking changes no solution (without Numba, on arms whose
+#: poses differ in their number of sample hints, e.g. the generic sweeps, some move by rounding, ~1e-13: the NumPy
+#: engine's grid gives a pose a spare sample for each hint another pose of its batch has).
 SAMPLE_BUDGET = CHUNK * N_SAMPLES
 #: The paper's strategy sweeps theta* in 10 mm (or 1 degree) steps over its whole range: a range needing more
 #: coarse samples than this (2 km of rail in mm) is refused, as its memory (~2 kB per pose-sample) and time grow

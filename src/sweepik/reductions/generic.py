@@ -468,7 +468,7 @@ class _Margins(Reduction):
 
         N = poses.shape[0]
         if fastsweep.AVAILABLE:
-            cand, _ = fastsweep.search(self, poses, lo, hi, sweep.N_SAMPLES, params)
+            cand, _ = fastsweep.search(self, poses, lo, hi, sweep.N_SAMPLES, params, multiplicity=False)
         else:
             cand, _ = sweep.find_candidates(self, poses, lo, hi, sweep.N_SAMPLES)
         if N == 1:
