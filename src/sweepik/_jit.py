@@ -11,7 +11,7 @@ try:
 except ImportError:  # pragma: no cover - without numba the NumPy engine is used
     _njit = None
 
-__all__ = ["internal", "inlined", "unowned", "function_at", "ERROR_MODEL"]
+__all__ = ["internal", "inlined", "unowned", "alive", "function_at", "ERROR_MODEL"]
 
 #: Numba's error model for every compiled function of sweepik: IEEE results for a division by zero (inf, NaN), as
 #: the NumPy reference engine gives them, rather than a ZeroDivisionError raised from deep inside a kernel (which
@@ -47,6 +47,7 @@ _INTERNAL = {"cache": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True
 
 
 unowned: Any = None
+alive: Any = None
 if _njit is not None:
     from numba.core import cgutils, types
     from numba.extending import intrinsic
@@ -66,6 +67,12 @@ if _njit is not None:
             return ary._getvalue()
 
         return a(a), codegen
+
+    @internal
+    def alive(*arrays: Any) -> int:
+        """Nothing: a use of arrays a compiled function allocated, after the last use of their ``unowned`` views, so
+        that they are freed after it."""
+        return len(arrays)
 
 
 def function_at(sig: Any) -> Any:

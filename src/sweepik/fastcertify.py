@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import parallel
-from ._jit import internal
+from ._jit import alive, internal, unowned
 from .dedupe import limit_args
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
@@ -181,7 +181,17 @@ if AVAILABLE:
         """Candidates ``start .. stop - 1``: the configuration of candidate k (pose ``pose[k]``) into ``q[k]``, its
         geodesic error and paper J (inf where the branch does not exist)."""
         cfg = as_configuration(cfg)
-        zd = np.empty(4)
+        # views Numba does not reference-count: each call below would count every array up and down (atomically)
+        params, world, q, err_geo, err_paper = (
+            unowned(params),
+            unowned(world),
+            unowned(q),
+            unowned(err_geo),
+            unowned(err_paper),
+        )
+        H, P, rev, R_end = unowned(H), unowned(P), unowned(rev), unowned(R_end)
+        own_zd = np.empty(4)
+        zd = unowned(own_zd)
         last = -1
         for k in range(start, stop):
             i = pose[k]
@@ -189,6 +199,7 @@ if AVAILABLE:
                 zd[0], last = 0.0, i
             cfg(params[i], theta[k], branch[k], q[k])
             _certify_row(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper)
+        alive(own_zd)
 
     @internal
     def _certify_row(H, P, rev, R_end, weight, q, Td, zd, k, err_geo, err_paper):
@@ -211,12 +222,23 @@ if AVAILABLE:
         """Poses ``start .. stop - 1``: every branch's configuration at once (rows ``i nb .. i nb + nb - 1`` of
         ``q`` for pose i) and their errors."""
         cfgs = as_configurations(cfgs)
-        zd = np.empty(4)
+        # (views Numba does not reference-count, as in ``_certify``)
+        params, world, q, err_geo, err_paper = (
+            unowned(params),
+            unowned(world),
+            unowned(q),
+            unowned(err_geo),
+            unowned(err_paper),
+        )
+        H, P, rev, R_end = unowned(H), unowned(P), unowned(rev), unowned(R_end)
+        own_zd = np.empty(4)
+        zd = unowned(own_zd)
         for i in range(start, stop):
             cfgs(params[i], 0.0, q[i * nb : (i + 1) * nb])
             zd[0] = 0.0
             for k in range(i * nb, (i + 1) * nb):
                 _certify_row(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper)
+        alive(own_zd)
 
     from .dedupe import wrap_inside_row
 

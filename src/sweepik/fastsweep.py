@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from . import parallel
 from . import sweep as _ref
-from ._jit import ERROR_MODEL, internal, unowned
+from ._jit import ERROR_MODEL, alive, internal, unowned
 from .errors import UnknownOptionError
 from .reductions.base import overridden_below_kernel
 from .reductions.kernels import address_of, lazy_njit, owned_kernel
@@ -403,11 +403,6 @@ if AVAILABLE:
                 _push(out_t, out_b, cnt, _root(res, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
 
     @internal
-    def _alive(*arrays):
-        """Nothing: a use of the work arrays after their last unowned view is used, so that they are freed after it."""
-        return len(arrays)
-
-    @internal
     def _sort_pairs(keys, values, carried, n):
         """The first ``n`` pairs ``(keys[k], values[k])`` sorted in place, by key, then by value, rows ``carried[k]``
         moving with them (insertion sort: a pose has a few dozen candidates at most; ``values`` are never NaN)."""
@@ -504,7 +499,7 @@ if AVAILABLE:
         own_f = np.empty(M)
         own_top = np.empty(1, dtype=np.int64)
         own_probes = np.empty((out_t.shape[1], 2))
-        # ... and the work arrays too (their owners are used at the end, ``_alive``: they outlive the views)
+        # ... and the work arrays too (their owners are used at the end, ``alive``: they outlive the views)
         c, stk_t, stk_f, stk_i = unowned(own_c), unowned(own_stk_t), unowned(own_stk_f), unowned(own_stk_i)
         stk_c, no_ctx, wv, wx = unowned(own_stk_c), unowned(own_no_ctx), unowned(own_wv), unowned(own_wx)
         wdd, buf_t, buf_f, buf_c = unowned(own_wdd), unowned(own_buf_t), unowned(own_buf_f), unowned(own_buf_c)
@@ -623,8 +618,8 @@ if AVAILABLE:
                     )
                 else:
                     out_m[i, k] = 1
-        _alive(own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx, own_wdd)
-        _alive(own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top, own_probes)
+        alive(own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx, own_wdd)
+        alive(own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top, own_probes)
 
     @lazy_njit(RESIDUALS_SIG, cache=True)
     def _no_residuals(params, theta, out):  # pragma: no cover - never called (n_all = 0)
