@@ -95,7 +95,7 @@ def _certified(
         flat_b = np.repeat(branch, M)
         # every member certified by FK: a family from a vanishing residual can still hold a point where the
         # branch's closed form breaks down (e.g. the wrist crossing joint 2's axis on the C-Arm)
-        q, err, _ = fastcertify.certify(robot, red, chain, world, flat_p, theta.ravel(), flat_b)
+        q, err, _ = fastcertify.certify(robot, red, chain, world, flat_p, theta.ravel(), flat_b, paper=False)
         q = q.reshape(*theta.shape, robot.n_joints)
         ok = np.all(np.isfinite(q), axis=-1) & (err <= tol).reshape(theta.shape)
     else:

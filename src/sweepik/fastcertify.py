@@ -121,10 +121,8 @@ if AVAILABLE:
         return _wrap(alpha), beta, _wrap(gamma)
 
     @internal
-    def _errors(T, Td, weight, zd):
-        """(geodesic error, paper J) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``. ``zd (4,)``:
-        the Z-Y-Z angles of ``Td`` once computed (``zd[1:]``, when ``zd[0]`` is 1; set here when needed, so that
-        candidates of one target compute them once: the caller sets ``zd[0] = 0`` for a new target)."""
+    def _geodesic(T, Td, weight):
+        """(geodesic error, position error) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``."""
         r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
         dp = math.sqrt((px - Td[0, 3]) ** 2 + (py - Td[1, 3]) ** 2 + (pz - Td[2, 3]) ** 2)
         # geodesic: angle of M = Td^T R (only its trace and skew part are needed)
@@ -139,7 +137,15 @@ if AVAILABLE:
         m01 = Td[0, 0] * r01 + Td[1, 0] * r11 + Td[2, 0] * r21
         vx, vy, vz = m21 - m12, m02 - m20, m10 - m01
         ang = math.atan2(0.5 * math.sqrt(vx * vx + vy * vy + vz * vz), 0.5 * (m00 + m11 + m22 - 1.0))
-        geo = dp + weight * ang
+        return dp + weight * ang, dp
+
+    @internal
+    def _errors(T, Td, weight, zd):
+        """(geodesic error, paper J) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``. ``zd (4,)``:
+        the Z-Y-Z angles of ``Td`` once computed (``zd[1:]``, when ``zd[0]`` is 1; set here when needed, so that
+        candidates of one target compute them once: the caller sets ``zd[0] = 0`` for a new target)."""
+        geo, dp = _geodesic(T, Td, weight)
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = T[0], T[1], T[2], T[3], T[4], T[5], T[6], T[7], T[8]
         if geo > J_CUTOFF_FACTOR * weight:  # far from a solution: the paper's J is not needed
             return geo, np.inf
         a, b, g = _zyz(r00, r01, r02, r10, r11, r12, r20, r21, r22)
@@ -164,6 +170,7 @@ if AVAILABLE:
         int64[::1],
         float64[::1],
         int64[::1],
+        types.boolean,
         float64[:, ::1],
         float64[:, ::1],
         types.boolean[::1],
@@ -177,9 +184,11 @@ if AVAILABLE:
     )
 
     @lazy_njit(_CERTIFY_SIG, cache=True, nogil=True)
-    def _certify(cfg, params, world, pose, theta, branch, H, P, rev, R_end, weight, q, err_geo, err_paper, start, stop):
+    def _certify(
+        cfg, params, world, pose, theta, branch, paper, H, P, rev, R_end, weight, q, err_geo, err_paper, start, stop
+    ):
         """Candidates ``start .. stop - 1``: the configuration of candidate k (pose ``pose[k]``) into ``q[k]``, its
-        geodesic error and paper J (inf where the branch does not exist)."""
+        geodesic error and paper J (inf where the branch does not exist; J inf too without ``paper``)."""
         cfg = as_configuration(cfg)
         # views Numba does not reference-count: each call below would count every array up and down (atomically)
         params, world, q, err_geo, err_paper = (
@@ -198,18 +207,35 @@ if AVAILABLE:
             if i != last:  # (a pose's candidates are mostly consecutive: the angles are redone when it changes)
                 zd[0], last = 0.0, i
             cfg(params[i], theta[k], branch[k], q[k])
-            _certify_row(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper)
+            if paper:
+                _certify_row(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper)
+            else:
+                err_geo[k], err_paper[k] = _geodesic_row(H, P, rev, R_end, weight, q, world[i], k), np.inf
         alive(own_zd)
 
     @internal
     def _certify_row(H, P, rev, R_end, weight, q, Td, zd, k, err_geo, err_paper):
         """Errors of candidate ``k`` (configuration ``q[k]``, target ``Td`` with its angles ``zd``, see ``_errors``):
         inf where the branch does not exist."""
+        if not _finite_row(q, k):
+            err_geo[k], err_paper[k] = np.inf, np.inf
+            return
+        err_geo[k], err_paper[k] = _errors(_poe_fk(H, P, rev, R_end, q[k]), Td, weight, zd)
+
+    @internal
+    def _geodesic_row(H, P, rev, R_end, weight, q, Td, k):
+        """``_certify_row``'s geodesic error alone (where the paper's J is not wanted: its Z-Y-Z angles cost as much
+        as the rest)."""
+        if not _finite_row(q, k):
+            return np.inf
+        return _geodesic(_poe_fk(H, P, rev, R_end, q[k]), Td, weight)[0]
+
+    @internal
+    def _finite_row(q, k):
         for j in range(q.shape[1]):
             if not math.isfinite(q[k, j]):
-                err_geo[k], err_paper[k] = np.inf, np.inf
-                return
-        err_geo[k], err_paper[k] = _errors(_poe_fk(H, P, rev, R_end, q[k]), Td, weight, zd)
+                return False
+        return True
 
     @lazy_njit(
         (_CFGS, float64[:, ::1], float64[:, :, ::1], int64)
@@ -278,21 +304,17 @@ if AVAILABLE:
         cfg = as_configuration(cfg)
         n = H.shape[0]
         q = np.empty((1, n))
-        eg = np.empty(1)
-        ep = np.empty(1)
-        zd = np.empty(4)
         ga, gb, gx = np.empty(n), np.empty(n), np.empty(n)  # each joint's limit excess at a, b and the new point
         for k in range(start, stop):
             i, br = pose[k], branch[k]
-            zd[0] = 0.0
             ak, bk = a[k], b[k]
             target = math.ldexp(abs(bk - ak), -steps)
             for j in range(n):
                 ga[j] = gb[j] = math.nan
             if limits:
-                _member(cfg, params[i], ak, br, q, world[i], zd, eg, ep, H, P, rev, R_end, weight, tol, limits,
+                _member(cfg, params[i], ak, br, q, world[i], H, P, rev, R_end, weight, tol, limits,
                         jrev, lower, upper, ltol, beyond, ga)  # fmt: skip
-                _member(cfg, params[i], bk, br, q, world[i], zd, eg, ep, H, P, rev, R_end, weight, tol, limits,
+                _member(cfg, params[i], bk, br, q, world[i], H, P, rev, R_end, weight, tol, limits,
                         jrev, lower, upper, ltol, beyond, gb)  # fmt: skip
             w1 = w2 = w3 = math.inf  # the bracket's widths 1, 2 and 3 steps ago
             side = 0
@@ -309,7 +331,7 @@ if AVAILABLE:
                     tmin = 0.5 * target / w
                     t = min(max(ga[js] / (ga[js] - gb[js]), tmin), 1.0 - tmin)
                 x = ak + t * (bk - ak)
-                on = _member(cfg, params[i], x, br, q, world[i], zd, eg, ep, H, P, rev, R_end, weight, tol, limits,
+                on = _member(cfg, params[i], x, br, q, world[i], H, P, rev, R_end, weight, tol, limits,
                              jrev, lower, upper, ltol, beyond, gx)  # fmt: skip
                 if on:
                     ak = x
@@ -329,15 +351,12 @@ if AVAILABLE:
             a[k], b[k] = ak, bk
 
     @internal
-    def _member(
-        cfg, p, x, br, q, Td, zd, eg, ep, H, P, rev, R_end, weight, tol, limits, jrev, lower, upper, ltol, beyond, ex
-    ):
+    def _member(cfg, p, x, br, q, Td, H, P, rev, R_end, weight, tol, limits, jrev, lower, upper, ltol, beyond, ex):
         """Whether the family member at ``x`` is certified and, with ``limits``, inside them; each joint's limit
         excess into ``ex``, as ``families._members_excess`` (NaN where it is not certified or without
         limits)."""
         cfg(p, x, br, q[0])
-        _certify_row(H, P, rev, R_end, weight, q, Td, zd, 0, eg, ep)
-        on = eg[0] <= tol  # (inf where the member does not exist)
+        on = _geodesic_row(H, P, rev, R_end, weight, q, Td, 0) <= tol  # (inf where the member does not exist)
         for j in range(ex.shape[0]):
             ex[j] = math.nan
         if on and limits:
@@ -462,13 +481,11 @@ if AVAILABLE:
     def _tool_poses(H, P, rev, R_end, q, target, weight, out, err, start, stop):
         """Rows ``start .. stop - 1``: the world tool pose of ``q[k]`` into ``out[k]`` and (``target`` non-empty)
         its geodesic error to ``target[k]`` into ``err[k]``."""
-        zd = np.empty(4)
         for k in range(start, stop):
             T = _poe_fk(H, P, rev, R_end, q[k])
             _put_pose(T, out[k])
             if target.shape[0]:
-                zd[0] = 0.0
-                err[k] = _errors(T, target[k], weight, zd)[0]
+                err[k] = _geodesic(T, target[k], weight)[0]
 
     @lazy_njit(
         (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64[:, ::1], float64[:, :, ::1])
@@ -591,12 +608,22 @@ def certify_every_branch(robot, red, chain: Array, world: Array, params: Array |
     return _run(_certify_every_branch, N, 2 * PARALLEL_MIN, N * nb, robot, red, chain, world, params, cfgs, int(nb))
 
 
-def certify(robot, red, chain: Array, world: Array, pose, theta: Array, branch, params: Array | None = None):
+def certify(
+    robot,
+    red,
+    chain: Array,
+    world: Array,
+    pose,
+    theta: Array,
+    branch,
+    params: Array | None = None,
+    paper: bool = True,
+):
     """Configurations ``(K, n)``, geodesic errors and paper errors ``(K,)`` of the candidates
-    (inf errors where the branch does not exist)."""
+    (inf errors where the branch does not exist; ``paper`` False: the paper errors are not wanted, inf)."""
     K = pose.shape[0]
     cfg = address_of(red.kernel[1], CONFIGURATION_SIG)
-    ids = (pose.astype(np.int64), theta.astype(np.float64), branch.astype(np.int64))
+    ids = (pose.astype(np.int64), theta.astype(np.float64), branch.astype(np.int64), bool(paper))
     return _run(_certify, K, 16 * PARALLEL_MIN, K, robot, red, chain, world, params, cfg, *ids)
 
 
