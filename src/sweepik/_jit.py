@@ -31,10 +31,12 @@ def internal(fn: Any) -> Any:
 
 def inlined(fn: Any) -> Any:
     """``internal``, and inlined into every compiled caller (``forceinline``: LLVM's ``alwaysinline``), for the small
-    functions a kernel is built of (vector algebra, subproblems, the steps of a family). Numba compiles each
-    function on its own and calls it with its own convention (results through memory, a status code); LLVM inlines
-    only the smallest. A generic family's residual left ~20 calls per evaluation: inlined, it takes 2.5 times less
-    (330 -> 134 ns on CRX-10iA, docs/performance.md), with the same results bit for bit.
+    functions a kernel is built of (vector algebra, subproblems, the steps of a family) and the engine's helpers
+    called per sample or candidate (root finding, probes, FK, errors). Numba compiles each function on its own and
+    calls it with its own convention (results through memory, a status code, and the reference counts of the arrays
+    passed counted up and down); LLVM inlines only the smallest. A generic family's residual made ~20 calls per
+    evaluation: inlined, it takes 2.5 times less (330 -> 134 ns on CRX-10iA, docs/performance.md), with the same
+    results bit for bit.
 
     Numba passes ``forceinline`` on to the functions first compiled while compiling an inlined one, unless they set
     it: ``internal`` sets it False, and so does a large subproblem (``sp5``, ``sp6``)."""

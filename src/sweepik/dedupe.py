@@ -231,7 +231,7 @@ if AVAILABLE:
 
     from numba import boolean, float64, int64
 
-    from ._jit import internal
+    from ._jit import inlined, internal
     from .reductions.kernels import lazy_njit
 
     @lazy_njit(
@@ -241,7 +241,7 @@ if AVAILABLE:
         for k in range(q.shape[0]):
             inside[k] = wrap_inside_row(q[k], rev, lower, upper, ltol, beyond)
 
-    @internal
+    @inlined
     def wrap_inside_row(q, rev, lower, upper, ltol, beyond):  # pragma: no cover
         """Steps 1 and 2 for one configuration ``q (n,)``: wrapped in place; whether it is inside the limits."""
         two_pi = 2.0 * math.pi

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import parallel
-from ._jit import alive, internal, unowned
+from ._jit import alive, inlined, unowned
 from .dedupe import limit_args
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
@@ -42,7 +42,7 @@ if AVAILABLE:
     #: A reduction's configuration kernel (all-branch kernel: ``_CFGS``) enters as its address (``address_of``).
     _CFG = _CFGS = int64
 
-    @internal
+    @inlined
     def _turn(r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, angle):
         """The rotation ``r`` (row by row) followed by a turn of ``angle`` about the unit axis ``k`` (Rodrigues)."""
         c, s = math.cos(angle), math.sin(angle)
@@ -62,7 +62,7 @@ if AVAILABLE:
             r20 * k02 + r21 * k12 + r22 * k22,
         )
 
-    @internal
+    @inlined
     def _poe_fk(H, P, rev, R_end, q):
         """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain as 12 scalars (rotation
         row by row, then position): scalar locals only, no array allocated (this runs once per candidate)."""
@@ -99,11 +99,11 @@ if AVAILABLE:
             pz,
         )
 
-    @internal
+    @inlined
     def _wrap(x):
         return math.pi - ((math.pi - x) % (2.0 * math.pi))
 
-    @internal
+    @inlined
     def _zyz(r00, r01, r02, r10, r11, r12, r20, r21, r22):
         """Z-Y-Z angles of a rotation given by its entries, as pose.zyz_from_matrix."""
         sb = math.hypot(r20, r21)
@@ -120,7 +120,7 @@ if AVAILABLE:
             gamma = math.atan2(ca * r10 - sa * r00, ca * r11 - sa * r01)
         return _wrap(alpha), beta, _wrap(gamma)
 
-    @internal
+    @inlined
     def _geodesic(T, Td, weight):
         """(geodesic error, position error) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``."""
         r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = T
@@ -139,7 +139,7 @@ if AVAILABLE:
         ang = math.atan2(0.5 * math.sqrt(vx * vx + vy * vy + vz * vz), 0.5 * (m00 + m11 + m22 - 1.0))
         return dp + weight * ang, dp
 
-    @internal
+    @inlined
     def _errors(T, Td, weight, zd):
         """(geodesic error, paper J) of the pose ``T`` (12 scalars, as ``_poe_fk``) against ``Td (4, 4)``. ``zd (4,)``:
         the Z-Y-Z angles of ``Td`` once computed (``zd[1:]``, when ``zd[0]`` is 1; set here when needed, so that
@@ -213,7 +213,7 @@ if AVAILABLE:
                 err_geo[k], err_paper[k] = _geodesic_row(H, P, rev, R_end, weight, q, world[i], k), np.inf
         alive(own_zd)
 
-    @internal
+    @inlined
     def _certify_row(H, P, rev, R_end, weight, q, Td, zd, k, err_geo, err_paper):
         """Errors of candidate ``k`` (configuration ``q[k]``, target ``Td`` with its angles ``zd``, see ``_errors``):
         inf where the branch does not exist."""
@@ -222,7 +222,7 @@ if AVAILABLE:
             return
         err_geo[k], err_paper[k] = _errors(_poe_fk(H, P, rev, R_end, q[k]), Td, weight, zd)
 
-    @internal
+    @inlined
     def _geodesic_row(H, P, rev, R_end, weight, q, Td, k):
         """``_certify_row``'s geodesic error alone (where the paper's J is not wanted: its Z-Y-Z angles cost as much
         as the rest)."""
@@ -230,7 +230,7 @@ if AVAILABLE:
             return np.inf
         return _geodesic(_poe_fk(H, P, rev, R_end, q[k]), Td, weight)[0]
 
-    @internal
+    @inlined
     def _finite_row(q, k):
         for j in range(q.shape[1]):
             if not math.isfinite(q[k, j]):
@@ -350,7 +350,7 @@ if AVAILABLE:
                 w3, w2, w1 = w2, w1, w
             a[k], b[k] = ak, bk
 
-    @internal
+    @inlined
     def _member(cfg, p, x, br, q, Td, H, P, rev, R_end, weight, tol, limits, jrev, lower, upper, ltol, beyond, ex):
         """Whether the family member at ``x`` is certified and, with ``limits``, inside them; each joint's limit
         excess into ``ex``, as ``families._members_excess`` (NaN where it is not certified or without
@@ -365,7 +365,7 @@ if AVAILABLE:
                 ex[j] = max((lower[j] - ltol[j]) - q[0, j], q[0, j] - (upper[j] + ltol[j]))
         return on
 
-    @internal
+    @inlined
     def _limit_excess_row(q, jrev, lower, upper, ltol, beyond):
         """``families._limit_excess`` of one member ``q (n,)`` (changed in place), value for value: NaN becomes
         inf and +-inf the largest float (``np.nan_to_num``); an infinite revolute value wraps to NaN."""
@@ -462,7 +462,7 @@ def dip_search(robot, red, chain: Array, pose, branch, a: Array, b: Array, best_
 
 if AVAILABLE:
 
-    @internal
+    @inlined
     def _put_pose(T, out):
         """``_poe_fk``'s 12 scalars as the 4x4 matrix ``out``."""
         for r in range(3):

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from . import parallel
 from . import sweep as _ref
-from ._jit import ERROR_MODEL, alive, internal, unowned
+from ._jit import ERROR_MODEL, alive, inlined, internal, unowned
 from .errors import UnknownOptionError
 from .reductions.base import overridden_below_kernel
 from .reductions.kernels import address_of, lazy_njit, owned_kernel
@@ -77,7 +77,7 @@ _U_EDGE = _ref._U_EDGE
 
 if AVAILABLE:
 
-    @internal
+    @inlined
     def _root(res, p, b, a, c, fa, fc, xtol):
         """Chandrupatla's bracketed root finder (scalar), as rootfind.find_roots."""
         eps = 2.220446049250313e-16
@@ -123,12 +123,12 @@ if AVAILABLE:
             t = min(max(t, tlim), 1.0 - tlim)
         return x
 
-    @internal
+    @inlined
     def _small(res, p, x, b, noise):
         f = res(p, x, b)
         return (not math.isnan(f)) and abs(f) <= noise
 
-    @internal
+    @inlined
     def _center_flat(res, p, x, b, noise, span, probes):
         """As sweep._Search._center_flat, for one root: (centre, lo, hi, is a family). ``probes (2,)``: the residual
         at ``x -+ FLAT_PROBE_REL * span`` where the root is not in a flat stretch (the first probes of
@@ -151,7 +151,7 @@ if AVAILABLE:
         family = open0 and open1 and hi - lo > CLUSTER_FAMILY_REL * span
         return 0.5 * (lo + hi), lo, hi, family
 
-    @internal
+    @inlined
     def _flat_grow(res, p, x, b, noise, d0, limit, sgn):
         """(inner, outer): the residual is within the noise at x + sgn inner, not at x + sgn outer (doubling)."""
         inner, outer = 0.0, d0
@@ -165,7 +165,7 @@ if AVAILABLE:
                     break
         return inner, outer
 
-    @internal
+    @inlined
     def _flat_end(res, p, x, b, noise, inner, outer, limit, sgn, short):
         """(reach, the stretch ends openly) on one side, as in sweep._Search._center_flat."""
         at_limit = inner >= limit
@@ -181,7 +181,7 @@ if AVAILABLE:
         far = abs(res(p, x + 2.0 * sgn * outer, b))
         return inner, at_limit or not (past <= JUMP_NOISE * noise) or far <= 2.0 * noise
 
-    @internal
+    @inlined
     def _multiplicity(res, p, x, b, noise, span, f_lo, f_hi):
         """As sweep._Search._multiplicity, for one root; ``f_lo, f_hi``: the residual at its first probes if known
         (``_center_flat``'s, the same points), else NaN."""
@@ -205,7 +205,7 @@ if AVAILABLE:
         m = total / count if count > 0 else 1.0
         return int(min(max(round(m), 1), MULT_MAX))
 
-    @internal
+    @inlined
     def _extend(res, p, b, inside, outside):
         for _ in range(FAMILY_BISECT):
             mid = 0.5 * (inside + outside)
@@ -216,7 +216,7 @@ if AVAILABLE:
                 outside = mid
         return inside
 
-    @internal
+    @inlined
     def _push(out_t, out_b, cnt, x, b):
         if cnt[0] < out_t.shape[0]:
             out_t[cnt[0]] = x
@@ -252,7 +252,7 @@ if AVAILABLE:
         elif abs(fx) <= FAR_NOISE * noise:
             _push(out_t, out_b, cnt, xe, b)
 
-    @internal
+    @inlined
     def _g(res, p, x, b, h):
         return res(p, x + h, b) - res(p, x - h, b)
 
@@ -402,7 +402,7 @@ if AVAILABLE:
             elif prod < 0:
                 _push(out_t, out_b, cnt, _root(res, p, b, th[j], th[j + 1], f[j], f[j + 1], xtol), b)
 
-    @internal
+    @inlined
     def _sort_pairs(keys, values, carried, n):
         """The first ``n`` pairs ``(keys[k], values[k])`` sorted in place, by key, then by value, rows ``carried[k]``
         moving with them (insertion sort: a pose has a few dozen candidates at most; ``values`` are never NaN)."""
