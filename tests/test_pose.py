@@ -281,3 +281,31 @@ def test_rotation_angle_batches_and_identity(rng: np.random.Generator) -> None:
     Q = random_rotation(rng)
     np.testing.assert_allclose(rotation_angle(np.swapaxes(R, -1, -2)), rotation_angle(R), rtol=1e-12)
     np.testing.assert_allclose(rotation_angle(Q @ R @ Q.T), rotation_angle(R), rtol=1e-9)
+
+
+def test_compiled_wrap_is_the_numpy_wrap_bit_for_bit() -> None:
+    """``_wrap.wrap_pi`` (compiled code's wrap, with a fast path for |pi - x| < 2 pi) gives exactly what the NumPy
+    expression gives: at the fast path's ends, at multiples of pi, at +-0, near the ends by an ulp, far out, inf, NaN."""
+    numba = pytest.importorskip("numba")
+    from sweepik import fastsweep
+    from sweepik._wrap import wrap_pi
+
+    if not fastsweep.AVAILABLE:
+        pytest.skip("the NumPy engine runs without compiled code")
+
+    @numba.njit
+    def wrapped(xs: NDArray[np.float64]) -> NDArray[np.float64]:
+        out = np.empty_like(xs)
+        for k in range(xs.shape[0]):
+            out[k] = wrap_pi(xs[k])
+        return out
+
+    special = [0.0, -0.0, np.pi, -np.pi, 2 * np.pi, -2 * np.pi, 3 * np.pi, -3 * np.pi, 1e300, -1e300, np.inf, -np.inf]
+    edges = np.array([np.pi, -np.pi, 3 * np.pi, 2 * np.pi, 0.0])
+    near = np.concatenate([np.nextafter(edges, np.inf), np.nextafter(edges, -np.inf)])
+    xs = np.concatenate([special, near, np.random.default_rng(3).uniform(-20.0, 20.0, 20_000), [np.nan]])
+    with np.errstate(invalid="ignore"):
+        ref = np.pi - np.mod(np.pi - xs, 2.0 * np.pi)
+    got = wrapped(xs)
+    assert np.array_equal(got, ref, equal_nan=True)
+    assert np.array_equal(np.signbit(got), np.signbit(ref))

@@ -232,6 +232,7 @@ if AVAILABLE:
     from numba import boolean, float64, int64
 
     from ._jit import inlined, internal
+    from ._wrap import wrap_pi
     from .reductions.kernels import lazy_njit
 
     @lazy_njit(
@@ -249,7 +250,7 @@ if AVAILABLE:
         for j in range(q.shape[0]):
             x = q[j]
             if rev[j] and math.isfinite(x):
-                x = math.pi - ((math.pi - x) % two_pi)
+                x = wrap_pi(x)
                 if beyond and (x < lower[j] - ltol[j] or x > upper[j] + ltol[j]):
                     for shift in (two_pi, -two_pi):
                         c = x + shift
@@ -318,7 +319,7 @@ if AVAILABLE:
                             if 2.0 * tol[j] < abs(d) < two_pi - 2.0 * tol[j]:
                                 same = False
                                 break
-                            d = math.pi - ((math.pi - d) % two_pi)
+                            d = wrap_pi(d)
                         if not abs(d) <= tol[j]:
                             same = False
                             break

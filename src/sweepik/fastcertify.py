@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import parallel
 from ._jit import alive, inlined, unowned
+from ._wrap import wrap_pi
 from .dedupe import limit_args
 from .fastsweep import AVAILABLE, PARALLEL_MIN
 from .pose import GIMBAL_TOL
@@ -100,10 +101,6 @@ if AVAILABLE:
         )
 
     @inlined
-    def _wrap(x):
-        return math.pi - ((math.pi - x) % (2.0 * math.pi))
-
-    @inlined
     def _zyz(r00, r01, r02, r10, r11, r12, r20, r21, r22):
         """Z-Y-Z angles of a rotation given by its entries, as pose.zyz_from_matrix."""
         sb = math.hypot(r20, r21)
@@ -118,7 +115,7 @@ if AVAILABLE:
         else:
             ca, sa = math.cos(alpha), math.sin(alpha)
             gamma = math.atan2(ca * r10 - sa * r00, ca * r11 - sa * r01)
-        return _wrap(alpha), beta, _wrap(gamma)
+        return wrap_pi(alpha), beta, wrap_pi(gamma)
 
     @inlined
     def _geodesic(T, Td, weight):
@@ -155,11 +152,11 @@ if AVAILABLE:
             )
             zd[0] = 1.0
         ad, bd, gd = zd[1], zd[2], zd[3]
-        da, db, dg = _wrap(a - ad), b - bd, _wrap(g - gd)
+        da, db, dg = wrap_pi(a - ad), b - bd, wrap_pi(g - gd)
         if b < GIMBAL_TOL or bd < GIMBAL_TOL:
-            da, dg = 0.0, _wrap((a + g) - (ad + gd))
+            da, dg = 0.0, wrap_pi((a + g) - (ad + gd))
         elif math.pi - b < GIMBAL_TOL or math.pi - bd < GIMBAL_TOL:
-            da, dg = 0.0, _wrap((a - g) - (ad - gd))
+            da, dg = 0.0, wrap_pi((a - g) - (ad - gd))
         jo = math.sqrt(da * da + db * db + dg * dg)
         return geo, math.sqrt(dp * dp + (weight * jo) ** 2)
 

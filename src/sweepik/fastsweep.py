@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 from . import parallel
 from . import sweep as _ref
 from ._jit import ERROR_MODEL, alive, inlined, internal, unowned
+from ._wrap import wrap_pi
 from .errors import UnknownOptionError
 from .reductions.base import overridden_below_kernel
 from .reductions.kernels import address_of, lazy_njit, owned_kernel
@@ -651,7 +652,7 @@ if AVAILABLE:
                 row[nh + k] = ends[k]
             if periodic:
                 for k in range(H):
-                    row[k] = math.pi - ((math.pi - row[k]) % (2.0 * math.pi))
+                    row[k] = wrap_pi(row[k])
             _merge_row(lo[i], hi[i], s, row, out[i], False)
 
     @internal

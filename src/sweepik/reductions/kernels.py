@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from .._jit import ERROR_MODEL, internal
+from .._wrap import wrap_pi
 from ..errors import UnknownOptionError
 
 _njit: Any
@@ -290,7 +291,7 @@ def _carm_configuration(p, x: float, b: int, out, rail: bool) -> None:
         return
     th3 = math.atan2(u - L2 * c34, L2 * s34 - Py)
     th4 = math.atan2(s34, c34) - th3
-    th4 = math.pi - ((math.pi - th4) % (2.0 * math.pi))
+    th4 = wrap_pi(th4)
     # V = R_B2^T R_D rows, N = R_24^T V; R = p[8:17] row-major
     v0 = (c2 * p[8] + s2 * p[14], c2 * p[9] + s2 * p[15], c2 * p[10] + s2 * p[16])
     v1z = -s2 * p[10] + c2 * p[16]
