@@ -285,7 +285,7 @@ def test_rotation_angle_batches_and_identity(rng: np.random.Generator) -> None:
 
 def test_compiled_wrap_is_the_numpy_wrap_bit_for_bit() -> None:
     """``_wrap.wrap_pi`` (compiled code's wrap, with a fast path for |pi - x| < 2 pi) gives exactly what the NumPy
-    expression gives: at the fast path's ends, at multiples of pi, at +-0, near the ends by an ulp, far out, inf, NaN."""
+    expression gives: at the fast path's ends, at multiples of pi, at +-0, an ulp from the ends, far out, inf, NaN."""
     numba = pytest.importorskip("numba")
     from sweepik import fastsweep
     from sweepik._wrap import wrap_pi

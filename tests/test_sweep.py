@@ -539,3 +539,25 @@ def test_family_cuts_are_where_bisection_puts_them(name: str, monkeypatch: pytes
             on = ok(mid)
             ra, rb = np.where(on, mid, ra), np.where(on, rb, mid)
         assert np.all(np.abs(got_a - ra) <= 2.0 * target), np.max(np.abs(got_a - ra) / target)
+
+
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+def test_search_without_multiplicities_finds_the_same_candidates() -> None:
+    """``fastsweep.search(..., multiplicity=False)`` (the margins' search) gives the same candidates and spans, each
+    with multiplicity 1; with multiplicities, poses with a double root (theta2 = +-90 deg, theta3 = 0, the paper's
+    excluded grid points) and random ones have some above 1 and some of 1, so the comparison sees what it ignores."""
+    from sweepik import solver, sweep
+
+    red = sweepik.get_reduction(CARM, "carm-d1")
+    q = _stress(100, seed=5)
+    q[:30, 1] = np.pi / 2
+    q[:30, 2] = 0.0
+    q[:30, 4] = 0.3
+    chain = solver._chain_poses(CARM, CARM.fk(q))
+    lo, hi = solver._theta_range(CARM, red, chain)
+    full, spans = fastsweep.search(red, chain, lo, hi, sweep.N_SAMPLES)
+    bare, spans2 = fastsweep.search(red, chain, lo, hi, sweep.N_SAMPLES, multiplicity=False)
+    for a, b in ((full.pose, bare.pose), (full.branch, bare.branch), (full.theta, bare.theta)):
+        np.testing.assert_array_equal(a, b)
+    assert (bare.mult == 1).all() and (full.mult > 1).any() and (full.mult == 1).any()
+    np.testing.assert_array_equal(spans.lo, spans2.lo)
