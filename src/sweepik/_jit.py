@@ -17,6 +17,8 @@ __all__ = ["internal", "inlined", "unowned", "alive", "function_at", "ERROR_MODE
 #: the NumPy reference engine gives them, rather than a ZeroDivisionError raised from deep inside a kernel (which
 #: would abort a whole batch where the NumPy engine gives a NaN sample or a candidate that fails certification).
 ERROR_MODEL: Final = "numpy"
+#: The options of ``internal`` and ``inlined``.
+_INTERNAL = {"cache": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": ERROR_MODEL}
 
 
 def internal(fn: Any) -> Any:
@@ -43,9 +45,6 @@ def inlined(fn: Any) -> Any:
     if _njit is None:  # pragma: no cover
         return fn
     return _njit(**_INTERNAL, forceinline=True)(fn)
-
-
-_INTERNAL = {"cache": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": ERROR_MODEL}
 
 
 unowned: Any = None

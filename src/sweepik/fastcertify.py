@@ -180,6 +180,22 @@ if AVAILABLE:
         int64,
     )
 
+    @inlined
+    def _views(params, world, q, err_geo, err_paper, H, P, rev, R_end):
+        """A certification kernel's arrays as views Numba does not reference-count (``unowned``): each call on them in
+        the kernel's loop would count every array up and down, atomically. Its caller holds the arrays."""
+        return (
+            unowned(params),
+            unowned(world),
+            unowned(q),
+            unowned(err_geo),
+            unowned(err_paper),
+            unowned(H),
+            unowned(P),
+            unowned(rev),
+            unowned(R_end),
+        )
+
     @lazy_njit(_CERTIFY_SIG, cache=True, nogil=True)
     def _certify(
         cfg, params, world, pose, theta, branch, paper, H, P, rev, R_end, weight, q, err_geo, err_paper, start, stop
@@ -187,15 +203,9 @@ if AVAILABLE:
         """Candidates ``start .. stop - 1``: the configuration of candidate k (pose ``pose[k]``) into ``q[k]``, its
         geodesic error and paper J (inf where the branch does not exist; J inf too without ``paper``)."""
         cfg = as_configuration(cfg)
-        # views Numba does not reference-count: each call below would count every array up and down (atomically)
-        params, world, q, err_geo, err_paper = (
-            unowned(params),
-            unowned(world),
-            unowned(q),
-            unowned(err_geo),
-            unowned(err_paper),
+        params, world, q, err_geo, err_paper, H, P, rev, R_end = _views(
+            params, world, q, err_geo, err_paper, H, P, rev, R_end
         )
-        H, P, rev, R_end = unowned(H), unowned(P), unowned(rev), unowned(R_end)
         own_zd = np.empty(4)
         zd = unowned(own_zd)
         last = -1
@@ -245,15 +255,9 @@ if AVAILABLE:
         """Poses ``start .. stop - 1``: every branch's configuration at once (rows ``i nb .. i nb + nb - 1`` of
         ``q`` for pose i) and their errors."""
         cfgs = as_configurations(cfgs)
-        # (views Numba does not reference-count, as in ``_certify``)
-        params, world, q, err_geo, err_paper = (
-            unowned(params),
-            unowned(world),
-            unowned(q),
-            unowned(err_geo),
-            unowned(err_paper),
+        params, world, q, err_geo, err_paper, H, P, rev, R_end = _views(
+            params, world, q, err_geo, err_paper, H, P, rev, R_end
         )
-        H, P, rev, R_end = unowned(H), unowned(P), unowned(rev), unowned(R_end)
         own_zd = np.empty(4)
         zd = unowned(own_zd)
         for i in range(start, stop):
