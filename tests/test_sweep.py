@@ -561,3 +561,47 @@ def test_search_without_multiplicities_finds_the_same_candidates() -> None:
         np.testing.assert_array_equal(a, b)
     assert (bare.mult == 1).all() and (full.mult > 1).any() and (full.mult == 1).any()
     np.testing.assert_array_equal(spans.lo, spans2.lo)
+
+
+def _same_search(a: Any, b: Any) -> None:
+    (ca, sa), (cb, sb) = a, b
+    for x, y in zip((ca.pose, ca.branch, ca.theta, ca.mult), (cb.pose, cb.branch, cb.theta, cb.mult), strict=True):
+        np.testing.assert_array_equal(x, y)
+    for x, y in zip((sa.pose, sa.branch, sa.lo, sa.hi), (sb.pose, sb.branch, sb.lo, sb.hi), strict=True):
+        np.testing.assert_array_equal(x, y)
+
+
+@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.parametrize("name", ["fanuc_crx10ia", "kinova_jaco2", "xarm6", "yaskawa_hc10"])
+def test_edge_search_is_the_staged_search(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A generic sweep's search in one pass per pose (its swing samples, its margins' zeros, its candidates:
+    ``fastsweep.EdgeSearch``) finds what the staged search finds (``sample_hints``, then ``sample_grid``, then the
+    search: ``edges=False``), bit for bit, batched and pose by pose: random poses, and poses on the singular set
+    (wrist straight, elbow straight, both). With the buffers cut to one candidate, every pose overflows and is
+    redone by the NumPy engine, in both."""
+    from sweepik import solver, sweep
+
+    robot = load_robot(name)
+    red = sweepik.get_reduction(robot, None)
+    assert fastsweep._plan(red).edges is not None  # (the one-pass search is what is tested)
+    rng = np.random.default_rng(11)
+    q = rng.uniform(robot.lower, robot.upper, (60, 6))
+    q[:10, 4] = 0.0
+    q[10:20, 2] = 0.0
+    q[20:25, 2] = 0.0
+    q[20:25, 4] = 0.0
+    chain = solver._chain_poses(robot, robot.fk(q))
+    lo, hi = solver._theta_range(robot, red, chain)
+    n = sweep.N_SAMPLES
+    one_pass = fastsweep.search(red, chain, lo, hi, n)
+    _same_search(one_pass, fastsweep.search(red, chain, lo, hi, n, edges=False))
+    assert one_pass[0].pose.size >= chain.shape[0]  # (candidates found: the comparison is not of empty sets)
+    for i in range(0, 60, 7):
+        one = fastsweep.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n)
+        _same_search(one, fastsweep.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n, edges=False))
+    monkeypatch.setattr(fastsweep, "MAX_CAND", 1)
+    few = slice(0, 25, 6)
+    _same_search(
+        fastsweep.search(red, chain[few], lo[few], hi[few], n),
+        fastsweep.search(red, chain[few], lo[few], hi[few], n, edges=False),
+    )

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import os
 import weakref
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -700,6 +700,132 @@ if AVAILABLE:
         return M
 
 
+if AVAILABLE:
+    from numba import void as _void
+
+    from ._jit import function_at
+    from .reductions.kernels import as_swing
+
+    #: ``_search`` called from compiled code, by its address (``kernels.address_of``: not linked in, so that
+    #: ``_edge_search`` compiles in a second rather than recompiling the search).
+    _SEARCH_FN_SIG = _void(*_SEARCH_SIG)
+    _as_search = function_at(_SEARCH_FN_SIG)
+    #: ``_edge_search``'s plan: the addresses and counts it takes as one array (a Python call costs per argument).
+    (_E_SEARCH, _E_RES, _E_RES_ALL, _E_N_ALL, _E_MARGIN, _E_MARGINS, _E_M_ALL, _E_SWING, _E_AMP, _E_AMPS, _E_N_SWING,
+     _E_N, _E_PERIODIC, _E_MULT, _E_SIZE) = range(15)  # fmt: skip
+    _EDGE_SIG = (
+        int64[::1],
+        int64[::1],
+        int64[::1],
+        int64[::1],
+        float64[::1],
+        float64[:, ::1],
+        float64[::1],
+        float64[::1],
+        float64[::1],
+        float64[::1],
+        float64[::1],
+        float64[::1],
+        float64[:, ::1],
+        int64[:, ::1],
+        int64[:, ::1],
+        int64[::1],
+        float64[:, :, ::1],
+        int64[::1],
+        boolean[::1],
+        int64,
+        int64,
+    )
+
+    @lazy_njit(_EDGE_SIG, cache=True, nogil=True)
+    def _edge_search(
+        plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, out_t, out_b, out_m, cnt, fam,
+        fcnt, redo, start, stop,
+    ):  # fmt: skip
+        """``search`` of poses ``start .. stop - 1`` for a reduction with an ``EdgeSearch``, each pose in one pass:
+        its swing samples, the margins' search over ``[hlo, hhi]`` sampled with them, then its own search over
+        ``[lo, hi]`` sampled with the margins' zeros and the swing samples, as ``sample_hints`` and ``sample_grid``
+        give them (the same samples in the same order, so the same candidates bit for bit). ``plan``: the addresses
+        and counts (``_E_*``); ``noise``: the search's residual noise and the margins'. A pose whose margins
+        overflow the buffers is marked in ``redo`` (its count 0), for ``search`` to redo with the NumPy engine."""
+        se, sw = _as_search(plan[_E_SEARCH]), as_swing(plan[_E_SWING])
+        n_swing, n, periodic = plan[_E_N_SWING], plan[_E_N], plan[_E_PERIODIC] != 0
+        n_s, n_e, n_c = s.shape[0], ends.shape[0], out_t.shape[1]
+        swings = np.empty((1, n_swing))
+        row = np.empty(n_c + n_swing + n_e)
+        grid = np.empty(n_s + n_c + n_swing + n_e)
+        n_grid = np.empty(1, dtype=np.int64)
+        span = np.empty(1)
+        for i in range(start, stop):
+            p, cnt_i, fcnt_i = params[i : i + 1], cnt[i : i + 1], fcnt[i : i + 1]
+            ot, ob, om, fm = out_t[i : i + 1], out_b[i : i + 1], out_m[i : i + 1], fam[i : i + 1]
+            redo[i] = False
+            for k in range(n_swing):
+                swings[0, k] = np.nan
+            sw(plan[_E_AMP], plan[_E_AMPS], p, hlo[i : i + 1], hhi[i : i + 1], n, periodic, steps, swings, 0, 1)
+            # the margins' samples: the swing samples and theta*'s ends (``grid_hints`` of the margins)
+            k = 0
+            for j in range(n_swing):  # (a NaN adds no sample: skipped here, not wrapped)
+                if not math.isnan(swings[0, j]):
+                    row[k] = swings[0, j]
+                    k += 1
+            for j in range(n_e):
+                row[k] = ends[j]
+                k += 1
+            if periodic:
+                for j in range(k):
+                    row[j] = wrap_pi(row[j])
+            M = _merge_row(hlo[i], hhi[i], s, row[:k], grid, True)
+            n_grid[0] = M
+            span[0] = hhi[i] - hlo[i]
+            fcnt[i] = 0
+            se(plan[_E_MARGIN], plan[_E_MARGINS], plan[_E_M_ALL], p, grid[:M].reshape((1, M)), n_grid, m_branches,
+               span, noise[1], ot, ob, om, cnt_i, fm, fcnt_i, False, 0, 1)  # fmt: skip
+            if cnt[i] > n_c or fcnt[i] > fam.shape[1]:
+                redo[i] = True
+                cnt[i] = 0
+                fcnt[i] = 0
+                continue
+            # its own samples: the margins' zeros, the swing samples, theta*'s ends (``sample_hints``, ``grid_hints``)
+            k = 0
+            for j in range(cnt[i]):
+                row[k] = out_t[i, j]
+                k += 1
+            for j in range(n_swing):
+                if not math.isnan(swings[0, j]):
+                    row[k] = swings[0, j]
+                    k += 1
+            for j in range(n_e):
+                row[k] = ends[j]
+                k += 1
+            if periodic:
+                for j in range(k):
+                    row[j] = wrap_pi(row[j])
+            M = _merge_row(lo[i], hi[i], s, row[:k], grid, True)
+            n_grid[0] = M
+            span[0] = hi[i] - lo[i]
+            fcnt[i] = 0
+            se(plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], p, grid[:M].reshape((1, M)), n_grid, branches, span,
+               noise[0], ot, ob, om, cnt_i, fm, fcnt_i, plan[_E_MULT] != 0, 0, 1)  # fmt: skip
+
+
+class EdgeSearch(NamedTuple):
+    """A reduction whose sample hints are the zeros of its margins (a generic sweep: the edges of its branch
+    domains, ``generic._Margins``) sampled with its swing samples (``geometric.swing_hints``), which are hints too:
+    what ``search`` needs to find them and the candidates in one compiled pass per pose (``Reduction.edge_search``;
+    its ``sample_hints`` must give the same samples, the reference's and ``sample_grid``'s way)."""
+
+    margins: object  # the margins' reduction (its engine plan: kernels, branches, residual noise)
+    swing: int  # the address of the swing kernel (``kernels.SWING_SIG``)
+    amplitude: int  # ... of the amplitude kernels it takes
+    amplitudes: int
+    steps: NDArray[np.int64]  # the steps whose amplitudes it examines
+    n_swing: int  # the samples it writes per pose, at most
+    n_samples: int  # its grid's samples (the sweep's default: ``sweep.N_SAMPLES``)
+    hint_range: Any  # ``hint_range(reduction, poses) -> (lo, hi)``: theta*'s range its hints are sought over
+    # (a function, not a bound method: the engine keeps its plan while the reduction lives, and no longer)
+
+
 def sample_grid(
     reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None
 ) -> tuple[Array, NDArray[np.int64]]:
@@ -764,6 +890,18 @@ class _Plan(NamedTuple):
     n_hints: int
     ends: Array  # theta*'s limits, sampled with the hints (none for a periodic theta*)
     periodic: bool
+    edges: _EdgePlan | None  # its ``EdgeSearch`` as ``_edge_search`` takes it, if any
+
+
+class _EdgePlan(NamedTuple):
+    """``_edge_search``'s arguments that do not change from call to call."""
+
+    ints: tuple[NDArray[np.int64], NDArray[np.int64]]  # its ``plan``, without and with multiplicities
+    margin_branches: NDArray[np.int64]
+    steps: NDArray[np.int64]
+    noise: Array  # the search's residual noise and the margins'
+    n_samples: int
+    hint_range: Any
 
 
 _PLANS: weakref.WeakKeyDictionary[object, _Plan] = weakref.WeakKeyDictionary()
@@ -789,7 +927,7 @@ def _make_plan(red) -> _Plan:
     j = red.free_joint
     ends = np.zeros(0) if red.periodic else np.array([red.robot.lower[j], red.robot.upper[j]], dtype=np.float64)
     branches = np.asarray(red.search_branches, dtype=np.int64)
-    return _Plan(
+    plan = _Plan(
         residual=address_of(red.kernel[0], RESIDUAL_SIG),
         residuals=address_of(_no_residuals if res_all is None else res_all, RESIDUALS_SIG),
         n_all=0 if res_all is None else int(red.n_branches),
@@ -798,7 +936,27 @@ def _make_plan(red) -> _Plan:
         n_hints=0 if hints is None else int(red.n_kernel_hints),
         ends=ends,
         periodic=bool(red.periodic),
+        edges=None,
     )
+    edge_search = owned_kernel(red, "edge_search")
+    if edge_search is None or hints is not None or overridden_below_kernel(red.__class__, ("sample_hints",)):
+        return plan
+    edges = edge_search(red)  # (read from the class: a function of the reduction)
+    if edges is None:
+        return plan
+    margins = _plan(edges.margins)
+    ints = np.zeros(_E_SIZE, dtype=np.int64)
+    ints[_E_SEARCH] = address_of(_search, _SEARCH_FN_SIG)
+    ints[_E_RES], ints[_E_RES_ALL], ints[_E_N_ALL] = plan.residual, plan.residuals, plan.n_all
+    ints[_E_MARGIN], ints[_E_MARGINS], ints[_E_M_ALL] = margins.residual, margins.residuals, margins.n_all
+    ints[_E_SWING], ints[_E_AMP], ints[_E_AMPS] = edges.swing, edges.amplitude, edges.amplitudes
+    ints[_E_N_SWING], ints[_E_N], ints[_E_PERIODIC] = edges.n_swing, edges.n_samples, plan.periodic
+    with_mult = ints.copy()
+    with_mult[_E_MULT] = 1
+    noise = np.array([red.residual_noise, edges.margins.residual_noise], dtype=np.float64)
+    steps = np.ascontiguousarray(edges.steps, dtype=np.int64)
+    edge_plan = _EdgePlan((ints, with_mult), margins.branches, steps, noise, edges.n_samples, edges.hint_range)
+    return plan._replace(edges=edge_plan)
 
 
 def _hints_kernel(reduction):
@@ -829,12 +987,14 @@ def search(
     n_samples: int,
     params: Array | None = None,
     multiplicity: bool = True,
+    edges: bool = True,
 ):
     """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
     Poses whose candidate or family buffers overflow are redone by the NumPy engine. ``multiplicity`` False: the
-    candidates' multiplicities are not wanted (each is given as 1; ~4 residuals a candidate less)."""
+    candidates' multiplicities are not wanted (each is given as 1; ~4 residuals a candidate less). A reduction with
+    an ``EdgeSearch`` finds its hints in the same pass, pose by pose, unless ``edges`` is False: then they come from
+    its ``sample_hints`` through ``sample_grid``, step by step (the same samples: the tests compare the two)."""
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
-    theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
     out_b = np.empty((N, MAX_CAND), dtype=np.int64)
@@ -842,31 +1002,62 @@ def search(
     cnt = np.zeros(N, dtype=np.int64)
     fam = np.empty((N, MAX_FAM, 3))
     fcnt = np.zeros(N, dtype=np.int64)
-    span = (hi - lo).astype(np.float64)
     plan = _plan(reduction)
+    edge = plan.edges if edges and plan.edges is not None and plan.edges.n_samples == n_samples else None
+    redo = None
     # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
-    parallel.run(
-        _search,
-        N,
-        PARALLEL_MIN,
-        plan.residual,
-        plan.residuals,
-        plan.n_all,
-        params,
-        np.ascontiguousarray(theta),
-        n_theta,
-        plan.branches,
-        np.ascontiguousarray(span, dtype=np.float64),
-        float(reduction.residual_noise),
-        out_t,
-        out_b,
-        out_m,
-        cnt,
-        fam,
-        fcnt,
-        multiplicity,
-    )
-    if N == 1 and cnt[0] <= MAX_CAND and fcnt[0] == 0:  # (a single pose: the general bookkeeping costs ~40 us)
+    if edge is not None:  # the hints and the candidates in one pass per pose
+        redo = np.empty(N, dtype=np.bool_)
+        hlo, hhi = edge.hint_range(reduction, poses)
+        parallel.run(
+            _edge_search,
+            N,
+            PARALLEL_MIN,
+            edge.ints[bool(multiplicity)],
+            plan.branches,
+            edge.margin_branches,
+            edge.steps,
+            edge.noise,
+            params,
+            np.ascontiguousarray(hlo, dtype=np.float64),
+            np.ascontiguousarray(hhi, dtype=np.float64),
+            np.ascontiguousarray(lo, dtype=np.float64),
+            np.ascontiguousarray(hi, dtype=np.float64),
+            _ref._unit_grid(n_samples),
+            plan.ends,
+            out_t,
+            out_b,
+            out_m,
+            cnt,
+            fam,
+            fcnt,
+            redo,
+        )
+    else:
+        theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
+        parallel.run(
+            _search,
+            N,
+            PARALLEL_MIN,
+            plan.residual,
+            plan.residuals,
+            plan.n_all,
+            params,
+            np.ascontiguousarray(theta),
+            n_theta,
+            plan.branches,
+            np.ascontiguousarray(hi - lo, dtype=np.float64),
+            float(reduction.residual_noise),
+            out_t,
+            out_b,
+            out_m,
+            cnt,
+            fam,
+            fcnt,
+            multiplicity,
+        )
+    if N == 1 and cnt[0] <= MAX_CAND and fcnt[0] == 0 and (redo is None or not redo[0]):
+        # (a single pose: the general bookkeeping costs ~40 us)
         k0 = int(cnt[0])
         single = _ref.Candidates(
             pose=np.zeros(k0, dtype=np.intp),
@@ -876,6 +1067,8 @@ def search(
         )
         return single, _ref.Spans.empty()
     over = (cnt > MAX_CAND) | (fcnt > MAX_FAM)
+    if redo is not None:
+        over |= redo
     counts = np.where(over, 0, cnt)
     pose_idx = np.repeat(np.arange(N), counts)
     slot = np.arange(pose_idx.size) - np.repeat(np.cumsum(counts) - counts, counts)

@@ -85,6 +85,11 @@ class Reduction(ABC):
     #: overrides ``sample_hints``.
     kernel_hints: Any = None
     n_kernel_hints: int = 0
+    #: Optional method ``edge_search(self) -> fastsweep.EdgeSearch | None``: the hints are zeros of another residual
+    #: (the generic sweeps' margins), which the engine then finds in the same compiled pass as the candidates, pose
+    #: by pose. Ignored unless set by the class that sets ``kernel`` and unless a subclass below that class
+    #: overrides ``sample_hints``.
+    edge_search: Any = None
     #: No sweep: every branch of ``solve_rest`` (at any theta*) is a candidate (a closed-form decomposition).
     closed_form: bool = False
     #: Classes of branches whose residuals are identical (they differ in the configuration only, e.g. by a

@@ -318,6 +318,26 @@ class GeometricReduction(Reduction):
         keep = np.any(np.isfinite(theta), axis=0)
         return theta[:, keep] if keep.any() else None
 
+    def edge_search(self) -> Any:
+        """``sample_hints`` as the engine finds them in the same compiled pass as the search
+        (``fastsweep.EdgeSearch``, ``Reduction.edge_search``); None for a closed form (no sweep)."""
+        if self.closed_form:
+            return None
+        from .. import fastsweep, sweep  # local: the engine imports the reductions
+        from .kernels import RESIDUAL_SIG, RESIDUALS_SIG, SWING_SIG, address_of
+
+        ck = self._case_kernels
+        return fastsweep.EdgeSearch(
+            margins=_Margins(self, np.empty((0, 0))),
+            swing=address_of(geometric.swing, SWING_SIG),
+            amplitude=address_of(ck.amplitude, RESIDUAL_SIG),
+            amplitudes=address_of(ck.amplitudes, RESIDUALS_SIG),
+            steps=np.asarray(self._steps[1], dtype=np.int64),
+            n_swing=geometric.SWING_PER_POSE,
+            n_samples=sweep.N_SAMPLES,
+            hint_range=GeometricReduction._range,
+        )
+
     def _range(self, poses: Array) -> tuple[Array, Array]:
         """theta*'s sweep range for chain ``poses (N, 4, 4)`` (as the solver's: the circle, or ``search_range``)."""
         n = poses.shape[0]

@@ -48,6 +48,7 @@ from .kernels import (
     CONFIGURATIONS_SIG,
     RESIDUAL_SIG,
     RESIDUALS_SIG,
+    SWING_SIG,
     LazyKernel,
     address_of,
     as_configuration,
@@ -390,7 +391,6 @@ SWING_DEPTH = 2.0
 SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
-@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
 def _swing(amp, amps, params, lo, hi, n, periodic, ks, out, start, stop):
     """Swing hints of poses ``start .. stop - 1`` (``swing_hints``). ``amp``: the address of ``amplitude``
     (``kernels.address_of``: called, not linked in: Numba re-optimises everything a compiled function links, and the
@@ -463,19 +463,24 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
     from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
 
     parallel.run(
-        _swing,
+        swing,
         params.shape[0],
         PARALLEL_MIN,
         address_of(amplitude, RESIDUAL_SIG),
         address_of(amplitudes, RESIDUALS_SIG),
         params,
-        lo,
-        hi,
+        np.ascontiguousarray(lo, dtype=np.float64),
+        np.ascontiguousarray(hi, dtype=np.float64),
         n,
         periodic,
         ks,
         out,
     )
+
+
+#: ``_swing`` with its signature (``kernels.SWING_SIG``): the engine calls it by its address too
+#: (``fastsweep.EdgeSearch``).
+swing = LazyKernel(_swing, SWING_SIG, cache=True, nogil=True)
 
 
 wrist_residual = LazyKernel(_no_residual, RESIDUAL_SIG, cache=True)

@@ -120,7 +120,7 @@ def _carm_theta2(p, th2: float, b: int) -> float:
 
 
 if _njit is not None:
-    from numba import float64, int64, void
+    from numba import boolean, float64, int64, void
 
     RESIDUAL_SIG = float64(float64[::1], float64, int64)
     #: ``residuals(params, theta, out)``: every branch's residual at theta* into ``out`` (optional, see
@@ -132,6 +132,13 @@ if _njit is not None:
     CONFIGURATIONS_SIG = void(float64[::1], float64, float64[:, ::1])
     #: ``hints(params, out)``: a reduction's sample hints of one pose (optional, see ``Reduction.kernel_hints``).
     HINTS_SIG = void(float64[::1], float64[::1])
+    #: ``swing(amplitude, amplitudes, params, lo, hi, n, periodic, steps, out, start, stop)``: a generic sweep's swing
+    #: samples of poses ``start .. stop - 1`` (``geometric.swing_hints``; ``amplitude`` and ``amplitudes`` the
+    #: addresses of its amplitude kernels), which the engine calls pose by pose (``fastsweep.EdgeSearch``).
+    SWING_SIG = void(
+        int64, int64, float64[:, ::1], float64[::1], float64[::1], int64, boolean, int64[::1], float64[:, ::1], int64,
+        int64,
+    )  # fmt: skip
     _elbow = internal(_elbow)
     _d1_position = internal(_d1_position)
     _elbow_residual = internal(_elbow_residual)
@@ -257,6 +264,7 @@ as_residuals: Any = None
 as_configuration: Any = None
 as_configurations: Any = None
 as_hints: Any = None
+as_swing: Any = None
 if _njit is not None:
     from .._jit import function_at
 
@@ -266,6 +274,7 @@ if _njit is not None:
     as_configuration = function_at(CONFIGURATION_SIG)
     as_configurations = function_at(CONFIGURATIONS_SIG)
     as_hints = function_at(HINTS_SIG)
+    as_swing = function_at(SWING_SIG)
 
 
 def _carm_configuration(p, x: float, b: int, out, rail: bool) -> None:
