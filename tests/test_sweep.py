@@ -572,17 +572,17 @@ def _same_search(a: Any, b: Any) -> None:
 
 
 @pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
-@pytest.mark.parametrize("name", ["fanuc_crx10ia", "kinova_jaco2", "xarm6", "yaskawa_hc10"])
+@pytest.mark.parametrize("name", ["fanuc_crx10ia", "kinova_jaco2", "xarm6", "yaskawa_hc10", "carm"])
 def test_edge_search_is_the_staged_search(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """A generic sweep's search in one pass per pose (its swing samples, its margins' zeros, its candidates:
     ``fastsweep.EdgeSearch``) finds what the staged search finds (``sample_hints``, then ``sample_grid``, then the
-    search: ``edges=False``), bit for bit, batched and pose by pose: random poses, and poses on the singular set
-    (wrist straight, elbow straight, both). With the buffers cut to one candidate, every pose overflows and is
-    redone by the NumPy engine, in both."""
+    search: ``edges=False``), bit for bit, batched and pose by pose, theta* revolute or prismatic (the C-Arm's rail,
+    automatic decomposition): random poses, and poses on the singular set (wrist straight, elbow straight, both).
+    With the buffers cut to one candidate, every pose overflows and is redone by the NumPy engine, in both."""
     from sweepik import solver, sweep
 
     robot = load_robot(name)
-    red = sweepik.get_reduction(robot, None)
+    red = sweepik.get_reduction(robot, "auto")
     assert fastsweep._plan(red).edges is not None  # (the one-pass search is what is tested)
     rng = np.random.default_rng(11)
     q = rng.uniform(robot.lower, robot.upper, (60, 6))

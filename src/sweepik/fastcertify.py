@@ -13,13 +13,13 @@ from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from . import parallel
 from ._jit import alive, inlined, unowned
 from ._wrap import wrap_pi
 from .dedupe import limit_args
-from .fastsweep import AVAILABLE, PARALLEL_MIN
+from .fastsweep import AVAILABLE, PARALLEL_MIN, writable
 from .pose import GIMBAL_TOL
 from .reductions.kernels import address_of, lazy_njit, owned_kernel
 from .units import orientation_weight
@@ -545,18 +545,12 @@ def chain_args(robot) -> tuple[Array, Array, NDArray[np.bool_], Array]:
     return np.array(ch.H), np.array(ch.P), np.array(ch.revolute), np.array(ch.R_end)
 
 
-def _writable(a: ArrayLike) -> Array:
-    """``a`` as a C-contiguous, writable float64 array (the compiled signatures' kind): copied only if needed."""
-    a = np.asarray(a)
-    return np.array(a, dtype=np.float64, order="C", copy=not a.flags.writeable or None)
-
-
 def pose_and_jacobian(robot, q: Array) -> tuple[Array, Array]:
     """World tool poses ``(K, 4, 4)`` and geometric Jacobians ``(K, 6, n)`` at the tool point of configurations
     ``q (K, n)`` (``kinematics.geometric_jacobian``), compiled."""
     K, n = q.shape
     T, J = np.empty((K, 4, 4)), np.empty((K, 6, n))
-    parallel.run(_pose_jacobian, K, 16 * PARALLEL_MIN, *chain_args(robot), _writable(q), T, J)
+    parallel.run(_pose_jacobian, K, 16 * PARALLEL_MIN, *chain_args(robot), writable(q), T, J)
     return T, J
 
 
@@ -570,8 +564,8 @@ def tool_poses(robot, q: Array, target: Array | None = None, weight: float = 1.0
         K,
         16 * PARALLEL_MIN,
         *chain_args(robot),
-        _writable(q),
-        np.zeros((0, 4, 4)) if target is None else _writable(target),
+        writable(q),
+        np.zeros((0, 4, 4)) if target is None else writable(target),
         float(weight),
         out,
         err,
@@ -591,7 +585,7 @@ def locate_cuts(robot, red, chain: Array, world: Array, pose, branch, a: Array, 
         PARALLEL_MIN,
         address_of(red.kernel[1], CONFIGURATION_SIG),
         np.ascontiguousarray(red.kernel_params(chain), dtype=np.float64),
-        _writable(world),
+        writable(world),
         *args,
         *geometry,
         float(orientation_weight(robot.length_unit)),
@@ -640,7 +634,7 @@ def _run(kernel, n, min_parallel, K, robot, red, chain, world, params, cfg, *mid
         min_parallel,
         cfg,
         np.ascontiguousarray(red.kernel_params(chain) if params is None else params, dtype=np.float64),
-        _writable(world),
+        writable(world),
         *middle,
         *chain_args(robot),
         float(orientation_weight(robot.length_unit)),

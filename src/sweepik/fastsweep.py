@@ -24,7 +24,7 @@ import weakref
 from typing import Any, NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import parallel
 from . import sweep as _ref
@@ -826,6 +826,12 @@ class EdgeSearch(NamedTuple):
     # (a function, not a bound method: the engine keeps its plan while the reduction lives, and no longer)
 
 
+def writable(a: ArrayLike) -> Array:
+    """``a`` as a C-contiguous, writable float64 array (the compiled signatures' kind): copied only if needed."""
+    a = np.asarray(a)
+    return np.array(a, dtype=np.float64, order="C", copy=not a.flags.writeable or None)
+
+
 def sample_grid(
     reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None
 ) -> tuple[Array, NDArray[np.int64]]:
@@ -1019,10 +1025,10 @@ def search(
             edge.steps,
             edge.noise,
             params,
-            np.ascontiguousarray(hlo, dtype=np.float64),
-            np.ascontiguousarray(hhi, dtype=np.float64),
-            np.ascontiguousarray(lo, dtype=np.float64),
-            np.ascontiguousarray(hi, dtype=np.float64),
+            writable(hlo),
+            writable(hhi),
+            writable(lo),
+            writable(hi),
             _ref._unit_grid(n_samples),
             plan.ends,
             out_t,

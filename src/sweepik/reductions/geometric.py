@@ -460,7 +460,7 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
     ``h``, where its angles turn by up to pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
     ``amplitude`` of ``case_kernels``: the arm's kernel, given as ``amplitude``, with ``amplitudes`` its all-step
     kernel, which must compute at least the steps ``ks``). Batches use both cores, as the engine's search."""
-    from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
+    from ..fastsweep import PARALLEL_MIN, writable  # local: the engine imports the reductions
 
     parallel.run(
         swing,
@@ -469,8 +469,8 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
         address_of(amplitude, RESIDUAL_SIG),
         address_of(amplitudes, RESIDUALS_SIG),
         params,
-        np.ascontiguousarray(lo, dtype=np.float64),
-        np.ascontiguousarray(hi, dtype=np.float64),
+        writable(lo),
+        writable(hi),
         n,
         periodic,
         ks,
