@@ -691,7 +691,12 @@ def _twin_rows(red: Reduction, branch: IntArray) -> tuple[IntArray, IntArray]:
     """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
     that branch: ``(rows, branches)``."""
     rows, branches = [], []
-    for twin in _twin_maps(tuple(tuple(int(b) for b in cls) for cls in red.twins), red.n_branches):
+    twins = red.twins
+    try:  # (as the reductions give them: tuples of ints, the cache's key as it is)
+        maps = _twin_maps(twins, red.n_branches)
+    except TypeError:  # (unhashable classes: lists, arrays)
+        maps = _twin_maps(tuple(tuple(int(b) for b in cls) for cls in twins), red.n_branches)
+    for twin in maps:
         t = twin[branch]
         k = np.nonzero(t >= 0)[0]
         rows.append(k)
