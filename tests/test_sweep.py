@@ -572,18 +572,29 @@ def _same_search(a: Any, b: Any) -> None:
 
 
 @pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
-@pytest.mark.parametrize("name", ["fanuc_crx10ia", "kinova_jaco2", "xarm6", "yaskawa_hc10", "carm"])
-def test_edge_search_is_the_staged_search(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A generic sweep's search in one pass per pose (its swing samples, its margins' zeros, its candidates:
-    ``fastsweep.EdgeSearch``) finds what the staged search finds (``sample_hints``, then ``sample_grid``, then the
-    search: ``edges=False``), bit for bit, batched and pose by pose, theta* revolute or prismatic (the C-Arm's rail,
-    automatic decomposition): random poses, and poses on the singular set (wrist straight, elbow straight, both).
-    With the buffers cut to one candidate, every pose overflows and is redone by the NumPy engine, in both."""
+@pytest.mark.parametrize(
+    ("name", "reduction"),
+    [
+        ("fanuc_crx10ia", "auto"),
+        ("kinova_jaco2", "auto"),
+        ("xarm6", "auto"),
+        ("yaskawa_hc10", "auto"),
+        ("carm", "auto"),
+        ("carm", "carm-d1"),
+    ],
+)
+def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The search in one compiled pass per pose finds what the staged search finds (every pose's samples first, by
+    ``sample_grid``, then the search: ``one_pass=False``), bit for bit, batched and pose by pose: a generic sweep
+    (its swing samples, its margins' zeros, its candidates: ``fastsweep.EdgeSearch``), theta* revolute or prismatic
+    (the C-Arm's rail, automatic decomposition), and a reduction with a hints kernel (carm-d1). Random poses, and
+    poses on the singular set (joint 5 at 0, joint 3 at 0, both). With the buffers cut to one candidate, every pose
+    overflows and is redone by the NumPy engine, in both."""
     from sweepik import solver, sweep
 
     robot = load_robot(name)
-    red = sweepik.get_reduction(robot, "auto")
-    assert fastsweep._plan(red).edges is not None  # (the one-pass search is what is tested)
+    red = sweepik.get_reduction(robot, reduction)
+    assert fastsweep._plan(red).one_pass is not None  # (the one-pass search is what is tested)
     rng = np.random.default_rng(11)
     q = rng.uniform(robot.lower, robot.upper, (60, 6))
     q[:10, 4] = 0.0
@@ -594,14 +605,14 @@ def test_edge_search_is_the_staged_search(name: str, monkeypatch: pytest.MonkeyP
     lo, hi = solver._theta_range(robot, red, chain)
     n = sweep.N_SAMPLES
     one_pass = fastsweep.search(red, chain, lo, hi, n)
-    _same_search(one_pass, fastsweep.search(red, chain, lo, hi, n, edges=False))
+    _same_search(one_pass, fastsweep.search(red, chain, lo, hi, n, one_pass=False))
     assert one_pass[0].pose.size >= chain.shape[0]  # (candidates found: the comparison is not of empty sets)
     for i in range(0, 60, 7):
         one = fastsweep.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n)
-        _same_search(one, fastsweep.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n, edges=False))
+        _same_search(one, fastsweep.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n, one_pass=False))
     monkeypatch.setattr(fastsweep, "MAX_CAND", 1)
     few = slice(0, 25, 6)
     _same_search(
         fastsweep.search(red, chain[few], lo[few], hi[few], n),
-        fastsweep.search(red, chain[few], lo[few], hi[few], n, edges=False),
+        fastsweep.search(red, chain[few], lo[few], hi[few], n, one_pass=False),
     )

@@ -706,14 +706,16 @@ if AVAILABLE:
     from ._jit import function_at
     from .reductions.kernels import as_swing
 
-    #: ``_search`` called from compiled code, by its address (``kernels.address_of``: not linked in, so that
-    #: ``_edge_search`` compiles in a second rather than recompiling the search).
+    #: ``_search`` called from compiled code, by its address (``kernels.address_of``: not linked in, so that the
+    #: one-pass kernels compile in a second rather than recompiling the search).
     _SEARCH_FN_SIG = _void(*_SEARCH_SIG)
     _as_search = function_at(_SEARCH_FN_SIG)
-    #: ``_edge_search``'s plan: the addresses and counts it takes as one array (a Python call costs per argument).
+    #: The one-pass kernels' plan: the addresses and counts they take as one array (a Python call costs per argument).
     (_E_SEARCH, _E_RES, _E_RES_ALL, _E_N_ALL, _E_MARGIN, _E_MARGINS, _E_M_ALL, _E_SWING, _E_AMP, _E_AMPS, _E_N_SWING,
-     _E_N, _E_PERIODIC, _E_MULT, _E_SIZE) = range(15)  # fmt: skip
-    _EDGE_SIG = (
+     _E_N, _E_PERIODIC, _E_MULT, _E_HINTS, _E_N_HINTS, _E_SIZE) = range(17)  # fmt: skip
+    #: ``(plan, branches, margin branches, steps, noise, params, hlo, hhi, lo, hi, unit grid, ends, out_t, out_b,
+    #: out_m, cnt, fam, fcnt, redo, start, stop)``: both one-pass kernels' (each ignores what it does not use).
+    _ONE_PASS_SIG = (
         int64[::1],
         int64[::1],
         int64[::1],
@@ -737,7 +739,21 @@ if AVAILABLE:
         int64,
     )
 
-    @lazy_njit(_EDGE_SIG, cache=True, nogil=True)
+    @inlined
+    def _pose_search(
+        se, res, res_all, n_all, branches, noise, mult, params, grid, M, n_grid, span, width, out_t, out_b, out_m,
+        cnt, fam, fcnt, i,
+    ):  # fmt: skip
+        """``_search`` of pose ``i`` alone (its rows of the arrays, as arrays of one row) on the first ``M`` samples
+        of ``grid``, over a range ``width`` wide (``n_grid``, ``span``: the caller's work arrays of one)."""
+        n_grid[0] = M
+        span[0] = width
+        fcnt[i] = 0
+        se(res, res_all, n_all, params[i : i + 1], grid[:M].reshape((1, M)), n_grid, branches, span, noise,
+           out_t[i : i + 1], out_b[i : i + 1], out_m[i : i + 1], cnt[i : i + 1], fam[i : i + 1], fcnt[i : i + 1], mult,
+           0, 1)  # fmt: skip
+
+    @lazy_njit(_ONE_PASS_SIG, cache=True, nogil=True)
     def _edge_search(
         plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, out_t, out_b, out_m, cnt, fam,
         fcnt, redo, start, stop,
@@ -757,12 +773,11 @@ if AVAILABLE:
         n_grid = np.empty(1, dtype=np.int64)
         span = np.empty(1)
         for i in range(start, stop):
-            p, cnt_i, fcnt_i = params[i : i + 1], cnt[i : i + 1], fcnt[i : i + 1]
-            ot, ob, om, fm = out_t[i : i + 1], out_b[i : i + 1], out_m[i : i + 1], fam[i : i + 1]
             redo[i] = False
             for k in range(n_swing):
                 swings[0, k] = np.nan
-            sw(plan[_E_AMP], plan[_E_AMPS], p, hlo[i : i + 1], hhi[i : i + 1], n, periodic, steps, swings, 0, 1)
+            sw(plan[_E_AMP], plan[_E_AMPS], params[i : i + 1], hlo[i : i + 1], hhi[i : i + 1], n, periodic, steps,
+               swings, 0, 1)  # fmt: skip
             # the margins' samples: the swing samples and theta*'s ends (``grid_hints`` of the margins)
             k = 0
             for j in range(n_swing):  # (a NaN adds no sample: skipped here, not wrapped)
@@ -776,11 +791,8 @@ if AVAILABLE:
                 for j in range(k):
                     row[j] = wrap_pi(row[j])
             M = _merge_row(hlo[i], hhi[i], s, row[:k], grid, True)
-            n_grid[0] = M
-            span[0] = hhi[i] - hlo[i]
-            fcnt[i] = 0
-            se(plan[_E_MARGIN], plan[_E_MARGINS], plan[_E_M_ALL], p, grid[:M].reshape((1, M)), n_grid, m_branches,
-               span, noise[1], ot, ob, om, cnt_i, fm, fcnt_i, False, 0, 1)  # fmt: skip
+            _pose_search(se, plan[_E_MARGIN], plan[_E_MARGINS], plan[_E_M_ALL], m_branches, noise[1], False, params,
+                         grid, M, n_grid, span, hhi[i] - hlo[i], out_t, out_b, out_m, cnt, fam, fcnt, i)  # fmt: skip
             if cnt[i] > n_c or fcnt[i] > fam.shape[1]:
                 redo[i] = True
                 cnt[i] = 0
@@ -802,11 +814,37 @@ if AVAILABLE:
                 for j in range(k):
                     row[j] = wrap_pi(row[j])
             M = _merge_row(lo[i], hi[i], s, row[:k], grid, True)
-            n_grid[0] = M
-            span[0] = hi[i] - lo[i]
-            fcnt[i] = 0
-            se(plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], p, grid[:M].reshape((1, M)), n_grid, branches, span,
-               noise[0], ot, ob, om, cnt_i, fm, fcnt_i, plan[_E_MULT] != 0, 0, 1)  # fmt: skip
+            _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
+                         params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt,
+                         i)  # fmt: skip
+
+    @lazy_njit(_ONE_PASS_SIG, cache=True, nogil=True)
+    def _hinted_search(
+        plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, out_t, out_b, out_m, cnt, fam,
+        fcnt, redo, start, stop,
+    ):  # fmt: skip
+        """``search`` of poses ``start .. stop - 1`` for a reduction with a hints kernel (``Reduction.kernel_hints``),
+        each pose in one pass: its samples as ``_hinted_grid`` gives them, then its search (``plan[_E_HINTS]``: the
+        hints kernel's address, ``plan[_E_N_HINTS]`` the hints it writes; ``m_branches``, ``steps``, ``hlo``, ``hhi``
+        unused). Nothing overflows here that the engine could redo: ``redo`` is all False."""
+        se, fn = _as_search(plan[_E_SEARCH]), as_hints(plan[_E_HINTS])
+        nh, n_e, periodic = plan[_E_N_HINTS], ends.shape[0], plan[_E_PERIODIC] != 0
+        row = np.empty(nh + n_e)
+        grid = np.empty(s.shape[0] + nh + n_e)
+        n_grid = np.empty(1, dtype=np.int64)
+        span = np.empty(1)
+        for i in range(start, stop):
+            redo[i] = False
+            fn(params[i], row[:nh])
+            for k in range(n_e):
+                row[nh + k] = ends[k]
+            if periodic:
+                for k in range(nh + n_e):
+                    row[k] = wrap_pi(row[k])
+            M = _merge_row(lo[i], hi[i], s, row, grid, False)
+            _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
+                         params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt,
+                         i)  # fmt: skip
 
 
 class EdgeSearch(NamedTuple):
@@ -896,18 +934,20 @@ class _Plan(NamedTuple):
     n_hints: int
     ends: Array  # theta*'s limits, sampled with the hints (none for a periodic theta*)
     periodic: bool
-    edges: _EdgePlan | None  # its ``EdgeSearch`` as ``_edge_search`` takes it, if any
+    one_pass: _OnePass | None  # its hints and search in one compiled pass per pose, if it can
 
 
-class _EdgePlan(NamedTuple):
-    """``_edge_search``'s arguments that do not change from call to call."""
+class _OnePass(NamedTuple):
+    """A one-pass kernel (``_edge_search``, ``_hinted_search``) and its arguments that do not change from call to
+    call."""
 
+    kernel: Any
     ints: tuple[NDArray[np.int64], NDArray[np.int64]]  # its ``plan``, without and with multiplicities
     margin_branches: NDArray[np.int64]
     steps: NDArray[np.int64]
     noise: Array  # the search's residual noise and the margins'
-    n_samples: int
-    hint_range: Any
+    n_samples: int | None  # the only sample count it takes (None: any)
+    hint_range: Any  # ``EdgeSearch.hint_range``; None: the search's range
 
 
 _PLANS: weakref.WeakKeyDictionary[object, _Plan] = weakref.WeakKeyDictionary()
@@ -942,27 +982,38 @@ def _make_plan(red) -> _Plan:
         n_hints=0 if hints is None else int(red.n_kernel_hints),
         ends=ends,
         periodic=bool(red.periodic),
-        edges=None,
+        one_pass=None,
     )
+    ints = np.zeros(_E_SIZE, dtype=np.int64)
+    ints[_E_SEARCH] = address_of(_search, _SEARCH_FN_SIG)
+    ints[_E_RES], ints[_E_RES_ALL], ints[_E_N_ALL] = plan.residual, plan.residuals, plan.n_all
+    ints[_E_PERIODIC] = plan.periodic
+    noise = np.array([red.residual_noise, 0.0], dtype=np.float64)
+    none = np.zeros(0, dtype=np.int64)
+    if plan.hints is not None:
+        ints[_E_HINTS], ints[_E_N_HINTS] = plan.hints, plan.n_hints
+        return plan._replace(one_pass=_OnePass(_hinted_search, _with_mult(ints), none, none, noise, None, None))
     edge_search = owned_kernel(red, "edge_search")
-    if edge_search is None or hints is not None or overridden_below_kernel(red.__class__, ("sample_hints",)):
+    if edge_search is None or overridden_below_kernel(red.__class__, ("sample_hints",)):
         return plan
     edges = edge_search(red)  # (read from the class: a function of the reduction)
     if edges is None:
         return plan
     margins = _plan(edges.margins)
-    ints = np.zeros(_E_SIZE, dtype=np.int64)
-    ints[_E_SEARCH] = address_of(_search, _SEARCH_FN_SIG)
-    ints[_E_RES], ints[_E_RES_ALL], ints[_E_N_ALL] = plan.residual, plan.residuals, plan.n_all
     ints[_E_MARGIN], ints[_E_MARGINS], ints[_E_M_ALL] = margins.residual, margins.residuals, margins.n_all
     ints[_E_SWING], ints[_E_AMP], ints[_E_AMPS] = edges.swing, edges.amplitude, edges.amplitudes
-    ints[_E_N_SWING], ints[_E_N], ints[_E_PERIODIC] = edges.n_swing, edges.n_samples, plan.periodic
+    ints[_E_N_SWING], ints[_E_N] = edges.n_swing, edges.n_samples
+    noise[1] = edges.margins.residual_noise
+    steps = np.ascontiguousarray(edges.steps, dtype=np.int64)
+    one = _OnePass(_edge_search, _with_mult(ints), margins.branches, steps, noise, edges.n_samples, edges.hint_range)
+    return plan._replace(one_pass=one)
+
+
+def _with_mult(ints: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """A one-pass plan without and with multiplicities."""
     with_mult = ints.copy()
     with_mult[_E_MULT] = 1
-    noise = np.array([red.residual_noise, edges.margins.residual_noise], dtype=np.float64)
-    steps = np.ascontiguousarray(edges.steps, dtype=np.int64)
-    edge_plan = _EdgePlan((ints, with_mult), margins.branches, steps, noise, edges.n_samples, edges.hint_range)
-    return plan._replace(edges=edge_plan)
+    return ints, with_mult
 
 
 def _hints_kernel(reduction):
@@ -993,13 +1044,14 @@ def search(
     n_samples: int,
     params: Array | None = None,
     multiplicity: bool = True,
-    edges: bool = True,
+    one_pass: bool = True,
 ):
     """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
     Poses whose candidate or family buffers overflow are redone by the NumPy engine. ``multiplicity`` False: the
     candidates' multiplicities are not wanted (each is given as 1; ~4 residuals a candidate less). A reduction with
-    an ``EdgeSearch`` finds its hints in the same pass, pose by pose, unless ``edges`` is False: then they come from
-    its ``sample_hints`` through ``sample_grid``, step by step (the same samples: the tests compare the two)."""
+    a hints kernel or an ``EdgeSearch`` finds each pose's samples and candidates in one compiled pass, unless
+    ``one_pass`` is False: then ``sample_grid`` gives the samples of every pose first (the same samples: the tests
+    compare the two)."""
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
@@ -1009,26 +1061,31 @@ def search(
     fam = np.empty((N, MAX_FAM, 3))
     fcnt = np.zeros(N, dtype=np.int64)
     plan = _plan(reduction)
-    edge = plan.edges if edges and plan.edges is not None and plan.edges.n_samples == n_samples else None
+    one = plan.one_pass if one_pass else None
+    if one is not None and one.n_samples is not None and one.n_samples != n_samples:
+        one = None
     redo = None
     # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
-    if edge is not None:  # the hints and the candidates in one pass per pose
+    if one is not None:  # each pose's samples, then its candidates
         redo = np.empty(N, dtype=np.bool_)
-        hlo, hhi = edge.hint_range(reduction, poses)
+        lo, hi = writable(lo), writable(hi)
+        hlo, hhi = lo, hi
+        if one.hint_range is not None:
+            hlo, hhi = (writable(a) for a in one.hint_range(reduction, poses))
         parallel.run(
-            _edge_search,
+            one.kernel,
             N,
             PARALLEL_MIN,
-            edge.ints[bool(multiplicity)],
+            one.ints[bool(multiplicity)],
             plan.branches,
-            edge.margin_branches,
-            edge.steps,
-            edge.noise,
+            one.margin_branches,
+            one.steps,
+            one.noise,
             params,
-            writable(hlo),
-            writable(hhi),
-            writable(lo),
-            writable(hi),
+            hlo,
+            hhi,
+            lo,
+            hi,
             _ref._unit_grid(n_samples),
             plan.ends,
             out_t,
