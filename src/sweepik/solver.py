@@ -468,7 +468,10 @@ def _settle_stepwise(
 
 
 def _errors(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array, Array]:
-    """Geodesic error and the paper's J ``(K,)`` of configurations ``q (K, n)`` against ``target (K, 4, 4)``."""
+    """Geodesic error and the paper's J ``(K,)`` of configurations ``q (K, n)`` against ``target (K, 4, 4)``:
+    compiled as certification computes them (``fastcertify.pose_errors``), else in NumPy."""
+    if fastcertify.AVAILABLE:
+        return fastcertify.pose_errors(robot, q, target, weight)
     T = fastsweep.flange_poses(robot, q) @ robot.T_flange_tool
     return pose_error_geodesic(T, target, weight), pose_error_paper(T, target, weight)
 
