@@ -616,3 +616,13 @@ def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeyp
         fastsweep.search(red, chain[few], lo[few], hi[few], n),
         fastsweep.search(red, chain[few], lo[few], hi[few], n, one_pass=False),
     )
+    if reduction == "auto":
+        # (a generic sweep redoes a pose whose margins overflow as a whole, the staged search its margins alone:
+        # with buffers cut below the margins' zeros they differ, as they may; MAX_CAND is far above them)
+        return
+    # some poses redone, the others not: the redone ones (and their twins' copies) in their place
+    counts = np.bincount(one_pass[0].pose, minlength=chain.shape[0])
+    cut = int(np.median(counts))
+    assert (counts > cut).any() and (counts <= cut).any()
+    monkeypatch.setattr(fastsweep, "MAX_CAND", cut)
+    _same_search(fastsweep.search(red, chain, lo, hi, n), fastsweep.search(red, chain, lo, hi, n, one_pass=False))

@@ -713,8 +713,8 @@ if AVAILABLE:
     #: The one-pass kernels' plan: the addresses and counts they take as one array (a Python call costs per argument).
     (_E_SEARCH, _E_RES, _E_RES_ALL, _E_N_ALL, _E_MARGIN, _E_MARGINS, _E_M_ALL, _E_SWING, _E_AMP, _E_AMPS, _E_N_SWING,
      _E_N, _E_PERIODIC, _E_MULT, _E_HINTS, _E_N_HINTS, _E_SIZE) = range(17)  # fmt: skip
-    #: ``(plan, branches, margin branches, steps, noise, params, hlo, hhi, lo, hi, unit grid, ends, out_t, out_b,
-    #: out_m, cnt, fam, fcnt, redo, start, stop)``: both one-pass kernels' (each ignores what it does not use).
+    #: ``(plan, branches, margin branches, steps, noise, params, hlo, hhi, lo, hi, unit grid, ends, twins, out_t,
+    #: out_b, out_m, cnt, fam, fcnt, redo, start, stop)``: both one-pass kernels' (each ignores what it does not use).
     _ONE_PASS_SIG = (
         int64[::1],
         int64[::1],
@@ -728,6 +728,7 @@ if AVAILABLE:
         float64[::1],
         float64[::1],
         float64[::1],
+        int64[:, ::1],
         float64[:, ::1],
         int64[:, ::1],
         int64[:, ::1],
@@ -753,17 +754,38 @@ if AVAILABLE:
            out_t[i : i + 1], out_b[i : i + 1], out_m[i : i + 1], cnt[i : i + 1], fam[i : i + 1], fcnt[i : i + 1], mult,
            0, 1)  # fmt: skip
 
+    @inlined
+    def _twin_copies(out_t, out_b, out_m, cnt, i, twins):
+        """Pose ``i``'s candidates on the first branch of a class of twins, copied to the class's other branches
+        after its own, class member by member (``twins``: ``sweep.twin_maps``), as ``sweep.twin_candidates`` copies
+        them; its count runs past the buffer if they do not fit (the pose is then redone)."""
+        n0 = cnt[i]
+        if n0 > out_t.shape[1]:
+            return
+        w = n0
+        for d in range(twins.shape[0]):
+            for k in range(n0):
+                t = twins[d, out_b[i, k]]
+                if t >= 0:
+                    if w < out_t.shape[1]:
+                        out_t[i, w] = out_t[i, k]
+                        out_b[i, w] = t
+                        out_m[i, w] = out_m[i, k]
+                    w += 1
+        cnt[i] = w
+
     @lazy_njit(_ONE_PASS_SIG, cache=True, nogil=True)
     def _edge_search(
-        plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, out_t, out_b, out_m, cnt, fam,
-        fcnt, redo, start, stop,
+        plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, out_t, out_b, out_m, cnt,
+        fam, fcnt, redo, start, stop,
     ):  # fmt: skip
         """``search`` of poses ``start .. stop - 1`` for a reduction with an ``EdgeSearch``, each pose in one pass:
         its swing samples, the margins' search over ``[hlo, hhi]`` sampled with them, then its own search over
         ``[lo, hi]`` sampled with the margins' zeros and the swing samples, as ``sample_hints`` and ``sample_grid``
         give them (the same samples in the same order, so the same candidates bit for bit). ``plan``: the addresses
-        and counts (``_E_*``); ``noise``: the search's residual noise and the margins'. A pose whose margins
-        overflow the buffers is marked in ``redo`` (its count 0), for ``search`` to redo with the NumPy engine."""
+        and counts (``_E_*``); ``noise``: the search's residual noise and the margins'; ``twins``: the candidates'
+        copies to make (``_twin_copies``). A pose whose margins overflow the buffers is marked in ``redo`` (its count
+        0), for ``search`` to redo with the NumPy engine."""
         se, sw = _as_search(plan[_E_SEARCH]), as_swing(plan[_E_SWING])
         n_swing, n, periodic = plan[_E_N_SWING], plan[_E_N], plan[_E_PERIODIC] != 0
         n_s, n_e, n_c = s.shape[0], ends.shape[0], out_t.shape[1]
@@ -817,16 +839,18 @@ if AVAILABLE:
             _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
                          params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt,
                          i)  # fmt: skip
+            _twin_copies(out_t, out_b, out_m, cnt, i, twins)
 
     @lazy_njit(_ONE_PASS_SIG, cache=True, nogil=True)
     def _hinted_search(
-        plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, out_t, out_b, out_m, cnt, fam,
-        fcnt, redo, start, stop,
+        plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, out_t, out_b, out_m, cnt,
+        fam, fcnt, redo, start, stop,
     ):  # fmt: skip
         """``search`` of poses ``start .. stop - 1`` for a reduction with a hints kernel (``Reduction.kernel_hints``),
         each pose in one pass: its samples as ``_hinted_grid`` gives them, then its search (``plan[_E_HINTS]``: the
         hints kernel's address, ``plan[_E_N_HINTS]`` the hints it writes; ``m_branches``, ``steps``, ``hlo``, ``hhi``
-        unused). Nothing overflows here that the engine could redo: ``redo`` is all False."""
+        unused; ``twins`` as for ``_edge_search``). Nothing overflows here that the engine could redo: ``redo`` is
+        all False."""
         se, fn = _as_search(plan[_E_SEARCH]), as_hints(plan[_E_HINTS])
         nh, n_e, periodic = plan[_E_N_HINTS], ends.shape[0], plan[_E_PERIODIC] != 0
         row = np.empty(nh + n_e)
@@ -845,6 +869,7 @@ if AVAILABLE:
             _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
                          params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt,
                          i)  # fmt: skip
+            _twin_copies(out_t, out_b, out_m, cnt, i, twins)
 
 
 class EdgeSearch(NamedTuple):
@@ -948,6 +973,7 @@ class _OnePass(NamedTuple):
     noise: Array  # the search's residual noise and the margins'
     n_samples: int | None  # the only sample count it takes (None: any)
     hint_range: Any  # ``EdgeSearch.hint_range``; None: the search's range
+    twins: NDArray[np.int64]  # ``sweep.twin_maps`` of the reduction, one row each (none: no twins)
 
 
 _PLANS: weakref.WeakKeyDictionary[object, _Plan] = weakref.WeakKeyDictionary()
@@ -990,9 +1016,12 @@ def _make_plan(red) -> _Plan:
     ints[_E_PERIODIC] = plan.periodic
     noise = np.array([red.residual_noise, 0.0], dtype=np.float64)
     none = np.zeros(0, dtype=np.int64)
+    maps = _ref.twin_maps(red)
+    twins = np.array(maps, dtype=np.int64) if maps else np.zeros((0, max(int(red.n_branches), 1)), dtype=np.int64)
     if plan.hints is not None:
         ints[_E_HINTS], ints[_E_N_HINTS] = plan.hints, plan.n_hints
-        return plan._replace(one_pass=_OnePass(_hinted_search, _with_mult(ints), none, none, noise, None, None))
+        one = _OnePass(_hinted_search, _with_mult(ints), none, none, noise, None, None, twins)
+        return plan._replace(one_pass=one)
     edge_search = owned_kernel(red, "edge_search")
     if edge_search is None or overridden_below_kernel(red.__class__, ("sample_hints",)):
         return plan
@@ -1005,7 +1034,9 @@ def _make_plan(red) -> _Plan:
     ints[_E_N_SWING], ints[_E_N] = edges.n_swing, edges.n_samples
     noise[1] = edges.margins.residual_noise
     steps = np.ascontiguousarray(edges.steps, dtype=np.int64)
-    one = _OnePass(_edge_search, _with_mult(ints), margins.branches, steps, noise, edges.n_samples, edges.hint_range)
+    one = _OnePass(
+        _edge_search, _with_mult(ints), margins.branches, steps, noise, edges.n_samples, edges.hint_range, twins
+    )
     return plan._replace(one_pass=one)
 
 
@@ -1048,10 +1079,11 @@ def search(
 ):
     """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
     Poses whose candidate or family buffers overflow are redone by the NumPy engine. ``multiplicity`` False: the
-    candidates' multiplicities are not wanted (each is given as 1; ~4 residuals a candidate less). A reduction with
-    a hints kernel or an ``EdgeSearch`` finds each pose's samples and candidates in one compiled pass, unless
-    ``one_pass`` is False: then ``sample_grid`` gives the samples of every pose first (the same samples: the tests
-    compare the two)."""
+    candidates' multiplicities are not wanted (each is given as 1; ~4 residuals a candidate less). The candidates
+    and spans of the first branch of each class of ``reduction.twins`` are given to the others too
+    (``sweep.twin_copies``). A reduction with a hints kernel or an ``EdgeSearch`` finds each pose's samples and
+    candidates, twins' copies included, in one compiled pass, unless ``one_pass`` is False: then ``sample_grid``
+    gives the samples of every pose first (the same samples: the tests compare the two)."""
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
     N = poses.shape[0]
     out_t = np.empty((N, MAX_CAND))
@@ -1088,6 +1120,7 @@ def search(
             hi,
             _ref._unit_grid(n_samples),
             plan.ends,
+            one.twins,
             out_t,
             out_b,
             out_m,
@@ -1128,7 +1161,7 @@ def search(
             theta=out_t[0, :k0].copy(),
             mult=out_m[0, :k0].astype(np.intp),
         )
-        return single, _ref.Spans.empty()
+        return (single if one is not None else _ref.twin_candidates(reduction, single)), _ref.Spans.empty()
     over = (cnt > MAX_CAND) | (fcnt > MAX_FAM)
     if redo is not None:
         over |= redo
@@ -1141,9 +1174,12 @@ def search(
     if fcnt.any():
         fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(fcnt, MAX_FAM)[:, None]) & ~over[:, None])
         spans.append(_ref.Spans(fp.astype(np.intp), fam[fp, fs, 2].astype(np.intp), fam[fp, fs, 0], fam[fp, fs, 1]))
-    if over.any():
+    redone = bool(over.any())
+    if redone:
         idx = np.nonzero(over)[0]
         c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples)
+        if one is not None:  # (the one-pass kernels copied the others' candidates to their twins)
+            c2 = _ref.twin_candidates(reduction, c2)
         cand_p.append(idx[c2.pose])
         cand_b.append(c2.branch)
         cand_t.append(c2.theta)
@@ -1155,7 +1191,12 @@ def search(
         theta=np.concatenate(cand_t),
         mult=np.concatenate(cand_m).astype(np.intp),
     )
-    return cand, _ref.Spans.concat(spans)
+    if one is None:
+        return _ref.twin_copies(reduction, cand, _ref.Spans.concat(spans))
+    if redone and reduction.twins:  # the redone poses in their place, as ``sweep.twin_candidates`` puts them
+        order = np.argsort(cand.pose, kind="stable")
+        cand = _ref.Candidates(cand.pose[order], cand.branch[order], cand.theta[order], cand.mult[order])
+    return cand, _ref.twin_spans(reduction, _ref.Spans.concat(spans))
 
 
 if AVAILABLE:

@@ -219,7 +219,7 @@ def _solve_chunk(
                 q = q[:, 0]
         elif compiled:
             params = red.kernel_params(chain)
-            cand, spans = twin_copies(red, *fastsweep.search(red, chain, lo, hi, n_samples, params))
+            cand, spans = fastsweep.search(red, chain, lo, hi, n_samples, params)  # (twins' copies included)
             cand = _limit_copies(robot, red, cand, hi - lo)
             q, err_geo, err_paper = fastcertify.certify(
                 robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params

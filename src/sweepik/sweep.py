@@ -669,34 +669,51 @@ def twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candida
     """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
     branches of the class too: their residuals are the same, their configurations differ. A pose's copies follow
     its own candidates, poses stay in order."""
+    return twin_candidates(red, cand), twin_spans(red, spans)
+
+
+def twin_candidates(red: Reduction, cand: Candidates) -> Candidates:
+    """``twin_copies``' candidates: each pose's own, then their copies (class member by member, in order), poses in
+    order (``fastsweep``'s one-pass search makes the same copies pose by pose)."""
     if not red.twins:
-        return cand, spans
+        return cand
     c_rows, c_branch = _twin_rows(red, cand.branch)
     pose = np.concatenate([cand.pose, cand.pose[c_rows]])
     # in pose order again, as the search gave them (certification and settling run on parts of whole poses)
     order = np.argsort(pose, kind="stable") if pose.size > 1 and pose[0] != pose[-1] else slice(None)
-    cand = Candidates(
+    return Candidates(
         pose[order],
         np.concatenate([cand.branch, c_branch])[order],
         np.concatenate([cand.theta, cand.theta[c_rows]])[order],
         np.concatenate([cand.mult, cand.mult[c_rows]])[order],
     )
-    if len(spans):  # (most sweeps find none)
-        s_rows, s_branch = _twin_rows(red, spans.branch)
-        spans = Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])])
-    return cand, spans
+
+
+def twin_spans(red: Reduction, spans: Spans) -> Spans:
+    """``twin_copies``' family spans: all of them, then their copies."""
+    if not red.twins or not len(spans):  # (most sweeps find none)
+        return spans
+    s_rows, s_branch = _twin_rows(red, spans.branch)
+    return Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])])
+
+
+def twin_maps(red: Reduction) -> tuple[IntArray, ...]:
+    """``red.twins`` as maps: for the d-th other member of the classes (d = 1, 2, ...), each branch's twin in that
+    place (-1: none); none without twins."""
+    twins = red.twins
+    if not twins:
+        return ()
+    try:  # (as the reductions give them: tuples of ints, the cache's key as it is)
+        return _twin_maps(twins, red.n_branches)
+    except TypeError:  # (unhashable classes: lists, arrays)
+        return _twin_maps(tuple(tuple(int(b) for b in cls) for cls in twins), red.n_branches)
 
 
 def _twin_rows(red: Reduction, branch: IntArray) -> tuple[IntArray, IntArray]:
     """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
     that branch: ``(rows, branches)``."""
     rows, branches = [], []
-    twins = red.twins
-    try:  # (as the reductions give them: tuples of ints, the cache's key as it is)
-        maps = _twin_maps(twins, red.n_branches)
-    except TypeError:  # (unhashable classes: lists, arrays)
-        maps = _twin_maps(tuple(tuple(int(b) for b in cls) for cls in twins), red.n_branches)
-    for twin in maps:
+    for twin in twin_maps(red):
         t = twin[branch]
         k = np.nonzero(t >= 0)[0]
         rows.append(k)
