@@ -589,7 +589,8 @@ def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeyp
     (its swing samples, its margins' zeros, its candidates: ``fastsweep.EdgeSearch``), theta* revolute or prismatic
     (the C-Arm's rail, automatic decomposition), and a reduction with a hints kernel (carm-d1). Random poses, and
     poses on the singular set (joint 5 at 0, joint 3 at 0, both). With the buffers cut to one candidate, every pose
-    overflows and is redone by the NumPy engine, in both."""
+    overflows and is redone by the NumPy engine, in both; cut to the median count (carm-d1), some are: the same
+    candidates in the same order, twins' copies included."""
     from sweepik import solver, sweep
 
     robot = load_robot(name)

@@ -755,6 +755,28 @@ if AVAILABLE:
            0, 1)  # fmt: skip
 
     @inlined
+    def _add_swings(row, k, swings):
+        """The swing samples ``swings[0]`` after the first ``k`` samples of ``row``, but the NaN ones (which add no
+        sample, see ``sample_grid``): their new number."""
+        for j in range(swings.shape[1]):
+            if not math.isnan(swings[0, j]):
+                row[k] = swings[0, j]
+                k += 1
+        return k
+
+    @inlined
+    def _with_ends(row, k, ends, periodic):
+        """theta*'s ``ends`` after the first ``k`` samples of ``row``, and all of them wrapped into [-pi, pi] for a
+        periodic theta*, as ``sweep.grid_hints`` gives them: their new number."""
+        for j in range(ends.shape[0]):
+            row[k] = ends[j]
+            k += 1
+        if periodic:
+            for j in range(k):
+                row[j] = wrap_pi(row[j])
+        return k
+
+    @inlined
     def _twin_copies(out_t, out_b, out_m, cnt, i, twins):
         """Pose ``i``'s candidates on the first branch of a class of twins, copied to the class's other branches
         after its own, class member by member (``twins``: ``sweep.twin_maps``), as ``sweep.twin_candidates`` copies
@@ -801,17 +823,7 @@ if AVAILABLE:
             sw(plan[_E_AMP], plan[_E_AMPS], params[i : i + 1], hlo[i : i + 1], hhi[i : i + 1], n, periodic, steps,
                swings, 0, 1)  # fmt: skip
             # the margins' samples: the swing samples and theta*'s ends (``grid_hints`` of the margins)
-            k = 0
-            for j in range(n_swing):  # (a NaN adds no sample: skipped here, not wrapped)
-                if not math.isnan(swings[0, j]):
-                    row[k] = swings[0, j]
-                    k += 1
-            for j in range(n_e):
-                row[k] = ends[j]
-                k += 1
-            if periodic:
-                for j in range(k):
-                    row[j] = wrap_pi(row[j])
+            k = _with_ends(row, _add_swings(row, 0, swings), ends, periodic)
             M = _merge_row(hlo[i], hhi[i], s, row[:k], grid, True)
             _pose_search(se, plan[_E_MARGIN], plan[_E_MARGINS], plan[_E_M_ALL], m_branches, noise[1], False, params,
                          grid, M, n_grid, span, hhi[i] - hlo[i], out_t, out_b, out_m, cnt, fam, fcnt, i)  # fmt: skip
@@ -821,20 +833,9 @@ if AVAILABLE:
                 fcnt[i] = 0
                 continue
             # its own samples: the margins' zeros, the swing samples, theta*'s ends (``sample_hints``, ``grid_hints``)
-            k = 0
             for j in range(cnt[i]):
-                row[k] = out_t[i, j]
-                k += 1
-            for j in range(n_swing):
-                if not math.isnan(swings[0, j]):
-                    row[k] = swings[0, j]
-                    k += 1
-            for j in range(n_e):
-                row[k] = ends[j]
-                k += 1
-            if periodic:
-                for j in range(k):
-                    row[j] = wrap_pi(row[j])
+                row[j] = out_t[i, j]
+            k = _with_ends(row, _add_swings(row, cnt[i], swings), ends, periodic)
             M = _merge_row(lo[i], hi[i], s, row[:k], grid, True)
             _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
                          params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt,
@@ -860,11 +861,7 @@ if AVAILABLE:
         for i in range(start, stop):
             redo[i] = False
             fn(params[i], row[:nh])
-            for k in range(n_e):
-                row[nh + k] = ends[k]
-            if periodic:
-                for k in range(nh + n_e):
-                    row[k] = wrap_pi(row[k])
+            _with_ends(row, nh, ends, periodic)
             M = _merge_row(lo[i], hi[i], s, row, grid, False)
             _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
                          params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt,
@@ -1010,34 +1007,41 @@ def _make_plan(red) -> _Plan:
         periodic=bool(red.periodic),
         one_pass=None,
     )
+    return plan._replace(one_pass=_one_pass(red, plan))
+
+
+def _one_pass(red, plan: _Plan) -> _OnePass | None:
+    """The reduction's one-pass kernel and its fixed arguments: ``_hinted_search`` with a hints kernel,
+    ``_edge_search`` with an ``EdgeSearch``, else None (the staged search)."""
+    edges = None
+    if plan.hints is None:
+        edge_search = owned_kernel(red, "edge_search")
+        if edge_search is None or overridden_below_kernel(red.__class__, ("sample_hints",)):
+            return None
+        edges = edge_search(red)  # (read from the class: a function of the reduction)
+        if edges is None:
+            return None
     ints = np.zeros(_E_SIZE, dtype=np.int64)
     ints[_E_SEARCH] = address_of(_search, _SEARCH_FN_SIG)
     ints[_E_RES], ints[_E_RES_ALL], ints[_E_N_ALL] = plan.residual, plan.residuals, plan.n_all
     ints[_E_PERIODIC] = plan.periodic
     noise = np.array([red.residual_noise, 0.0], dtype=np.float64)
-    none = np.zeros(0, dtype=np.int64)
     maps = _ref.twin_maps(red)
     twins = np.array(maps, dtype=np.int64) if maps else np.zeros((0, max(int(red.n_branches), 1)), dtype=np.int64)
     if plan.hints is not None:
         ints[_E_HINTS], ints[_E_N_HINTS] = plan.hints, plan.n_hints
-        one = _OnePass(_hinted_search, _with_mult(ints), none, none, noise, None, None, twins)
-        return plan._replace(one_pass=one)
-    edge_search = owned_kernel(red, "edge_search")
-    if edge_search is None or overridden_below_kernel(red.__class__, ("sample_hints",)):
-        return plan
-    edges = edge_search(red)  # (read from the class: a function of the reduction)
-    if edges is None:
-        return plan
+        none = np.zeros(0, dtype=np.int64)
+        return _OnePass(_hinted_search, _with_mult(ints), none, none, noise, None, None, twins)
+    assert edges is not None  # (no hints kernel: an EdgeSearch)
     margins = _plan(edges.margins)
     ints[_E_MARGIN], ints[_E_MARGINS], ints[_E_M_ALL] = margins.residual, margins.residuals, margins.n_all
     ints[_E_SWING], ints[_E_AMP], ints[_E_AMPS] = edges.swing, edges.amplitude, edges.amplitudes
     ints[_E_N_SWING], ints[_E_N] = edges.n_swing, edges.n_samples
     noise[1] = edges.margins.residual_noise
     steps = np.ascontiguousarray(edges.steps, dtype=np.int64)
-    one = _OnePass(
+    return _OnePass(
         _edge_search, _with_mult(ints), margins.branches, steps, noise, edges.n_samples, edges.hint_range, twins
     )
-    return plan._replace(one_pass=one)
 
 
 def _with_mult(ints: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
