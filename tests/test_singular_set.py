@@ -32,7 +32,7 @@ from sweepik.robot_file import robot_from_dict
 from sweepik.solutions import joint_distance
 
 CARM = load_robot("carm")
-REDUCTIONS = ("carm-d1", "carm-theta2")
+REDUCTIONS = ("carm-d1", "carm-theta2", "auto")
 #: FK acceptance of a solution, as the solver's (geodesic error, relative to the arm's length scale)
 ACCEPT_REL = 2e-13
 #: "found": every joint within this (mm, radians modulo 2 pi)

@@ -157,12 +157,11 @@ def near_singular_set(q: np.ndarray) -> bool:
     return abs(np.cos(q[1])) < 1e-6 and (abs(q[2]) < 1e-3 or abs(np.sin(q[4])) < 1e-3)
 
 
-@pytest.mark.parametrize("reduction", ["carm-d1", pytest.param("auto", marks=pytest.mark.xfail(strict=True))])
+@pytest.mark.parametrize("reduction", ["carm-d1", "auto"])
 def test_theta2_self_motion_is_a_family(reduction: str) -> None:
     """theta3 = 0 with theta4 = -90 deg: joint 5's axis on joint 2's, theta2 free (a self-motion, docs/carm.md). The
-    default decomposition reports the family (its fallback, carm-theta2, sweeps theta2). Known gap, marked xfail: the
-    automatic decomposition sweeps the rail and has no fallback for a continuum along another joint, so it reports a
-    few isolated members, not the generating configuration (docs/performance.md, 2026-11-25 round 2)."""
+    default decomposition reports the family (its fallback, carm-theta2, sweeps theta2); the automatic one sweeps the
+    rail, sees theta2 left free at its candidates and traces the family along theta2 (sweepik.continuation)."""
     for q in ([500.0, 0.3, 0.0, -np.pi / 2, 0.2, 1.0], [1200.0, -1.1, 0.0, -np.pi / 2, -0.7, 2.5]):
         sol = solve(CARM, CARM.fk(np.array(q)), reduction=reduction)
         assert_certified(sol, CARM.fk(np.array(q)))

@@ -30,7 +30,7 @@ def _pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:
     return _pose(robot, q), kinematics.geometric_jacobian(robot, q)
 
 
-def _error(robot: Robot, q: Array, target: Array, weight: float) -> Array:
+def geodesic_errors(robot: Robot, q: Array, target: Array, weight: float) -> Array:
     """Geodesic errors of configurations ``q (K, n)`` to ``target (K, 4, 4)`` (compiled when Numba is present: a
     polish of a few configurations is mostly these evaluations, ~70 us each in NumPy)."""
     from .fastcertify import AVAILABLE, tool_poses
@@ -63,7 +63,7 @@ def polish(
     if q.shape[0] == 0:
         return q
     q = q.copy()
-    err = _error(robot, q, target, weight)
+    err = geodesic_errors(robot, q, target, weight)
     scale = np.array([1.0, 1.0, 1.0, weight, weight, weight])
     active = np.arange(q.shape[0])
     for _ in range(iterations):
@@ -82,7 +82,7 @@ def polish(
         todo = np.arange(active.size)
         for _ in range(BACKTRACK + 1):
             q_new = qa[todo] + step[todo]
-            err_new = _error(robot, q_new, ta[todo], weight)
+            err_new = geodesic_errors(robot, q_new, ta[todo], weight)
             better = np.isfinite(err_new) & (err_new < err[active[todo]])
             rows = active[todo[better]]
             q[rows], err[rows] = q_new[better], err_new[better]

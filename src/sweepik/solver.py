@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import fastcertify, fastsweep, parallel
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch
+from .continuation import continuum_families
 from .dedupe import finish, merged_multiplicity, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from .families import MAX_ISOLATED_SOLUTIONS, collapse_continua, families_of, off_families, unique_families
@@ -56,6 +57,9 @@ POLISH_ABOVE_REL = 1e-14
 POLISH_PAPER_ABOVE_REL = 5e-14
 #: Paper strategy: the paper's acceptance threshold J < 1e-5 mm (section 4).
 PAPER_ACCEPT_MM = 1e-5
+#: Candidates within this (relative to the arm's length scale) of their pose seed the continua that a reduction
+#: cannot see (``Reduction.continuum_joints``): certified ones and those a polish would certify.
+SEED_TOL_REL = 1e-6
 #: Poses per chunk of ``solve_many``: bounds memory at (chunk x samples x branches) residuals.
 CHUNK = 2048
 
@@ -242,13 +246,33 @@ def _solve_chunk(
             q = np.concatenate([q, q_sp])
             pose_idx = np.concatenate([pose_idx, sp_p])
             mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp) if sp_mult is None else sp_mult[sp_p, sp_k]])
+        tol = ACCEPT_TOL_REL * robot.length_scale
+        members: list[tuple[NDArray[np.intp], Array]] = []  # (isolated members of families: pose index, q)
         if len(spans):  # (most sweeps find none)
             # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
             s_lo, s_hi = np.maximum(spans.lo, lo[spans.pose]), np.minimum(spans.hi, hi[spans.pose])
             keep_span = s_hi > s_lo
             spans = Spans(spans.pose[keep_span], spans.branch[keep_span], s_lo[keep_span], s_hi[keep_span])
-            tol = ACCEPT_TOL_REL * robot.length_scale
             fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, tol)
+            members.append((fam_p, fam_q))
+        # a continuum along a joint other than theta*: its candidates (certified ones, when their errors are known
+        # already: fewer to look at) where the reduction leaves such a joint free are traced (few poses)
+        rows = (
+            np.arange(cand.pose.size)
+            if err_geo is None
+            else np.nonzero(err_geo[: cand.pose.size] <= SEED_TOL_REL * robot.length_scale)[0]
+        )
+        free = (
+            red.continuum_joints(chain, cand.pose[rows], cand.theta[rows], cand.branch[rows]) if use_fallback else None
+        )
+        if free is not None and (free >= 0).any():
+            seeds, free = rows[free >= 0], free[free >= 0]
+            seed_p, seed_q = cand.pose[seeds], q[seeds]
+            traced, fam_p, fam_q = continuum_families(robot, chain, poses, seed_p, seed_q, free, limits, tol)
+            for i, f in traced.items():
+                fams.setdefault(i, []).extend(f)
+            members.append((fam_p, fam_q))
+        for fam_p, fam_q in members:
             if fam_p.size:
                 if err_geo is not None and err_paper is not None:
                     eg_f, ep_f = _errors(robot, fam_q, poses[fam_p], weight)

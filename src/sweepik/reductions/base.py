@@ -157,6 +157,13 @@ class Reduction(ABC):
         """``(N,)`` True where this reduction cannot describe the pose's solutions (``fallback`` solves them)."""
         return None
 
+    def continuum_joints(self, poses: Array, pose: IntArray, theta: Array, branch: IntArray) -> IntArray | None:
+        """For candidates ``(pose[k], theta[k], branch[k])`` of chain ``poses``: ``(K,)`` a joint other than theta*
+        that the closed form leaves free at the candidate (a continuum of solutions may run along it, which a sweep
+        of theta* cannot see), -1 for none. The solver traces such continua (:mod:`sweepik.continuation`). None:
+        the reduction cannot tell (it then needs ``fallback`` and ``degenerate`` for its blind spots)."""
+        return None
+
     def search_range(self, poses: Array) -> Array | None:
         """``(N, 2)`` theta* interval that holds every solution, for a prismatic theta* searched without
         joint limits (``limits=False``). ``None``: the joint limits are used.

@@ -18,7 +18,12 @@ from ..chain import Chain
 from ..robot import Robot
 from . import geometric
 from .base import Array, IntArray, Reduction
-from .position import CASES
+from .position import CASES, STEP_JOINTS
+
+#: A candidate where a step's amplitude (``amplitude`` of ``geometric.case_kernels``) is below this fraction of the
+#: step's typical amplitude leaves that step's joint free (``continuum_joints``). On the C-Arm's theta2 self-motion
+#: the first step's amplitude is 1e-12 to 1e-8 mm at the candidates, against 30 to 700 mm at random poses.
+CONTINUUM_AMPLITUDE = 1e-7
 
 #: Twin branches: residuals compared at this many random poses and theta* values, equal to this (absolute; the
 #: residual is a difference of cosines).
@@ -139,6 +144,7 @@ class GeometricReduction(Reduction):
         self._row = row
         self._last_params: tuple[Array, Array] | None = None
         self._last_range: tuple[Array, Array] | None = None
+        self._last_singular: tuple[Array, NDArray[np.bool_], Array | None] | None = None
         # the wrist centre in the tool frame (the last joints do not move it)
         p_end = chain.P.sum(axis=0)
         self._w_tool = chain.R_end.T @ (np.asarray(plan.W) - p_end)
@@ -208,6 +214,54 @@ class GeometricReduction(Reduction):
         return margins, amplitudes
 
     @cached_property
+    def _step_scales(self) -> Array:
+        """The typical amplitude of each step ``k = 0, 1, 2`` (as ``amplitude`` numbers them): its median over random
+        poses and theta* values; inf for a step with one solution."""
+        a = np.abs(self._probe(self._case_kernels.amplitude, 3)).reshape(-1, 3)
+        return np.array([np.median(c[np.isfinite(c)]) if np.isfinite(c).any() else np.inf for c in a.T])
+
+    @cached_property
+    def _step_joints(self) -> tuple[int, int]:
+        """The robot joints that the position case's first and second two-solution steps turn (-1: no such step)."""
+        others = [i for i in range(4) if i != self.plan.free]
+        return tuple(  # type: ignore[return-value]
+            -1 if x is None else self.plan.joint(others["abc".index(x)]) for x in STEP_JOINTS[self.plan.case]
+        )
+
+    def continuum_joints(self, poses: Array, pose: IntArray, theta: Array, branch: IntArray) -> IntArray | None:
+        """The pair and wrist families: a candidate where a position step's amplitude vanishes (its equation no longer
+        involves its joint, ``CONTINUUM_AMPLITUDE``) gives that step's joint; the first step's before the second's.
+        (The wrist family's continua where its wrist is singular are its fallback's, ``degenerate``.)"""
+        if self._case is None:  # the parallel family
+            return None
+        out = np.full(pose.size, -1, dtype=np.intp)
+        if pose.size == 0:
+            return out
+        position = np.asarray(branch) // (2 if self.plan.closed_form else 1)  # (a wrist branch: two per position's)
+        steps = ((self._step_joints[1], 1 + position // 2), (self._step_joints[0], np.zeros(pose.size, np.intp)))
+        params = self.kernel_params(poses)
+        per_pose = None
+        if self.plan.closed_form:  # theta* moves nothing: a pose's amplitudes serve all its branches
+            per_pose = self._singular(poses)[1]  # (computed with its wrist's singularity, which the solver asks for)
+            assert per_pose is not None
+            if not np.any(per_pose < CONTINUUM_AMPLITUDE * self._step_scales):  # (almost always)
+                return out
+        for joint, k in steps:  # (the first step's last: it wins)
+            if joint >= 0:
+                amp = per_pose[pose, k] if per_pose is not None else self._amplitude(params, pose, theta, k)
+                out[amp < CONTINUUM_AMPLITUDE * self._step_scales[k]] = joint
+        return out
+
+    def _amplitude(self, params: Array, pose: IntArray, theta: Array, k: IntArray) -> Array:
+        """The amplitudes of the steps ``k`` (as ``amplitude`` of ``geometric.case_kernels`` numbers them) at
+        ``(pose, theta*)``, element by element (one compiled call)."""
+        out = np.empty(pose.size)
+        # (writable copies: the kernels' signature wants them)
+        p, th, kk = np.array(pose, dtype=np.int64), np.array(theta, dtype=np.float64), np.array(k, dtype=np.int64)
+        geometric.evaluate(self._case_kernels.amplitude, params, p, th, kk, out)
+        return out
+
+    @cached_property
     def _continua(self) -> GeometricReduction | None:
         """For a closed form: a pair plan sweeping a joint that moves along the continuum of a singular wrist (joint
         4 preferred, then joint 6; for the parallel family also joints 2, 3), which solves the poses at or near it
@@ -234,13 +288,27 @@ class GeometricReduction(Reduction):
         solver answers them with the fallback sweep."""
         if not self.plan.closed_form or poses.shape[0] == 0:
             return None
-        out = np.zeros(poses.shape[0], dtype=np.bool_)
-        singular = geometric.parallel_singular if self.plan.family == "parallel" else self._case_kernels.wrist_singular
+        return self._singular(poses)[0]
+
+    def _singular(self, poses: Array) -> tuple[NDArray[np.bool_], Array | None]:
+        """A closed form's ``degenerate`` poses, and (the wrist family) its steps' amplitudes ``(N, 3)``, computed
+        in the same pass (``wrist_singular``). The last chunk's are kept: the solver asks for both."""
+        last = self._last_singular
+        if last is not None and last[0] is poses:
+            return last[1], last[2]
         from .. import parallel
         from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
 
-        parallel.run(singular, poses.shape[0], 2 * PARALLEL_MIN, self.kernel_params(poses), out)
-        return out
+        N = poses.shape[0]
+        out = np.zeros(N, dtype=np.bool_)
+        if self.plan.family == "parallel":
+            amps = None
+            parallel.run(geometric.parallel_singular, N, 2 * PARALLEL_MIN, self.kernel_params(poses), out)
+        else:
+            amps = np.empty((N, 3))
+            parallel.run(self._case_kernels.wrist_singular, N, 2 * PARALLEL_MIN, self.kernel_params(poses), out, amps)
+        self._last_singular = (poses, out, amps)
+        return out, amps
 
     def search_range(self, poses: Array) -> Array | None:
         """A prismatic theta*: the travel that can hold a solution, joint limits aside, ``(N, 2)``: the wrist centre
@@ -314,7 +382,7 @@ class GeometricReduction(Reduction):
         )
         keep = np.any(np.isfinite(swings), axis=0)
         swings = swings[:, keep]
-        theta = np.concatenate([_Margins(self, swings).zeros(poses, lo, hi, params), swings], axis=1)
+        theta = np.concatenate([_Margins(self, swings, poses).zeros(poses, lo, hi, params), swings], axis=1)
         keep = np.any(np.isfinite(theta), axis=0)
         return theta[:, keep] if keep.any() else None
 
@@ -459,10 +527,11 @@ class _Margins(Reduction):
     def search_branches(self) -> list[int]:
         return self.red._steps[0]
 
-    def __init__(self, red: GeometricReduction, swings: Array) -> None:
+    def __init__(self, red: GeometricReduction, swings: Array, poses: Array | None = None) -> None:
         super().__init__(red.robot, red.free_joint, 3)
         self.red = red
-        self.swings = swings
+        self.swings = swings  # (the swing samples of the chain poses ``poses``, row by row)
+        self.poses = poses
         # the engine's plan (kernels, branches, limits) is the pair plan's, not the call's: kept with the plan
         self.plan_key = red._margins_key
         self.kernel = (red._case_kernels.pair_margin, red._case_kernels.pair_configuration)
@@ -470,7 +539,13 @@ class _Margins(Reduction):
 
     def sample_hints(self, poses: Array) -> Array | None:
         # where a step's angle swings, the next step's margin changes as fast: a domain there can be narrow
-        return self.swings if self.swings.shape[1] else None
+        if not self.swings.shape[1]:
+            return None
+        if poses is self.poses or self.poses is None:
+            return self.swings
+        # some of the poses (the engine redoes those that overflow its buffers): their rows, found by value
+        row = {p.tobytes(): i for i, p in enumerate(self.poses)}
+        return self.swings[[row[p.tobytes()] for p in poses]]
 
     def kernel_params(self, poses: Array) -> Array:
         return self.red.kernel_params(poses)

@@ -559,8 +559,8 @@ def parallel_singular(params, out, start, stop):
 
 class CaseKernels(NamedTuple):
     """The compiled kernels of the pair and wrist families for one position case (``position.CASES``): Python calls
-    ``wrist_singular(params, out, start, stop)``; the others are :class:`~.kernels.LazyKernel` objects with the engine's
-    signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch;
+    ``wrist_singular(params, out, amps, start, stop)``; the others are :class:`~.kernels.LazyKernel` objects with the
+    engine's signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch;
     ``pair_residuals`` and ``pair_margins`` are their all-branch kernels, ``Reduction.kernel_residuals``)."""
 
     pair_residual: Any
@@ -700,18 +700,23 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
                 for i in range(6):
                     out[r, i] = math.nan
 
-        def singular(params, out, start, stop):
+        def singular(params, out, amps, start, stop):
             """``out[i]`` for poses ``start .. stop - 1``: some exact position branch of the wrist family leaves
-            pose i with a singular wrist."""
+            pose i with a singular wrist; ``amps[i]``: the amplitudes of the position case's steps, ``k = 0, 1, 2``
+            as ``amplitude`` numbers them (inf for a second step on a first-step branch the case does not have)."""
             h3, h5 = _h(params[0], 3), _h(params[0], 5)
             for i in range(start, stop):
                 p = params[i]
                 out[i] = False
+                for k in range(3):
+                    amps[i, k] = math.inf
                 nb = int(p[_POS_BRANCHES])
                 both = BOTH + 0 * nb  # (a run-time value: see position.place)
                 for b1 in range((nb + 1) // 2):
                     # the two branches of a first step share its work (as in ``wrists``, the same values)
                     arm = _arm(p, 0.0, b1, both, case, free, rev)
+                    amps[i, 0] = arm[4]
+                    amps[i, 1 + b1] = arm[5]
                     for j in range(2):
                         if 2 * b1 + j >= nb:
                             break

@@ -45,7 +45,19 @@ from .._jit import ERROR_MODEL, inlined
 from ..subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
 from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
-__all__ = ["CASES", "BRANCHES", "BOTH", "NEITHER", "reduce_chain", "place", "motion", "angle", "move", "move_back"]
+__all__ = [
+    "CASES",
+    "BRANCHES",
+    "STEP_JOINTS",
+    "BOTH",
+    "NEITHER",
+    "reduce_chain",
+    "place",
+    "motion",
+    "angle",
+    "move",
+    "move_back",
+]
 
 #: Case names, in the order of their integer codes in a family's parameter row.
 CASES = ("ab_par", "bc_par", "ab_int", "bc_int", "ppp", "ppr", "ac_par", "rpp")
@@ -59,6 +71,20 @@ BRANCHES = {
     "ppr": (2, 2),
     "ac_par": (2, 2),
     "rpp": (2, 2),
+}
+
+#: The joint (``a``, ``b`` or ``c``) that each case's two-solution steps turn, for their amplitudes ``(r1, r2)`` of
+#: ``place`` (None: no such step). Where a step's amplitude vanishes its equation no longer involves that joint: the
+#: joint is free as far as ``W`` goes (a continuum along it, when the orientation follows it too).
+STEP_JOINTS = {
+    "ab_par": ("c", "b"),
+    "bc_par": ("a", "c"),
+    "ab_int": ("c", "a"),
+    "bc_int": ("a", "b"),
+    "ppp": (None, None),
+    "ppr": (None, "c"),
+    "ac_par": (None, "c"),
+    "rpp": (None, "a"),
 }
 
 

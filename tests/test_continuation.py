@@ -1,0 +1,167 @@
+"""Continua along a joint other than theta*, traced numerically (sweepik.continuation): the automatic decomposition
+of the C-Arm (rail swept) on its theta2 self-motion, the closed-form wrist arm (carm_swapped) on its own, joint
+limits on the traced joint, batches, and no false alarm at random poses. The traced members are checked against an
+independent reduction (the hand-written carm-theta2, which sweeps theta2) and by forward kinematics."""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from importlib import resources
+
+import numpy as np
+import pytest
+
+from sweepik import load_robot, solve, solve_many
+from sweepik.pose import pose_error_geodesic
+from sweepik.reductions import get_reduction
+from sweepik.robot_file import robot_from_dict
+from sweepik.solutions import joint_distance
+from sweepik.solver import ACCEPT_TOL_REL, _chain_poses
+
+CARM = load_robot("carm")
+#: "the same configuration": every joint within this (mm, radians modulo 2 pi)
+SAME = 1e-7
+
+
+def on_theta2_self_motion(robot, rng: np.random.Generator, n: int) -> np.ndarray:
+    """In-limit configurations with theta3 = 0 and theta4 = -90 deg (joint 5's axis on joint 2's: theta2 free)."""
+    q = rng.uniform(robot.lower, robot.upper, (n, 6))
+    q[:, 2], q[:, 3] = 0.0, -np.pi / 2
+    return q
+
+
+def member_of(robot, sol, q: np.ndarray) -> bool:
+    """``q`` is a member of one of ``sol``'s families (its free joint's value wrapped onto the family's interval)."""
+    for f in sol.families:
+        th = q[f.free_joint]
+        if robot.is_revolute[f.free_joint]:
+            th = np.mod(th + np.pi, 2.0 * np.pi) - np.pi
+        lo, hi = f.interval
+        if lo - SAME <= th <= hi + SAME and joint_distance(robot, f.at(np.clip(th, lo, hi)), q).max() <= SAME:
+            return True
+    return False
+
+
+def assert_members_certified(robot, sol, T: np.ndarray, count: int = 25) -> None:
+    for f in sol.families:
+        m = f.sample(count)
+        err = pose_error_geodesic(robot.fk(m), np.broadcast_to(T, (count, 4, 4)))
+        # (the solver's acceptance, with room for this test's own forward kinematics: a different rounding)
+        assert err.max() <= 4.0 * ACCEPT_TOL_REL * robot.length_scale
+        assert np.all(robot.within_limits(m))
+
+
+def test_traced_family_agrees_with_an_independent_reduction() -> None:
+    """The automatic decomposition's traced theta2 family and carm-theta2's swept one: the same members."""
+    for q in on_theta2_self_motion(CARM, np.random.default_rng(3), 4):
+        T = CARM.fk(q)
+        auto, ref = solve(CARM, T, reduction="auto"), solve(CARM, T, reduction="carm-theta2")
+        assert [f.free_joint for f in auto.families] == [1] and len(ref.families) == 1
+        assert auto.families[0].interval == pytest.approx(ref.families[0].interval)
+        assert len(auto) == len(ref) == 0  # (every solution is a member)
+        th = np.linspace(-3.1, 3.1, 13)
+        d = joint_distance(CARM, auto.families[0].at(th), ref.families[0].at(th))
+        assert d.max() <= SAME
+        assert member_of(CARM, auto, q)
+        assert_members_certified(CARM, auto, T)
+
+
+def test_batch_on_the_self_motion() -> None:
+    """A batch of poses on the self-motion gives each pose its family. (Many candidates each: the poses are redone by
+    the NumPy engine, and so are some of them in the search of their margins' zeros, whose swing samples must follow
+    the poses redone; these 12 made ``solve_many`` raise a ValueError before.)"""
+    q = on_theta2_self_motion(CARM, np.random.default_rng(5), 12)
+    sols = solve_many(CARM, CARM.fk(q), reduction="auto")
+    for i, sol in enumerate(sols):
+        assert member_of(CARM, sol, q[i]), i
+
+
+def test_closed_form_with_a_position_continuum() -> None:
+    """carm_swapped (a spherical wrist: a closed form) with theta3 = 0: the wrist centre on joint 2's axis, theta2
+    free. The closed form gives isolated members; the continuum is traced along theta2."""
+    robot = load_robot("carm_swapped")
+    assert get_reduction(robot, None).closed_form
+    rng = np.random.default_rng(5)
+    q = rng.uniform(robot.lower, robot.upper, (6, 6))
+    q[:, 2] = 0.0
+    for qi in q:
+        T = robot.fk(qi)
+        sol = solve(robot, T)
+        assert any(f.free_joint == 1 for f in sol.families)
+        assert member_of(robot, sol, qi)
+        assert_members_certified(robot, sol, T)
+
+
+def _carm_with_theta2_limits(lo: float, hi: float):
+    data = copy.deepcopy(tomllib.loads((resources.files("sweepik") / "robots" / "carm.toml").read_text()))
+    data["joints"][1]["limits"] = [lo, hi]
+    data["name"] = "carm_theta2_limited"
+    return robot_from_dict(data, "variant.toml")
+
+
+def test_traced_family_cut_to_the_limits() -> None:
+    """theta2 limited to [-60, 120] deg: the traced family is the limited stretch, with and without limits."""
+    robot = _carm_with_theta2_limits(-60.0, 120.0)
+    q = on_theta2_self_motion(robot, np.random.default_rng(6), 3)
+    for qi in q:
+        T = robot.fk(qi)
+        sol = solve(robot, T, reduction="auto")
+        assert [f.interval for f in sol.families] == [pytest.approx(np.radians([-60.0, 120.0]))]
+        assert member_of(robot, sol, qi)
+        assert_members_certified(robot, sol, T)
+        free = solve(robot, T, reduction="auto", limits=False)
+        assert [f.interval for f in free.families] == [pytest.approx((-np.pi, np.pi))]
+
+
+@pytest.mark.parametrize("name", ["carm", "fanuc_crx10ia", "kinova_jaco2", "carm_swapped", "abb_irb140"])
+def test_no_continuum_at_random_poses(name: str) -> None:
+    """Away from the special sets no candidate leaves another joint free: nothing is traced."""
+    robot = load_robot(name)
+    red = get_reduction(robot, "auto")
+    q = np.random.default_rng(7).uniform(robot.lower, robot.upper, (300, 6))
+    chain = _chain_poses(robot, robot.fk(q))
+    pose = np.repeat(np.arange(300), red.n_branches)
+    branch = np.tile(np.arange(red.n_branches), 300)
+    theta = q[pose, red.free_joint]  # (candidates' theta*: the generating ones)
+    free = red.continuum_joints(chain, pose, theta, branch)
+    assert free is not None and np.all(free == -1)
+
+
+def _elbow_manipulator():
+    """The PUMA 560 without its shoulder offsets (axes 1 and 2 meet): a spherical-wrist closed form whose shoulder
+    singularity (the wrist centre on joint 1's axis) leaves joint 1 free."""
+    data = copy.deepcopy(tomllib.loads((resources.files("sweepik") / "robots" / "puma560_std.toml").read_text()))
+    data["joints"][2]["a"], data["joints"][2]["d"] = 0.0, 0.0
+    for joint in data["joints"]:
+        joint["limits"] = [-180.0, 180.0]
+    data["name"] = "elbow_manipulator"
+    return robot_from_dict(data, "variant.toml")
+
+
+def test_shoulder_singularity_of_an_elbow_manipulator() -> None:
+    """The wrist centre on joint 1's axis (q3 chosen, q2 solved for it by bisection): four families along joint 1
+    (two elbows, two wrists), each certified, one of them holding the generating configuration."""
+    from scipy.optimize import brentq
+
+    from sweepik.kinematics import chain_frames
+
+    robot = _elbow_manipulator()
+    rng = np.random.default_rng(8)
+    for _ in range(4):
+        q = rng.uniform(-np.pi, np.pi, 6)
+
+        def off_axis(q2: float, q: np.ndarray = q) -> float:  # (x of the wrist centre at q1 = 0: the x-z plane)
+            qq = q.copy()
+            qq[0], qq[1] = 0.0, q2
+            return float(chain_frames(robot, qq[None])[0, 4, 0, 3])
+
+        x = np.linspace(-np.pi, np.pi, 181)
+        v = np.array([off_axis(t) for t in x])
+        k = int(np.nonzero(v[:-1] * v[1:] < 0)[0][0])
+        q[1] = brentq(off_axis, x[k], x[k + 1], xtol=1e-15)
+        T = robot.fk(q)
+        sol = solve(robot, T)
+        assert len(sol.families) == 4 and all(f.free_joint == 0 for f in sol.families)
+        assert member_of(robot, sol, q)
+        assert_members_certified(robot, sol, T)
