@@ -257,14 +257,14 @@ def _solve_chunk(
             members.append((fam_p, fam_q))
         # a continuum along a joint other than theta*: its candidates (certified ones, when their errors are known
         # already: fewer to look at) where the reduction leaves such a joint free are traced (few poses)
-        rows = (
-            np.arange(cand.pose.size)
-            if err_geo is None
-            else np.nonzero(err_geo[: cand.pose.size] <= SEED_TOL_REL * robot.length_scale)[0]
-        )
-        free = (
-            red.continuum_joints(chain, cand.pose[rows], cand.theta[rows], cand.branch[rows]) if use_fallback else None
-        )
+        free = None
+        if use_fallback and type(red).continuum_joints is not Reduction.continuum_joints:  # (else: None)
+            rows = (
+                np.arange(cand.pose.size)
+                if err_geo is None
+                else np.nonzero(err_geo[: cand.pose.size] <= SEED_TOL_REL * robot.length_scale)[0]
+            )
+            free = red.continuum_joints(chain, cand.pose[rows], cand.theta[rows], cand.branch[rows])
         if free is not None and (free >= 0).any():
             seeds, free = rows[free >= 0], free[free >= 0]
             seed_p, seed_q = cand.pose[seeds], q[seeds]
