@@ -259,15 +259,12 @@ def _solve_chunk(
         # already: fewer to look at) where the reduction leaves such a joint free are traced (few poses)
         free = None
         if use_fallback and type(red).continuum_joints is not Reduction.continuum_joints:  # (else: None)
-            rows = (
-                np.arange(cand.pose.size)
-                if err_geo is None
-                else np.nonzero(err_geo[: cand.pose.size] <= SEED_TOL_REL * robot.length_scale)[0]
-            )
-            free = red.continuum_joints(chain, cand.pose[rows], cand.theta[rows], cand.branch[rows])
-        if free is not None and (free >= 0).any():
-            seeds, free = rows[free >= 0], free[free >= 0]
-            seed_p, seed_q = cand.pose[seeds], q[seeds]
+            n, seed_tol = cand.pose.size, SEED_TOL_REL * robot.length_scale
+            e = None if err_geo is None else err_geo[:n]
+            free = red.continuum_joints(chain, cand.pose, cand.theta, cand.branch, e, seed_tol)
+        if free is not None:
+            seeds = np.nonzero(free >= 0)[0]
+            seed_p, seed_q, free = cand.pose[seeds], q[seeds], free[seeds]
             traced, fam_p, fam_q = continuum_families(robot, chain, poses, seed_p, seed_q, free, limits, tol)
             for i, f in traced.items():
                 fams.setdefault(i, []).extend(f)

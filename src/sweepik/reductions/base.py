@@ -157,11 +157,14 @@ class Reduction(ABC):
         """``(N,)`` True where this reduction cannot describe the pose's solutions (``fallback`` solves them)."""
         return None
 
-    def continuum_joints(self, poses: Array, pose: IntArray, theta: Array, branch: IntArray) -> IntArray | None:
-        """For candidates ``(pose[k], theta[k], branch[k])`` of chain ``poses``: ``(K,)`` a joint other than theta*
-        that the closed form leaves free at the candidate (a continuum of solutions may run along it, which a sweep
-        of theta* cannot see), -1 for none. The solver traces such continua (:mod:`sweepik.continuation`). None:
-        the reduction cannot tell (it then needs ``fallback`` and ``degenerate`` for its blind spots)."""
+    def continuum_joints(
+        self, poses: Array, pose: IntArray, theta: Array, branch: IntArray, error: Array | None = None, tol: float = 0.0
+    ) -> IntArray | None:
+        """For candidates ``(pose[k], theta[k], branch[k])`` of chain ``poses`` (with ``error``, only those whose pose
+        error is at most ``tol``): ``(K,)`` a joint other than theta* that the closed form leaves free at the
+        candidate (a continuum of solutions may run along it, which a sweep of theta* cannot see), -1 for none; None
+        when there is none. The solver traces such continua (:mod:`sweepik.continuation`). The base class cannot
+        tell (a reduction then needs ``fallback`` and ``degenerate`` for its blind spots)."""
         return None
 
     def search_range(self, poses: Array) -> Array | None:

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import parallel
 from ..chain import Chain
 from ..robot import Robot
 from . import geometric
@@ -144,7 +145,7 @@ class GeometricReduction(Reduction):
         self._row = row
         self._last_params: tuple[Array, Array] | None = None
         self._last_range: tuple[Array, Array] | None = None
-        self._last_singular: tuple[Array, NDArray[np.bool_], Array | None] | None = None
+        self._last_singular: tuple[Array, NDArray[np.bool_], NDArray[np.bool_]] | None = None
         # the wrist centre in the tool frame (the last joints do not move it)
         p_end = chain.P.sum(axis=0)
         self._w_tool = chain.R_end.T @ (np.asarray(plan.W) - p_end)
@@ -228,38 +229,34 @@ class GeometricReduction(Reduction):
             -1 if x is None else self.plan.joint(others["abc".index(x)]) for x in STEP_JOINTS[self.plan.case]
         )
 
-    def continuum_joints(self, poses: Array, pose: IntArray, theta: Array, branch: IntArray) -> IntArray | None:
+    @cached_property
+    def _continuum_thresholds(self) -> Array:
+        """Below these amplitudes (steps ``k = 0, 1, 2``) a step leaves its joint free (``CONTINUUM_AMPLITUDE``)."""
+        return np.ascontiguousarray(CONTINUUM_AMPLITUDE * self._step_scales)
+
+    def continuum_joints(
+        self, poses: Array, pose: IntArray, theta: Array, branch: IntArray, error: Array | None = None, tol: float = 0.0
+    ) -> IntArray | None:
         """The pair and wrist families: a candidate where a position step's amplitude vanishes (its equation no longer
         involves its joint, ``CONTINUUM_AMPLITUDE``) gives that step's joint; the first step's before the second's.
-        (The wrist family's continua where its wrist is singular are its fallback's, ``degenerate``.)"""
-        if self._case is None:  # the parallel family
+        None when no candidate does (almost always). (The wrist family's continua where its wrist is singular are its
+        fallback's, ``degenerate``.)"""
+        if self._case is None or pose.size == 0:  # (the parallel family: its steps have no amplitudes)
             return None
-        out = np.full(pose.size, -1, dtype=np.intp)
-        if pose.size == 0:
-            return out
-        position = np.asarray(branch) // (2 if self.plan.closed_form else 1)  # (a wrist branch: two per position's)
-        steps = ((self._step_joints[1], 1 + position // 2), (self._step_joints[0], np.zeros(pose.size, np.intp)))
-        params = self.kernel_params(poses)
-        per_pose = None
-        if self.plan.closed_form:  # theta* moves nothing: a pose's amplitudes serve all its branches
-            per_pose = self._singular(poses)[1]  # (computed with its wrist's singularity, which the solver asks for)
-            assert per_pose is not None
-            if not np.any(per_pose < CONTINUUM_AMPLITUDE * self._step_scales):  # (almost always)
-                return out
-        for joint, k in steps:  # (the first step's last: it wins)
-            if joint >= 0:
-                amp = per_pose[pose, k] if per_pose is not None else self._amplitude(params, pose, theta, k)
-                out[amp < CONTINUUM_AMPLITUDE * self._step_scales[k]] = joint
-        return out
+        if self.plan.closed_form and not self._singular(poses)[1].any():  # (a pose's amplitudes: theta* moves nothing)
+            return None
+        from ..fastsweep import writable  # local: the engine imports the reductions
 
-    def _amplitude(self, params: Array, pose: IntArray, theta: Array, k: IntArray) -> Array:
-        """The amplitudes of the steps ``k`` (as ``amplitude`` of ``geometric.case_kernels`` numbers them) at
-        ``(pose, theta*)``, element by element (one compiled call)."""
-        out = np.empty(pose.size)
-        # (writable copies: the kernels' signature wants them)
-        p, th, kk = np.array(pose, dtype=np.int64), np.array(theta, dtype=np.float64), np.array(k, dtype=np.int64)
-        geometric.evaluate(self._case_kernels.amplitude, params, p, th, kk, out)
-        return out
+        ints = [np.array(a, dtype=np.int64, copy=not a.flags.writeable or None) for a in (pose, branch)]
+        err = np.zeros(pose.size) if error is None else writable(error)
+        joints = np.array(self._step_joints, dtype=np.int64)
+        out = np.empty(pose.size, dtype=np.int64)
+        div = 2 if self.plan.closed_form else 1  # (a wrist branch: two per position branch)
+        params, th, thr = self.kernel_params(poses), writable(theta), self._continuum_thresholds
+        flagged = geometric.continuum_rows(
+            self._case_kernels.amplitude, params, ints[0], th, ints[1], err, float(tol), div, thr, joints, out
+        )
+        return out.astype(np.intp) if flagged else None
 
     @cached_property
     def _continua(self) -> GeometricReduction | None:
@@ -290,25 +287,25 @@ class GeometricReduction(Reduction):
             return None
         return self._singular(poses)[0]
 
-    def _singular(self, poses: Array) -> tuple[NDArray[np.bool_], Array | None]:
-        """A closed form's ``degenerate`` poses, and (the wrist family) its steps' amplitudes ``(N, 3)``, computed
-        in the same pass (``wrist_singular``). The last chunk's are kept: the solver asks for both."""
+    def _singular(self, poses: Array) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+        """A closed form's ``degenerate`` poses and, computed in the same pass (the wrist family), those where a step
+        of the position case leaves its joint free (``continuum_joints``). The last chunk's are kept: the solver asks
+        for both."""
         last = self._last_singular
         if last is not None and last[0] is poses:
             return last[1], last[2]
-        from .. import parallel
         from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
 
         N = poses.shape[0]
-        out = np.zeros(N, dtype=np.bool_)
+        out, low = np.zeros(N, dtype=np.bool_), np.zeros(N, dtype=np.bool_)
+        params = self.kernel_params(poses)
         if self.plan.family == "parallel":
-            amps = None
-            parallel.run(geometric.parallel_singular, N, 2 * PARALLEL_MIN, self.kernel_params(poses), out)
+            parallel.run(geometric.parallel_singular, N, 2 * PARALLEL_MIN, params, out)
         else:
-            amps = np.empty((N, 3))
-            parallel.run(self._case_kernels.wrist_singular, N, 2 * PARALLEL_MIN, self.kernel_params(poses), out, amps)
-        self._last_singular = (poses, out, amps)
-        return out, amps
+            singular = self._case_kernels.wrist_singular
+            parallel.run(singular, N, 2 * PARALLEL_MIN, params, self._continuum_thresholds, out, low)
+        self._last_singular = (poses, out, low)
+        return out, low
 
     def search_range(self, poses: Array) -> Array | None:
         """A prismatic theta*: the travel that can hold a solution, joint limits aside, ``(N, 2)``: the wrist centre

@@ -532,6 +532,50 @@ def configure(cfg, params, pose, theta, branch, out):
     _configure(address_of(cfg, CONFIGURATION_SIG), params, pose, theta, branch, out)
 
 
+_CONTINUUM_SIG = (
+    int64,
+    float64[:, ::1],
+    int64[::1],
+    float64[::1],
+    int64[::1],
+    float64[::1],
+    float64,
+    int64,
+    float64[::1],
+    int64[::1],
+    int64[::1],
+)
+
+
+@lazy_njit(_CONTINUUM_SIG, cache=True)
+def _continuum_rows(amp, params, pose, theta, branch, err, tol, div, thr, joints, out):
+    amp = as_residual(amp)
+    flagged = 0
+    for k in range(pose.shape[0]):
+        out[k] = -1
+        if not err[k] <= tol:
+            continue
+        p = params[pose[k]]
+        if joints[1] >= 0:
+            s = 1 + (branch[k] // div) // 2
+            if amp(p, theta[k], s) < thr[s]:
+                out[k] = joints[1]
+        if joints[0] >= 0 and amp(p, theta[k], 0) < thr[0]:
+            out[k] = joints[0]
+        flagged += out[k] >= 0
+    return flagged
+
+
+def continuum_rows(amplitude, params, pose, theta, branch, err, tol, div, thr, joints, out):
+    """For candidates ``(pose[k], theta[k], branch[k])`` with ``err[k] <= tol`` (the others: -1): ``out[k]`` the
+    joint that a step of the position case leaves free there (its amplitude, ``amplitude`` of ``case_kernels``,
+    below ``thr[step]``; ``joints``: the first and second steps' joints, -1 for none; the first step's wins), else -1.
+    ``div``: branches per position branch (2 for the wrist family). Returns the number of rows flagged."""
+    return _continuum_rows(
+        address_of(amplitude, RESIDUAL_SIG), params, pose, theta, branch, err, tol, div, thr, joints, out
+    )
+
+
 #: A closed form's wrist is singular (joint 6's target axis along joint 4's, or along the parallel axes: a continuum
 #: of solutions) when the sine of the angle between them is below 1e-9; within this of it the closed form's angles
 #: carry the square root of the rounding (~1e-8) and can miss the pose by far more than the certification accepts.
@@ -559,8 +603,8 @@ def parallel_singular(params, out, start, stop):
 
 class CaseKernels(NamedTuple):
     """The compiled kernels of the pair and wrist families for one position case (``position.CASES``): Python calls
-    ``wrist_singular(params, out, amps, start, stop)``; the others are :class:`~.kernels.LazyKernel` objects with the
-    engine's signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch;
+    ``wrist_singular(params, thr, out, low, start, stop)``; the others are :class:`~.kernels.LazyKernel` objects with
+    the engine's signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch;
     ``pair_residuals`` and ``pair_margins`` are their all-branch kernels, ``Reduction.kernel_residuals``)."""
 
     pair_residual: Any
@@ -700,23 +744,22 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
                 for i in range(6):
                     out[r, i] = math.nan
 
-        def singular(params, out, amps, start, stop):
+        def singular(params, thr, out, low, start, stop):
             """``out[i]`` for poses ``start .. stop - 1``: some exact position branch of the wrist family leaves
-            pose i with a singular wrist; ``amps[i]``: the amplitudes of the position case's steps, ``k = 0, 1, 2``
-            as ``amplitude`` numbers them (inf for a second step on a first-step branch the case does not have)."""
+            pose i with a singular wrist; ``low[i]``: the amplitude of a step of the position case is below its
+            threshold ``thr[k]`` (``k = 0, 1, 2`` as ``amplitude`` numbers them: a joint left free there)."""
             h3, h5 = _h(params[0], 3), _h(params[0], 5)
             for i in range(start, stop):
                 p = params[i]
                 out[i] = False
-                for k in range(3):
-                    amps[i, k] = math.inf
+                low[i] = False
                 nb = int(p[_POS_BRANCHES])
                 both = BOTH + 0 * nb  # (a run-time value: see position.place)
                 for b1 in range((nb + 1) // 2):
                     # the two branches of a first step share its work (as in ``wrists``, the same values)
                     arm = _arm(p, 0.0, b1, both, case, free, rev)
-                    amps[i, 0] = arm[4]
-                    amps[i, 1 + b1] = arm[5]
+                    if arm[4] < thr[0] or arm[5] < thr[1 + b1]:
+                        low[i] = True
                     for j in range(2):
                         if 2 * b1 + j >= nb:
                             break
