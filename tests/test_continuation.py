@@ -43,13 +43,13 @@ def member_of(robot, sol, q: np.ndarray) -> bool:
     return False
 
 
-def assert_members_certified(robot, sol, T: np.ndarray, count: int = 25) -> None:
+def assert_members_certified(robot, sol, T: np.ndarray, count: int = 25, limits: bool = True) -> None:
     for f in sol.families:
         m = f.sample(count)
         err = pose_error_geodesic(robot.fk(m), np.broadcast_to(T, (count, 4, 4)))
         # (the solver's acceptance, with room for this test's own forward kinematics: a different rounding)
         assert err.max() <= 4.0 * ACCEPT_TOL_REL * robot.length_scale
-        assert np.all(robot.within_limits(m))
+        assert np.all(robot.within_limits(m)) or not limits
 
 
 def test_traced_family_agrees_with_an_independent_reduction() -> None:
@@ -164,3 +164,28 @@ def test_shoulder_singularity_of_an_elbow_manipulator() -> None:
         assert len(sol.families) == 4 and all(f.free_joint == 0 for f in sol.families)
         assert member_of(robot, sol, q)
         assert_members_certified(robot, sol, T)
+
+
+@pytest.mark.parametrize("limits", [True, False])
+def test_wrist_continuum_the_fallback_sweep_cuts(limits: bool) -> None:
+    """carm_swapped on its wrist singularity (theta5 = 90 deg: a continuum along joint 4) with its elbow nearly
+    straight (theta3 ~ 0.01 rad), where the fallback sweep of joint 4 loses digits and returned the continuum as short
+    pieces: traced from them, the whole continuum is one family holding the generating configuration. Also a batch
+    of random poses on that singularity."""
+    robot = load_robot("carm_swapped")
+    near_straight = np.array(
+        [
+            [1518.417, -0.0271, 0.0175, -0.4086, np.pi / 2, -2.7027],
+            [1923.6208, 2.8781, -0.0117, -1.107, np.pi / 2, 0.5497],
+        ]
+    )
+    rng = np.random.default_rng(3)
+    q = rng.uniform(robot.lower, robot.upper, (60, 6))
+    q[:, 4] = np.pi / 2
+    q = np.concatenate([near_straight, q])
+    sols = solve_many(robot, robot.fk(q), limits=limits)
+    for i, sol in enumerate(sols):
+        assert member_of(robot, sol, q[i]) or joint_distance(robot, sol.q, q[i]).max(axis=-1).min() <= SAME, i
+    for i in range(2):
+        assert member_of(robot, sols[i], q[i])
+        assert_members_certified(robot, sols[i], robot.fk(q[i]), limits=limits)

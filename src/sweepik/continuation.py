@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from .kinematics import geometric_jacobian
 from .polish import geodesic_errors, polish
 from .reductions.base import Reduction
 from .robot import Robot
@@ -38,6 +39,13 @@ TRACE_HALVINGS = 14
 TRACE_JUMP = 0.25
 #: Newton steps per correction.
 TRACE_NEWTON = 6
+#: A seed is followed only where a continuum can pass along the joint: the arm's Jacobian (lengths over the arm's
+#: length scale) has its smallest singular value below this fraction of its largest (members of a continuum: ~1e-17,
+#: and ~1e-9 where two singular directions meet and the member is pinned down only to the root of the rounding;
+#: regular solutions: above ~1e-3) ...
+TRACE_SINGULAR = 1e-7
+#: ... and the joint's share of that singular value's direction (the continuum's tangent) is above this.
+TRACE_SHARE = 1e-3
 #: Seeds corrected at once (``continuum_families``).
 SEED_BATCH = 8
 #: A traced stretch shorter than this fraction of a step is no family (the candidate is isolated).
@@ -49,6 +57,17 @@ def _distance(robot: Robot, a: Array, b: Array) -> Array:
     d = np.abs(a - b)
     d = np.where(robot.is_revolute, np.abs(np.mod(d + np.pi, 2.0 * np.pi) - np.pi), d / robot.length_scale)
     return np.asarray(np.max(d, axis=-1))
+
+
+def _singular_along(robot: Robot, q: Array, joint: int) -> NDArray[np.bool_]:
+    """``(K,)``: the configurations ``q (K, n)`` are singular with a null direction that moves ``joint``
+    (``TRACE_SINGULAR``, ``TRACE_SHARE``): the only places a continuum along it can pass (elsewhere the arm's
+    solutions are isolated)."""
+    J = geometric_jacobian(robot, q)
+    J[:, :3, :] /= robot.length_scale
+    J[:, :, ~robot.is_revolute] *= robot.length_scale
+    _, s, vt = np.linalg.svd(J)
+    return np.asarray((s[:, -1] <= TRACE_SINGULAR * s[:, 0]) & (np.abs(vt[:, -1, joint]) >= TRACE_SHARE))
 
 
 def _world(robot: Robot, chain: Array) -> Array:
@@ -198,6 +217,7 @@ def continuum_families(
                 head = left[:SEED_BATCH]
                 head, err = _correct(robot, head, np.repeat(world[i][None], head.shape[0], axis=0), j, tol)
                 good = np.nonzero(err <= tol)[0]
+                good = good[_singular_along(robot, head[good], j)]
                 if good.size == 0:
                     left = left[SEED_BATCH:]
                     continue

@@ -24,7 +24,7 @@ from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptio
 from .families import MAX_ISOLATED_SOLUTIONS, collapse_continua, families_of, off_families, unique_families
 from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
-from .polish import polish
+from .polish import geodesic_errors, polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, get_reduction
 from .reductions.decompose import not_sweepable
@@ -322,6 +322,7 @@ def _solve_chunk(
             )
             if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
                 fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx)}
+                _trace_cut_continua(robot, red, chain, poses, idx, alt, limits, fams, fallback)
             else:  # the reduction's blind spot: the fallback's families
                 fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)}
     # poses with families (few): their isolated solutions lying on a family are reported by the family; the
@@ -360,6 +361,76 @@ def _solve_chunk(
         n_reachable=n_reachable.astype(np.intp),
         empty_reason=empty_reason,
     )
+
+
+#: A family's end is at a joint limit when a joint of its member there is this close to it (radians; relative to
+#: the length scale for a slide): the limits cut it there (``_cut_short``) ...
+_AT_LIMIT = 1e-7
+#: ... and elsewhere the continuum goes on past it when the member this far beyond it (relative to the joint's
+#: range) is a near-solution (within ``POLISH_BELOW_REL``): the family's closed form lost digits there. Past a
+#: fold or a branch-domain edge, where a continuum ends, the member misses the pose by ~this times the arm.
+_PAST_END_REL = 1e-3
+
+
+def _cut_short(robot: Robot, family: Family, target: Array, limits: bool) -> bool:
+    """The family's continuum goes on past one of its ends (the sweep's closed form lost it there: its members stop
+    being certified), where no joint limit cuts it."""
+    j = family.free_joint
+    ends = np.array(family.interval)
+    span = (-np.pi, np.pi) if robot.is_revolute[j] else (float(robot.lower[j]), float(robot.upper[j]))
+    inner = (np.abs(ends - span[0]) > _AT_LIMIT) & (np.abs(ends - span[1]) > _AT_LIMIT)
+    if limits:
+        m = robot.wrap(family.at(ends))
+        slack = np.where(robot.is_revolute, _AT_LIMIT, _AT_LIMIT * robot.length_scale)
+        inner &= ~np.any((np.abs(m - robot.lower) <= slack) | (np.abs(m - robot.upper) <= slack), axis=-1)
+    if not inner.any():
+        return False
+    past = (ends + np.array([-1.0, 1.0]) * _PAST_END_REL * (span[1] - span[0]))[inner]
+    red = family.reduction
+    q = red.solve_rest(family.chain_pose[None], past[None, :], np.full((1, past.size), family.branch))[0]
+    err = geodesic_errors(robot, q, np.broadcast_to(target, (past.size, 4, 4)), orientation_weight(robot.length_unit))
+    return bool(np.any(err <= POLISH_BELOW_REL * robot.length_scale))
+
+
+def _trace_cut_continua(
+    robot: Robot,
+    red: Reduction,
+    chain: Array,
+    poses: Array,
+    idx: NDArray[np.intp],
+    alt: Block,
+    limits: bool,
+    fams: dict[int, list[Family]],
+    fallback: dict[int, Solutions],
+) -> None:
+    """A closed form's degenerate poses ``idx``, answered by its fallback sweep (``alt``): where the sweep's closed
+    form loses digits along a continuum (the C-Arm with joints 5 and 6 swapped, its elbow nearly straight), the
+    continuum comes out as short pieces and isolated members. From those (each isolated solution, the middle of each
+    piece) it is traced along the sweep's joint (:mod:`.continuation`: exact members, and only from a configuration
+    where the arm is singular); the continua found go to ``fams``, and the fallback's families they cover are
+    dropped from ``fallback``."""
+    pose = [idx[np.repeat(np.arange(idx.size), np.diff(alt.bounds))]]
+    seeds = [alt.q]
+    for k, pieces in alt.families.items():  # (few poses)
+        cut = [f for f in pieces if _cut_short(robot, f, poses[idx[k]], limits)]
+        if cut:
+            pose.append(np.full(len(cut), idx[k], dtype=np.intp))
+            seeds.append(np.array([f.at(0.5 * (f.interval[0] + f.interval[1])) for f in cut]))
+    p, q = np.concatenate(pose), np.concatenate(seeds)
+    if p.size == 0:
+        return
+    joint = np.full(p.size, get_reduction(robot, red.fallback).free_joint, dtype=np.intp)
+    tol = ACCEPT_TOL_REL * robot.length_scale
+    traced, _, _ = continuum_families(robot, chain, poses, p, q, joint, limits, tol)  # (their point pieces:
+    # members at a limit, which the fallback has as solutions)
+    for i, found in traced.items():
+        fams.setdefault(i, []).extend(found)
+        sol = fallback[i]
+        if sol.families:  # the pieces: covered when their ends and middle are members of a traced continuum
+            ends = [f.at(np.linspace(f.interval[0], f.interval[1], 3)) for f in sol.families]
+            off = off_families(robot, [(m, tuple(found)) for m in ends])
+            kept = tuple(f for f, o in zip(sol.families, off, strict=True) if o.any())
+            fallback[i] = dataclasses.replace(sol, families=kept)
 
 
 def _with_families(
