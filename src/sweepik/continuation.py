@@ -23,7 +23,7 @@ from .kinematics import geometric_jacobian
 from .polish import geodesic_errors, polish
 from .reductions.base import Reduction
 from .robot import Robot
-from .solutions import Family
+from .solutions import Family, weighted_joint_distance
 from .sweep import Spans
 from .units import orientation_weight
 
@@ -34,8 +34,8 @@ IntArray = NDArray[np.intp]
 TRACE_STEPS = 64
 #: ... halved on a failed step at most this many times before the family is taken to end there.
 TRACE_HALVINGS = 14
-#: A corrected member farther than this from its prediction (radians; lengths relative to the arm's length scale,
-#: the largest joint) is refused: the correction jumped to another piece of the solution set.
+#: A corrected member farther than this from its prediction (``solutions.weighted_joint_distance``: radians, and
+#: 100 mm of a slide per radian) is refused: the correction jumped to another piece of the solution set.
 TRACE_JUMP = 0.25
 #: Newton steps per correction.
 TRACE_NEWTON = 6
@@ -50,13 +50,6 @@ TRACE_SHARE = 1e-3
 SEED_BATCH = 8
 #: A traced stretch shorter than this fraction of a step is no family (the candidate is isolated).
 TRACE_MIN = 0.5
-
-
-def _distance(robot: Robot, a: Array, b: Array) -> Array:
-    """Largest joint difference ``(..., n) -> (...)``: radians (modulo 2 pi) and lengths over the length scale."""
-    d = np.abs(a - b)
-    d = np.where(robot.is_revolute, np.abs(np.mod(d + np.pi, 2.0 * np.pi) - np.pi), d / robot.length_scale)
-    return np.asarray(np.max(d, axis=-1))
 
 
 def _singular_along(robot: Robot, q: Array, joint: int) -> NDArray[np.bool_]:
@@ -113,14 +106,15 @@ def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) ->
                 pred = q + (q - qp) * (step / abs(x - xp))
             pred[joint] = x + sign * step
             corr, err = _correct(robot, pred[None], world[None], joint, tol)
-            if err[0] <= tol and _distance(robot, corr[0], pred) <= TRACE_JUMP:
+            if err[0] <= tol and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP:
                 nodes.append((x + sign * step, corr[0]))
                 done += step
                 h = min(2.0 * h, h0)
             else:
                 h *= 0.5
         sides.append(nodes)
-        if periodic and sign > 0 and done >= reach and _distance(robot, nodes[-1][1], q0) <= TRACE_JUMP * 1e-3:
+        back_home = weighted_joint_distance(robot, nodes[-1][1], q0) <= TRACE_JUMP * 1e-3
+        if periodic and sign > 0 and done >= reach and back_home:
             closed = True
             break
     back = sides[1][:0:-1] if len(sides) > 1 else []

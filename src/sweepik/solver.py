@@ -421,8 +421,8 @@ def _trace_cut_continua(
         return
     joint = np.full(p.size, get_reduction(robot, red.fallback).free_joint, dtype=np.intp)
     tol = ACCEPT_TOL_REL * robot.length_scale
-    traced, _, _ = continuum_families(robot, chain, poses, p, q, joint, limits, tol)  # (their point pieces:
-    # members at a limit, which the fallback has as solutions)
+    # (the continua's pieces that shrink to a point at a limit are left out: the fallback has them as solutions)
+    traced, _, _ = continuum_families(robot, chain, poses, p, q, joint, limits, tol)
     for i, found in traced.items():
         fams.setdefault(i, []).extend(found)
         sol = fallback[i]
