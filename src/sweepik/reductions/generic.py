@@ -234,6 +234,16 @@ class GeometricReduction(Reduction):
         """Below these amplitudes (steps ``k = 0, 1, 2``) a step leaves its joint free (``CONTINUUM_AMPLITUDE``)."""
         return np.ascontiguousarray(CONTINUUM_AMPLITUDE * self._step_scales)
 
+    @cached_property
+    def _continuum_args(self) -> tuple[int, int, Array, NDArray[np.int64]]:
+        """``geometric.continuum_rows``'s arguments that do not change: the amplitude kernel's address, the branches
+        per position branch (2 for the wrist family), the thresholds, the steps' joints."""
+        from .kernels import RESIDUAL_SIG, address_of
+
+        address = address_of(self._case_kernels.amplitude, RESIDUAL_SIG)
+        joints = np.array(self._step_joints, dtype=np.int64)
+        return address, 2 if self.plan.closed_form else 1, self._continuum_thresholds, joints
+
     def continuum_joints(
         self, poses: Array, pose: IntArray, theta: Array, branch: IntArray, error: Array | None = None, tol: float = 0.0
     ) -> IntArray | None:
@@ -245,17 +255,13 @@ class GeometricReduction(Reduction):
             return None
         if self.plan.closed_form and not self._singular(poses)[1].any():  # (a pose's amplitudes: theta* moves nothing)
             return None
-        from ..fastsweep import writable  # local: the engine imports the reductions
-
-        ints = [np.array(a, dtype=np.int64, copy=not a.flags.writeable or None) for a in (pose, branch)]
-        err = np.zeros(pose.size) if error is None else writable(error)
-        joints = np.array(self._step_joints, dtype=np.int64)
-        out = np.empty(pose.size, dtype=np.int64)
-        div = 2 if self.plan.closed_form else 1  # (a wrist branch: two per position branch)
-        params, th, thr = self.kernel_params(poses), writable(theta), self._continuum_thresholds
-        flagged = geometric.continuum_rows(
-            self._case_kernels.amplitude, params, ints[0], th, ints[1], err, float(tol), div, thr, joints, out
-        )
+        # (writable arrays of the kernel's types: copies only where the candidates' are not)
+        p, b = (a if a.dtype == np.int64 and a.flags.writeable else np.array(a, dtype=np.int64) for a in (pose, branch))
+        th = theta if theta.flags.writeable else np.array(theta)
+        err = np.zeros(pose.size) if error is None else error if error.flags.writeable else np.array(error)
+        address, div, thr, joints = self._continuum_args
+        out, params = np.empty(pose.size, dtype=np.int64), self.kernel_params(poses)
+        flagged = geometric.continuum_rows(address, params, p, th, b, err, tol, div, thr, joints, out)
         return out.astype(np.intp) if flagged else None
 
     @cached_property

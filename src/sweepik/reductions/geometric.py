@@ -568,12 +568,11 @@ def _continuum_rows(amp, params, pose, theta, branch, err, tol, div, thr, joints
 
 def continuum_rows(amplitude, params, pose, theta, branch, err, tol, div, thr, joints, out):
     """For candidates ``(pose[k], theta[k], branch[k])`` with ``err[k] <= tol`` (the others: -1): ``out[k]`` the
-    joint that a step of the position case leaves free there (its amplitude, ``amplitude`` of ``case_kernels``,
-    below ``thr[step]``; ``joints``: the first and second steps' joints, -1 for none; the first step's wins), else -1.
-    ``div``: branches per position branch (2 for the wrist family). Returns the number of rows flagged."""
-    return _continuum_rows(
-        address_of(amplitude, RESIDUAL_SIG), params, pose, theta, branch, err, tol, div, thr, joints, out
-    )
+    joint that a step of the position case leaves free there (its amplitude, ``amplitude`` of ``case_kernels`` given
+    by its address, ``kernels.address_of``, below ``thr[step]``; ``joints``: the first and second steps' joints, -1
+    for none; the first step's wins), else -1. ``div``: branches per position branch (2 for the wrist family).
+    Returns the number of rows flagged."""
+    return _continuum_rows(amplitude, params, pose, theta, branch, err, tol, div, thr, joints, out)
 
 
 #: A closed form's wrist is singular (joint 6's target axis along joint 4's, or along the parallel axes: a continuum
