@@ -12,7 +12,7 @@ from importlib import resources
 import numpy as np
 import pytest
 
-from sweepik import load_robot, solve, solve_many
+from sweepik import SweepikError, load_robot, solve, solve_many
 from sweepik.pose import pose_error_geodesic
 from sweepik.reductions import get_reduction
 from sweepik.robot_file import robot_from_dict
@@ -109,6 +109,10 @@ def test_traced_family_cut_to_the_limits() -> None:
         sol = solve(robot, T, reduction="auto")
         assert [f.interval for f in sol.families] == [pytest.approx(np.radians([-60.0, 120.0]))]
         assert member_of(robot, sol, qi)
+        f = sol.families[0]
+        assert joint_distance(robot, f.at(qi[1] + 2.0 * np.pi), qi).max() <= SAME  # (by whole turns)
+        with pytest.raises(SweepikError, match="outside the family's interval"):
+            f.at(np.pi)  # (180 deg: off [-60, 120] deg, any number of turns away)
         assert_members_certified(robot, sol, T)
         free = solve(robot, T, reduction="auto", limits=False)
         assert [f.interval for f in free.families] == [pytest.approx((-np.pi, np.pi))]

@@ -71,3 +71,16 @@ def test_family_member_at_a_removable_singular_point_is_a_solution() -> None:
             np.testing.assert_allclose(robot.fk(members), np.broadcast_to(T, (4, 4, 4)), atol=1e-9)
             checked += 1
     assert checked >= 2
+
+
+def test_family_member_at_an_angle_past_pi() -> None:
+    """IRB 140's joint 4 reaches +-200 deg: a configuration's own joint-4 value past pi names a member of the wrist
+    family (whose interval is in [-pi, pi]) by whole turns. (A value off the interval modulo 2 pi is refused:
+    test_continuation's limited family.)"""
+    robot = sweepik.load_robot("abb_irb140")
+    q = np.array(robot.lower + 0.37 * (robot.upper - robot.lower))
+    q[3], q[4] = 3.4, 0.0
+    sols = sweepik.solve(robot, robot.fk(q))
+    on = [f for f in sols.families if f.free_joint == 3 and np.max(joint_distance(robot, f.at(q[3]), q)) <= 1e-9]
+    assert on, "the generating configuration should be a member, named by its own joint 4"
+    np.testing.assert_allclose(joint_distance(robot, on[0].at(q[3] - 2.0 * np.pi), q), 0.0, atol=1e-9)

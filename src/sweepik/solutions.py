@@ -111,13 +111,16 @@ class Family:
     held: HeldJoints | None = field(default=None, repr=False)
 
     def at(self, theta: ArrayLike) -> Array:
-        """Member configuration(s) ``(n,)`` (or ``(..., n)``) at theta* value(s) inside ``interval``. Each is a
-        solution of the pose: at an isolated theta* where the reduction's closed form breaks down (the C-Arm's
-        wrist crossing joint 2's axis), the member ~1e-9 of the interval away is given, the solution there being
-        its limit."""
+        """Member configuration(s) ``(n,)`` (or ``(..., n)``) at theta* value(s) inside ``interval`` (a revolute
+        joint's angle modulo 2 pi: a configuration's own value of the joint will do, wherever its range puts it).
+        Each is a solution of the pose: at an isolated theta* where the reduction's closed form breaks down (the
+        C-Arm's wrist crossing joint 2's axis), the member ~1e-9 of the interval away is given, the solution there
+        being its limit."""
         th = np.asarray(theta, dtype=np.float64)
         lo, hi = self.interval
         tol = _FAMILY_EDGE_TOL * max(hi - lo, 1.0)
+        if self.reduction.periodic:  # an angle by whole turns onto the interval (a joint's range can pass +-pi)
+            th = lo - tol + np.mod(th - (lo - tol), 2.0 * np.pi)
         if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
             raise SweepikError(f"theta* = {th.tolist()} is outside the family's interval [{lo:.12g}, {hi:.12g}]")
         flat = np.clip(th.reshape(-1), lo, hi)
