@@ -299,3 +299,15 @@ def test_a_second_writer_and_another_version_are_refused(tmp_path: Path) -> None
     zarr.open_group(str(other), mode="r+").attrs["sweepik_version"] = "0.0.1-other"
     with pytest.raises(StoreError, match="written by sweepik 0.0.1-other"):
         StoreWriter(other, CARM, opts, len(P), 10, resume=True)
+
+
+def test_traced_families_round_trip(tmp_path: Path) -> None:
+    """Families traced numerically (the C-Arm's theta2 self-motion under the automatic decomposition,
+    sweepik.continuation) are stored with their nodes and give the same members when loaded."""
+    q = np.array([[500.0, 0.3, 0.0, -np.pi / 2, 0.2, 1.0], [1200.0, -1.1, 0.0, -np.pi / 2, -0.7, 2.5]])
+    rng = np.random.default_rng(5)
+    P = np.concatenate([CARM.fk(q), CARM.fk(rng.uniform(CARM.lower, CARM.upper, (5, 6)))])
+    ref = solve_many(CARM, P, reduction="auto")
+    assert [f.reduction.name for i in (0, 1) for f in ref[i].families] == ["traced", "traced"]
+    write_store(tmp_path / "t.zarr", CARM, P, 3, reduction="auto")
+    assert_same_batch(load_solutions(tmp_path / "t.zarr"), ref)

@@ -123,16 +123,24 @@ def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) ->
 
 
 class Traced(Reduction):
-    """The members of traced continua along one joint: branch ``k`` is the ``k``-th traced one, its member at a value
-    of the joint corrected from the nodes around it (linear interpolation, then Newton steps with the joint held).
-    Used only as the ``reduction`` of the families it traced (no residual: it is not swept)."""
+    """The members of traced continua along one joint: branch ``k`` is a traced one (``nodes[k]``: the joint's values
+    ``(M,)``, increasing, and the members there ``(M, n)``), its member at a value of the joint corrected from the
+    nodes around it (linear interpolation, then Newton steps with the joint held, to within ``tol``). Used only as the
+    ``reduction`` of the families it traced (no residual: it is not swept); a store keeps a family's nodes."""
 
     name = "traced"
 
-    def __init__(self, robot: Robot, joint: int, nodes: list[tuple[Array, Array]], tol: float) -> None:
-        super().__init__(robot, joint, len(nodes))
+    def __init__(self, robot: Robot, joint: int, nodes: dict[int, tuple[Array, Array]], tol: float) -> None:
+        super().__init__(robot, joint, max(nodes, default=-1) + 1)
         self.nodes = nodes
         self.tol = tol
+
+    def add(self, theta: Array, q: Array) -> int:
+        """A traced continuum as a new branch: its index."""
+        b = self.n_branches
+        self.nodes[b] = (theta, q)
+        self.n_branches = b + 1
+        return b
 
     def _unwrapped(self, branch: int, x: Array) -> Array:
         """``x`` moved by whole turns into the nodes' stretch of ``branch`` (a revolute joint), then clipped to it."""
@@ -143,9 +151,12 @@ class Traced(Reduction):
         return np.clip(x, th[0], th[-1])
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        if branch is None:  # every branch
+        if branch is None:  # every branch (NaN where there is none)
             each = [
-                self.solve_rest(poses, theta, np.full(theta.shape, b, dtype=np.intp)) for b in range(self.n_branches)
+                self.solve_rest(poses, theta, np.full(theta.shape, b, dtype=np.intp))
+                if b in self.nodes
+                else np.full((*theta.shape, self.robot.n_joints), np.nan)
+                for b in range(self.n_branches)
             ]
             return np.stack(each, axis=-2)
         n, j = self.robot.n_joints, self.free_joint
@@ -199,9 +210,8 @@ def continuum_families(
     iso_p: list[IntArray] = [np.zeros(0, dtype=np.intp)]
     iso_q: list[Array] = [np.zeros((0, robot.n_joints))]
     for j in np.unique(joint).tolist():
-        nodes: list[tuple[Array, Array]] = []
         spans: list[tuple[int, int, float, float]] = []
-        traced = Traced(robot, j, nodes, tol)
+        traced = Traced(robot, j, {}, tol)
         ks = np.nonzero(joint == j)[0]
         for i in np.unique(pose[ks]).tolist():
             left = q[ks[pose[ks] == i]]
@@ -220,9 +230,7 @@ def continuum_families(
                 h = (2.0 * np.pi if traced.periodic else float(robot.upper[j] - robot.lower[j])) / TRACE_STEPS
                 if th[-1] - th[0] < TRACE_MIN * h:
                     continue
-                spans += _pieces(i, len(nodes), th, closed, traced.periodic)
-                nodes.append((th, Q))
-                traced.n_branches = len(nodes)
+                spans += _pieces(i, traced.add(th, Q), th, closed, traced.periodic)
                 if left.shape[0]:  # the other seeds on it are not traced again
                     mine = tuple(Family(j, (lo, hi), traced, chain[i], b) for p, b, lo, hi in spans if p == i)
                     left = left[off_families(robot, [(left, mine)])[0]]
