@@ -77,10 +77,11 @@ def _correct(robot: Robot, q: Array, world: Array, joint: int, tol: float) -> tu
     return q, geodesic_errors(robot, q, world, weight)
 
 
-def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) -> tuple[Array, Array, bool]:
+def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) -> tuple[Array, Array, bool] | None:
     """Members of the continuum through ``q0`` with ``joint`` as parameter, both ways from ``q0[joint]`` (a revolute
     joint over one turn at most, a prismatic one within its limits): ``(theta (M,), q (M, n), closed)`` in increasing
-    theta (not wrapped), ``closed`` when a revolute joint came back to ``q0`` after a whole turn."""
+    theta (not wrapped), ``closed`` when a revolute joint came back to ``q0`` after a whole turn. None when the
+    stretch is shorter than ``TRACE_MIN`` steps (``q0`` is isolated)."""
     periodic = bool(robot.is_revolute[joint])
     x0 = float(q0[joint])
     if periodic:
@@ -119,7 +120,10 @@ def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) ->
             break
     back = sides[1][:0:-1] if len(sides) > 1 else []
     ordered = back + sides[0]
-    return np.array([x for x, _ in ordered]), np.array([q for _, q in ordered]), closed
+    theta = np.array([x for x, _ in ordered])
+    if theta[-1] - theta[0] < TRACE_MIN * h0:
+        return None
+    return theta, np.array([q for _, q in ordered]), closed
 
 
 class Traced(Reduction):
@@ -226,10 +230,10 @@ def continuum_families(
                     left = left[SEED_BATCH:]
                     continue
                 seed, left = head[good[0]], left[good[0] + 1 :]
-                th, Q, closed = _trace_one(robot, world[i], seed, j, tol)
-                h = (2.0 * np.pi if traced.periodic else float(robot.upper[j] - robot.lower[j])) / TRACE_STEPS
-                if th[-1] - th[0] < TRACE_MIN * h:
+                stretch = _trace_one(robot, world[i], seed, j, tol)
+                if stretch is None:
                     continue
+                th, Q, closed = stretch
                 spans += _pieces(i, traced.add(th, Q), th, closed, traced.periodic)
                 if left.shape[0]:  # the other seeds on it are not traced again
                     mine = tuple(Family(j, (lo, hi), traced, chain[i], b) for p, b, lo, hi in spans if p == i)

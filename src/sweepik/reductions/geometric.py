@@ -532,19 +532,9 @@ def configure(cfg, params, pose, theta, branch, out):
     _configure(address_of(cfg, CONFIGURATION_SIG), params, pose, theta, branch, out)
 
 
-_CONTINUUM_SIG = (
-    int64,
-    float64[:, ::1],
-    int64[::1],
-    float64[::1],
-    int64[::1],
-    float64[::1],
-    float64,
-    int64,
-    float64[::1],
-    int64[::1],
-    int64[::1],
-)
+#: ``_evaluate``'s (the last array: the candidates' errors), then the tolerance, branches per position branch,
+#: thresholds, joints and the output.
+_CONTINUUM_SIG = _EVALUATE_SIG + (float64, int64, float64[::1], int64[::1], int64[::1])
 
 
 @lazy_njit(_CONTINUUM_SIG, cache=True)
