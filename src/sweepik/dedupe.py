@@ -328,13 +328,14 @@ if AVAILABLE:
                         break
             start = stop
 
-    @lazy_njit(
+    #: ``_settle``'s arguments (``fastsolve`` calls it by its address too).
+    _SETTLE_SIG = (
         (float64[:, ::1], float64[::1], float64[::1], int64[::1], float64[::1], boolean[::1], float64[::1])
         + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, boolean[::1], int64[::1])
-        + (float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64[::1], int64[::1], int64, int64),
-        cache=True,
-        nogil=True,
+        + (float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64[::1], int64[::1], int64, int64)
     )
+
+    @lazy_njit(_SETTLE_SIG, cache=True, nogil=True)
     def _settle(
         q, eg, ep, pose, thr, rev, lower, upper, ltol, beyond, reach, tol, scale,
         due, idx, w, score, inside, keep, parts, counts, start, stop,

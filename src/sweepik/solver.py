@@ -15,7 +15,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import fastcertify, fastsweep, parallel
+from . import fastcertify, fastsolve, fastsweep, parallel
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch
 from .continuation import continuum_families
@@ -199,6 +199,10 @@ def _solve_chunk(
     n_samples: int,
     use_fallback: bool = True,
 ) -> Block:
+    if len(poses) == 1 and strategy == "precise" and use_fallback and red.uses_kernel and not red.closed_form:
+        block = _settled_single(robot, red, poses, limits, n_samples)
+        if block is not None:
+            return block
     chain = _chain_poses(robot, poses)
     closed = red.closed_form
     if not closed:  # (a closed form sweeps nothing)
@@ -360,6 +364,48 @@ def _solve_chunk(
         families=families,
         n_reachable=n_reachable.astype(np.intp),
         empty_reason=empty_reason,
+    )
+
+
+def _settled_single(robot: Robot, red: Reduction, poses: Array, limits: bool, n_samples: int) -> Block | None:
+    """``_solve_chunk`` of one pose in one compiled call (``fastsolve``), the same values; None where the pose needs
+    one of its rarer steps (a polish, families, special solutions, a continuum along another joint, the fallback)."""
+    chain = _chain_poses(robot, poses)
+    lo, hi = _theta_range(robot, red, chain)
+    params = red.kernel_params(chain)
+    bounds, reach = _settle_bounds(robot), _snap_reach(robot)
+    out = fastsolve.settle_one(robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL)
+    if out is None or out.status != fastsolve.OK or out.rows.size > MAX_ISOLATED_SOLUTIONS:
+        return None
+    special = red.special_solutions(chain)
+    if special is not None and np.isfinite(special[0] if isinstance(special, tuple) else special).all(-1).any():
+        return None
+    if type(red).continuum_joints is not Reduction.continuum_joints:
+        pose = np.zeros(out.theta.size, dtype=np.intp)
+        free = red.continuum_joints(chain, pose, out.theta, out.branch, out.err_geo, SEED_TOL_REL * robot.length_scale)
+        if free is not None and bool((free >= 0).any()):
+            return None
+    if red.fallback is not None:
+        deg = red.degenerate(chain)
+        if deg is not None and bool(deg.any()):
+            return None
+    rows, keep, inside = out.rows, out.keep, out.inside
+    n_reachable = np.array([np.count_nonzero(keep)], dtype=np.intp)
+    if limits:
+        keep = keep & inside
+    sel = rows[keep]
+    return Block(
+        robot=robot,
+        poses=poses.copy(),
+        bounds=np.array([0, sel.size], dtype=np.intp),
+        q=out.w[keep],
+        error=out.err_paper[sel],
+        error_geodesic=out.err_geo[sel],
+        within_limits=inside[keep],
+        multiplicity=out.mult[sel].astype(np.intp),
+        families={},
+        n_reachable=n_reachable,
+        empty_reason=None,
     )
 
 

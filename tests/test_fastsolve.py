@@ -1,0 +1,109 @@
+"""The one-call path of a single pose (``fastsolve.settle_one``, ``solver._settled_single``) gives what the general
+path gives, bit for bit, and hands the poses it cannot settle to it."""
+
+from __future__ import annotations
+
+from collections import Counter
+from typing import Any
+
+import numpy as np
+import pytest
+
+import sweepik
+from sweepik import fastsolve, fastsweep, load_robot, solver
+
+pytestmark = pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+
+
+def _poses(robot: sweepik.Robot, seed: int) -> np.ndarray:
+    """Random configurations' poses, and poses on the singular set (joint 5 at 0, joint 3 at 0, both)."""
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(robot.lower, robot.upper, (48, 6))
+    q[:8, 4] = 0.0
+    q[8:16, 2] = 0.0
+    q[16:20, 2] = 0.0
+    q[16:20, 4] = 0.0
+    return robot.fk(q)
+
+
+def _assert_same(a: sweepik.Solutions, b: sweepik.Solutions) -> None:
+    for x, y in (
+        (a.q, b.q),
+        (a.error, b.error),
+        (a.error_geodesic, b.error_geodesic),
+        (a.multiplicity, b.multiplicity),
+        (a.within_limits, b.within_limits),
+    ):
+        assert x.dtype == y.dtype
+        np.testing.assert_array_equal(x, y)
+    assert len(a.families) == len(b.families)
+    assert a.reason == b.reason
+
+
+def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, poses: np.ndarray, **kw: Any) -> list[Any]:
+    with monkeypatch.context() as m:
+        m.setattr(solver, "_settled_single", lambda *args: None)
+        return [sweepik.solve(robot, T, **kw) for T in poses]
+
+
+def _counted(monkeypatch: pytest.MonkeyPatch) -> Counter[int]:
+    """Counts of ``settle_one``'s statuses from now on."""
+    seen: Counter[int] = Counter()
+    real = fastsolve.settle_one
+
+    def counting(*args: Any) -> Any:
+        out = real(*args)
+        seen[-1 if out is None else out.status] += 1
+        return out
+
+    monkeypatch.setattr(fastsolve, "settle_one", counting)
+    return seen
+
+
+@pytest.mark.parametrize(
+    ("name", "reduction"),
+    [("carm", None), ("carm", "auto"), ("fanuc_crx10ia", None), ("kinova_jaco2", None), ("xarm6", None)],
+)
+@pytest.mark.parametrize("limits", [True, False])
+def test_one_call_is_the_general_path(
+    name: str, reduction: str | None, limits: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every pose's solutions are the general path's bit for bit: those settled in one call (most of them) and
+    those it hands over (families, a polish due, a continuum along another joint). theta* revolute and prismatic,
+    a hints kernel (carm-d1) and generic sweeps."""
+    robot = load_robot(name)
+    poses = _poses(robot, 5)
+    seen = _counted(monkeypatch)
+    fast = [sweepik.solve(robot, T, reduction=reduction, limits=limits) for T in poses]
+    assert seen[fastsolve.OK] >= len(poses) // 2  # (the one-call path is what is tested)
+    for a, b in zip(fast, _general(monkeypatch, robot, poses, reduction=reduction, limits=limits), strict=True):
+        _assert_same(a, b)
+
+
+def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
+    """With the candidate buffer cut to one, every pose overflows it: each goes the general way (whose engine redoes
+    it), with the same solutions."""
+    robot = load_robot("fanuc_crx10ia")
+    poses = _poses(robot, 6)[::6]
+    monkeypatch.setattr(fastsweep, "MAX_CAND", 1)
+    seen = _counted(monkeypatch)
+    fast = [sweepik.solve(robot, T) for T in poses]
+    assert seen == {fastsolve.SEARCH_ELSEWHERE: len(poses)}
+    for a, b in zip(fast, _general(monkeypatch, robot, poses), strict=True):
+        _assert_same(a, b)
+        assert len(a) > 0
+
+
+def test_a_pose_due_a_polish_goes_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A candidate that needs the Newton polish (here: every certified one, with the polish threshold above them)
+    sends its pose the general way, which polishes it."""
+    robot = load_robot("carm")
+    poses = _poses(robot, 7)[20:26]
+    monkeypatch.setattr(solver, "POLISH_ABOVE_REL", 0.0)
+    monkeypatch.setattr(solver, "POLISH_PAPER_ABOVE_REL", 0.0)
+    seen = _counted(monkeypatch)
+    fast = [sweepik.solve(robot, T) for T in poses]
+    assert seen == {fastsolve.DUE: len(poses)}
+    for a, b in zip(fast, _general(monkeypatch, robot, poses), strict=True):
+        _assert_same(a, b)
+        assert len(a) > 0
