@@ -17,9 +17,9 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from . import fastsweep
 from .dedupe import _tolerance, limit_args
 from .fastcertify import chain_args
-from . import fastsweep
 from .fastsweep import AVAILABLE, _plan, writable
 from .reductions.kernels import CONFIGURATION_SIG, address_of, lazy_njit
 from .sweep import _unit_grid
