@@ -87,31 +87,35 @@ if AVAILABLE:
         """``settle_one``'s kernel: pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``),
         certified and settled; ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped
         to them (``solver._limit_copies``: the general path's)."""
+        # (np.empty and explicit loops: np.zeros, slice copies and the like each add to the first compilation)
         n = rev.shape[0]
         out_t = np.empty((1, max_cand))
         out_b = np.empty((1, max_cand), dtype=np.int64)
         out_m = np.empty((1, max_cand), dtype=np.int64)
-        cnt = np.zeros(1, dtype=np.int64)
+        ints = np.empty(6, dtype=np.int64)  # cnt, fcnt, parts (2), counts, pose (when K > 0: all 0)
+        flags = np.empty(2, dtype=np.bool_)  # redo, due
+        ints[0], ints[1], ints[2], ints[4] = 0, 0, 0, 0
+        flags[0], flags[1] = False, False
         fam = np.empty((1, max_fam, 3))
-        fcnt = np.zeros(1, dtype=np.int64)
-        redo = np.zeros(1, dtype=np.bool_)
         _as_one_pass(addr[_A_SEARCH])(
             plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, out_t, out_b, out_m,
-            cnt, fam, fcnt, redo, 0, 1,
+            ints[0:1], fam, ints[1:2], flags[0:1], 0, 1,
         )  # fmt: skip
-        K = cnt[0]
+        K = ints[0]
         status = OK
-        if redo[0] or K > max_cand or fcnt[0] != 0:
+        if flags[0] or K > max_cand or ints[1] != 0:
             status, K = SEARCH_ELSEWHERE, 0
         for k in range(K):
             t = out_t[0, k]
             if out_m[0, k] >= 2 and ((limits[0] - clip <= t < limits[0]) or (limits[1] < t <= limits[1] + clip)):
                 status, K = SEARCH_ELSEWHERE, 0
                 break
-        theta = out_t[0, :K].copy()
-        branch = out_b[0, :K].copy()
-        mult = out_m[0, :K].copy()
-        pose = np.zeros(K, dtype=np.int64)
+        theta = np.empty(K)
+        branch = np.empty(K, dtype=np.int64)
+        mult = np.empty(K, dtype=np.int64)
+        pose = np.empty(K, dtype=np.int64)
+        for k in range(K):
+            theta[k], branch[k], mult[k], pose[k] = out_t[0, k], out_b[0, k], out_m[0, k], 0
         q = np.empty((K, n))
         eg = np.empty(K)
         ep = np.empty(K)
@@ -123,18 +127,15 @@ if AVAILABLE:
         score = np.empty(K)
         inside = np.empty(K, dtype=np.bool_)
         keep = np.empty(K, dtype=np.bool_)
-        due = np.zeros(1, dtype=np.bool_)
-        parts = np.zeros(2, dtype=np.int64)
-        parts[1] = K
-        counts = np.zeros(1, dtype=np.int64)
+        ints[3] = K
         _as_settle(addr[_A_SETTLE])(
-            q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, due, rows, w, score, inside,
-            keep, parts, counts, 0, 1,
+            q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, flags[1:2], rows, w, score,
+            inside, keep, ints[2:4], ints[4:5], 0, 1,
         )  # fmt: skip
-        c = counts[0]
-        if due[0] and status == OK:
+        c = ints[4]
+        if flags[1] and status == OK:
             status, c = DUE, 0
-        return status, theta, branch, mult, q, eg, ep, rows[:c], w[:c], inside[:c], keep[:c]
+        return status, c, theta, branch, mult, q, eg, ep, rows, w, inside, keep
 
 
 class _Fixed(NamedTuple):
@@ -210,7 +211,7 @@ def settle_one(
     clip = float(clip_rel * (hi[0] - lo[0]))
     p = np.ascontiguousarray(params, dtype=np.float64)
     buffers = (fastsweep.MAX_CAND, fastsweep.MAX_FAM)  # (read here: a test may cut them)
-    out = _settle_one(
+    status, c, theta, branch, mult, q, eg, ep, rows, w, inside, keep = _settle_one(
         *fixed.head, p, hlo, hhi, lo, hi, *fixed.middle, *buffers, fixed.limits, clip, writable(world), *fixed.tail
     )
-    return Settled(*out)
+    return Settled(status, theta, branch, mult, q, eg, ep, rows[:c], w[:c], inside[:c], keep[:c])
