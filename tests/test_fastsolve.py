@@ -1,5 +1,6 @@
-"""The one-call path of a single pose (``fastsolve.settle_one``, ``solver._settled_single``) gives what the general
-path gives, bit for bit, and hands the poses it cannot settle to it."""
+"""The one-call path of a single pose (``fastsolve.settle_one``, ``fastsolve.settle_closed``,
+``solver._settled_single``) gives what the general path gives, bit for bit, and hands the poses it cannot settle
+to it."""
 
 from __future__ import annotations
 
@@ -49,28 +50,38 @@ def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, poses: np.nd
 def _counted(monkeypatch: pytest.MonkeyPatch) -> Counter[int]:
     """Counts of ``settle_one``'s statuses from now on."""
     seen: Counter[int] = Counter()
-    real = fastsolve.settle_one
+    for name in ("settle_one", "settle_closed"):
+        real = getattr(fastsolve, name)
 
-    def counting(*args: Any) -> Any:
-        out = real(*args)
-        seen[-1 if out is None else out.status] += 1
-        return out
+        def counting(*args: Any, real: Any = real) -> Any:
+            out = real(*args)
+            seen[-1 if out is None else out.status] += 1
+            return out
 
-    monkeypatch.setattr(fastsolve, "settle_one", counting)
+        monkeypatch.setattr(fastsolve, name, counting)
     return seen
 
 
 @pytest.mark.parametrize(
     ("name", "reduction"),
-    [("carm", None), ("carm", "auto"), ("fanuc_crx10ia", None), ("kinova_jaco2", None), ("xarm6", None)],
+    [
+        ("carm", None),
+        ("carm", "auto"),
+        ("fanuc_crx10ia", None),
+        ("kinova_jaco2", None),
+        ("xarm6", None),
+        ("ur5", None),
+        ("puma560", None),
+        ("carm_swapped", None),
+    ],
 )
 @pytest.mark.parametrize("limits", [True, False])
 def test_one_call_is_the_general_path(
     name: str, reduction: str | None, limits: bool, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Every pose's solutions are the general path's bit for bit: those settled in one call (most of them) and
-    those it hands over (families, a polish due, a continuum along another joint). theta* revolute and prismatic,
-    a hints kernel (carm-d1) and generic sweeps."""
+    those it hands over (families, a polish due, a continuum along another joint, a closed form's singular poses).
+    theta* revolute and prismatic, a hints kernel (carm-d1), generic sweeps, closed forms."""
     robot = load_robot(name)
     poses = _poses(robot, 5)
     seen = _counted(monkeypatch)

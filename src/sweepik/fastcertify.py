@@ -244,13 +244,14 @@ if AVAILABLE:
                 return False
         return True
 
-    @lazy_njit(
+    #: ``_certify_every_branch``'s arguments (``fastsolve`` calls it by its address too).
+    _CERTIFY_EVERY_SIG = (
         (_CFGS, float64[:, ::1], float64[:, :, ::1], int64)
         + (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64)
-        + (float64[:, ::1], float64[::1], float64[::1], int64, int64),
-        cache=True,
-        nogil=True,
+        + (float64[:, ::1], float64[::1], float64[::1], int64, int64)
     )
+
+    @lazy_njit(_CERTIFY_EVERY_SIG, cache=True, nogil=True)
     def _certify_every_branch(cfgs, params, world, nb, H, P, rev, R_end, weight, q, err_geo, err_paper, start, stop):
         """Poses ``start .. stop - 1``: every branch's configuration at once (rows ``i nb .. i nb + nb - 1`` of
         ``q`` for pose i) and their errors."""

@@ -21,11 +21,11 @@ from . import fastsweep
 from .dedupe import _tolerance, limit_args
 from .fastcertify import chain_args
 from .fastsweep import AVAILABLE, _plan, writable
-from .reductions.kernels import CONFIGURATION_SIG, address_of, lazy_njit
+from .reductions.kernels import CONFIGURATION_SIG, CONFIGURATIONS_SIG, address_of, lazy_njit, owned_kernel
 from .sweep import _unit_grid
 from .units import orientation_weight
 
-__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "Settled", "settle_one"]
+__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "Settled", "settle_one", "settle_closed"]
 
 Array = NDArray[np.float64]
 
@@ -59,17 +59,39 @@ if AVAILABLE:
     from numba import boolean, float64, int64
     from numba import void as _void
 
-    from ._jit import function_at
+    from ._jit import function_at, internal
     from .dedupe import _SETTLE_SIG, _settle
-    from .fastcertify import _CERTIFY_SIG, _certify
+    from .fastcertify import _CERTIFY_EVERY_SIG, _CERTIFY_SIG, _certify, _certify_every_branch
     from .fastsweep import _ONE_PASS_SIG
 
     _ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG = _void(*_ONE_PASS_SIG), _void(*_CERTIFY_SIG), _void(*_SETTLE_SIG)
-    _as_one_pass, _as_certify, _as_settle = (
-        function_at(s) for s in (_ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG)
+    _EVERY_FN_SIG = _void(*_CERTIFY_EVERY_SIG)
+    _as_one_pass, _as_certify, _as_settle, _as_every = (
+        function_at(s) for s in (_ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG, _EVERY_FN_SIG)
     )
     #: The kernels' addresses in ``addr``.
     _A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG = range(4)
+
+    @internal
+    def _settled(settle, q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale):
+        """One pose's certified candidates settled (``dedupe._settle`` at the address ``settle``): whether one is
+        due the solver's rarer steps, and the count, rows, wrapped configurations, limit check and duplicate mask
+        of the certified ones (buffers as long as the candidates)."""
+        K, n = q.shape
+        rows = np.empty(K, dtype=np.int64)
+        w = np.empty((K, n))
+        score = np.empty(K)
+        inside = np.empty(K, dtype=np.bool_)
+        keep = np.empty(K, dtype=np.bool_)
+        ints = np.empty(3, dtype=np.int64)  # parts (2), counts
+        ints[0], ints[1], ints[2] = 0, K, 0
+        due = np.empty(1, dtype=np.bool_)
+        due[0] = False
+        _as_settle(settle)(
+            q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, due, rows, w, score, inside,
+            keep, ints[0:2], ints[2:3], 0, 1,
+        )  # fmt: skip
+        return due[0], ints[2], rows, w, inside, keep
 
     @lazy_njit(
         (int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], float64[::1], float64[:, ::1], float64[::1])
@@ -92,18 +114,17 @@ if AVAILABLE:
         out_t = np.empty((1, max_cand))
         out_b = np.empty((1, max_cand), dtype=np.int64)
         out_m = np.empty((1, max_cand), dtype=np.int64)
-        ints = np.empty(6, dtype=np.int64)  # cnt, fcnt, parts (2), counts, pose (when K > 0: all 0)
-        flags = np.empty(2, dtype=np.bool_)  # redo, due
-        ints[0], ints[1], ints[2], ints[4] = 0, 0, 0, 0
-        flags[0], flags[1] = False, False
+        ints = np.empty(2, dtype=np.int64)  # cnt, fcnt
+        redo = np.empty(1, dtype=np.bool_)
+        ints[0], ints[1], redo[0] = 0, 0, False
         fam = np.empty((1, max_fam, 3))
         _as_one_pass(addr[_A_SEARCH])(
             plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, out_t, out_b, out_m,
-            ints[0:1], fam, ints[1:2], flags[0:1], 0, 1,
+            ints[0:1], fam, ints[1:2], redo, 0, 1,
         )  # fmt: skip
         K = ints[0]
         status = OK
-        if flags[0] or K > max_cand or ints[1] != 0:
+        if redo[0] or K > max_cand or ints[1] != 0:
             status, K = SEARCH_ELSEWHERE, 0
         for k in range(K):
             t = out_t[0, k]
@@ -122,20 +143,36 @@ if AVAILABLE:
         _as_certify(addr[_A_CERTIFY])(
             addr[_A_CFG], params, world, pose, theta, branch, True, H, P, rev, R_end, weight, q, eg, ep, 0, K
         )
-        rows = np.empty(K, dtype=np.int64)
-        w = np.empty((K, n))
-        score = np.empty(K)
-        inside = np.empty(K, dtype=np.bool_)
-        keep = np.empty(K, dtype=np.bool_)
-        ints[3] = K
-        _as_settle(addr[_A_SETTLE])(
-            q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, flags[1:2], rows, w, score,
-            inside, keep, ints[2:4], ints[4:5], 0, 1,
-        )  # fmt: skip
-        c = ints[4]
-        if flags[1] and status == OK:
+        due, c, rows, w, inside, keep = _settled(
+            addr[_A_SETTLE], q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
+        )
+        if due and status == OK:
             status, c = DUE, 0
         return status, c, theta, branch, mult, q, eg, ep, rows, w, inside, keep
+
+    @lazy_njit(
+        (int64[::1], float64[:, ::1], float64[:, :, ::1], int64, float64[:, ::1], float64[:, ::1], boolean[::1])
+        + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
+        + (float64[::1], float64[::1], float64),
+        cache=True,
+        nogil=True,
+    )
+    def _settle_closed(
+        addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
+    ):  # pragma: no cover
+        """``settle_closed``'s kernel: every branch of pose 0 of ``params``/``world`` (the all-branch configuration
+        kernel at ``addr[_A_CFG]``) certified and settled."""
+        q = np.empty((nb, rev.shape[0]))
+        eg = np.empty(nb)
+        ep = np.empty(nb)
+        _as_every(addr[_A_CERTIFY])(addr[_A_CFG], params, world, nb, H, P, rev, R_end, weight, q, eg, ep, 0, 1)
+        pose = np.empty(nb, dtype=np.int64)
+        for k in range(nb):
+            pose[k] = 0
+        due, c, rows, w, inside, keep = _settled(
+            addr[_A_SETTLE], q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
+        )
+        return (DUE if due else OK), (0 if due else c), q, eg, ep, rows, w, inside, keep
 
 
 class _Fixed(NamedTuple):
@@ -144,27 +181,44 @@ class _Fixed(NamedTuple):
     head: tuple[Any, ...]  # the arguments before the pose's own (addresses, plan, ...)
     middle: tuple[Any, ...]  # between them (the unit grid, theta*'s ends, the twins)
     limits: Array  # theta*'s limits
-    tail: tuple[Any, ...]  # after the target (the chain's geometry, the settling's thresholds, limits, tolerances)
+    tail: tuple[Any, ...]  # after the target: ``_tail``
     hint_range: Any  # ``EdgeSearch.hint_range`` (the margins' range of a pose), or None: the search's own
 
 
-_FIXED: weakref.WeakKeyDictionary[object, dict[tuple[Any, ...], _Fixed | None]] = weakref.WeakKeyDictionary()
+_FIXED: weakref.WeakKeyDictionary[object, dict[tuple[Any, ...], Any]] = weakref.WeakKeyDictionary()
+
+
+def _kept(red: Any, key: tuple[Any, ...], make: Any) -> Any:
+    """``make()``, worked out once per reduction and ``key`` (a reduction's kernels, plan and robot are fixed once
+    it is used; an unhashable reduction: every time)."""
+    try:
+        per_red = _FIXED.setdefault(red, {})
+    except TypeError:
+        return make()
+    if key not in per_red:
+        per_red[key] = make()
+    return per_red[key]
+
+
+def _tail(robot: Any, thresholds: tuple[float, ...], reach: Array) -> tuple[Any, ...]:
+    """The kernels' last arguments: the chain's geometry and orientation weight (the certification's), the
+    thresholds, limits, snap reach, duplicate tolerances and length scale (the settling's)."""
+    rev, lower, upper, ltol, beyond = limit_args(robot)
+    H, P, crev, R_end = chain_args(robot)
+    weight = float(orientation_weight(robot.length_unit))
+    thr = np.array(thresholds, dtype=np.float64)
+    settling = (thr, rev, lower, upper, ltol, beyond, writable(reach), _tolerance(robot), float(robot.length_scale))
+    return (H, P, crev, R_end, weight, *settling)
 
 
 def _fixed(robot: Any, red: Any, n_samples: int, thresholds: tuple[float, ...], reach: Array) -> _Fixed | None:
-    """The fixed arguments of ``_settle_one`` for ``red`` (None: it has no one-pass search for ``n_samples``),
-    worked out once per reduction and settings (a reduction's kernels, plan and robot are fixed once it is used)."""
-    key = (n_samples, thresholds)
-    try:
-        per_red = _FIXED.setdefault(red, {})
-    except TypeError:  # (an unhashable reduction: worked out every time)
-        per_red = {}
-    if key in per_red:
-        return per_red[key]
-    plan = _plan(red)
-    one = plan.one_pass
-    fixed = None
-    if one is not None and (one.n_samples is None or one.n_samples == n_samples):
+    """The fixed arguments of ``_settle_one`` for ``red`` (None: it has no one-pass search for ``n_samples``)."""
+
+    def make() -> _Fixed | None:
+        plan = _plan(red)
+        one = plan.one_pass
+        if one is None or not (one.n_samples is None or one.n_samples == n_samples):
+            return None
         addr = np.zeros(4, dtype=np.int64)
         addr[_A_SEARCH] = address_of(one.kernel, _ONE_PASS_FN_SIG)
         addr[_A_CERTIFY] = address_of(_certify, _CERTIFY_FN_SIG)
@@ -174,14 +228,9 @@ def _fixed(robot: Any, red: Any, n_samples: int, thresholds: tuple[float, ...], 
         head = (addr, one.ints[1], plan.branches, one.margin_branches, one.steps, one.noise)
         limits = np.array([robot.lower[j], robot.upper[j]], dtype=np.float64)
         middle = (_unit_grid(n_samples), plan.ends, one.twins)
-        rev, lower, upper, ltol, beyond = limit_args(robot)
-        H, P, crev, R_end = chain_args(robot)
-        weight = float(orientation_weight(robot.length_unit))
-        thr = np.array(thresholds, dtype=np.float64)
-        tail = (H, P, crev, R_end, weight, thr, rev, lower, upper, ltol, beyond, writable(reach), _tolerance(robot))
-        fixed = _Fixed(head, middle, limits, tail + (float(robot.length_scale),), one.hint_range)
-    per_red[key] = fixed
-    return fixed
+        return _Fixed(head, middle, limits, _tail(robot, thresholds, reach), one.hint_range)
+
+    return _kept(red, ("sweep", n_samples, thresholds), make)
 
 
 def settle_one(
@@ -214,4 +263,33 @@ def settle_one(
     status, c, theta, branch, mult, q, eg, ep, rows, w, inside, keep = _settle_one(
         *fixed.head, p, hlo, hhi, lo, hi, *fixed.middle, *buffers, fixed.limits, clip, writable(world), *fixed.tail
     )
+    return Settled(status, theta, branch, mult, q, eg, ep, rows[:c], w[:c], inside[:c], keep[:c])
+
+
+def settle_closed(
+    robot: Any, red: Any, world: Array, params: Array, thresholds: tuple[float, float, float, float], reach: Array
+) -> Settled | None:
+    """A closed form's one pose ``world (1, 4, 4)``: every branch (in order: ``Settled.branch``) certified and settled
+    in one compiled call, as ``settle_one``; None where ``red`` has no all-branch configuration kernel."""
+    if not AVAILABLE:
+        return None
+
+    def make() -> tuple[Any, ...] | None:
+        cfgs = owned_kernel(red, "kernel_configurations")
+        if cfgs is None:
+            return None
+        addr = np.zeros(4, dtype=np.int64)
+        addr[_A_CERTIFY] = address_of(_certify_every_branch, _EVERY_FN_SIG)
+        addr[_A_SETTLE] = address_of(_settle, _SETTLE_FN_SIG)
+        addr[_A_CFG] = address_of(cfgs, CONFIGURATIONS_SIG)
+        nb = int(red.n_branches)
+        branches = np.arange(nb, dtype=np.int64)
+        return addr, nb, np.zeros(nb), branches, np.ones(nb, dtype=np.int64), _tail(robot, thresholds, reach)
+
+    fixed = _kept(red, ("closed", thresholds), make)
+    if fixed is None:
+        return None
+    addr, nb, theta, branch, mult, tail = fixed
+    p = np.ascontiguousarray(params, dtype=np.float64)
+    status, c, q, eg, ep, rows, w, inside, keep = _settle_closed(addr, p, writable(world), nb, *tail)
     return Settled(status, theta, branch, mult, q, eg, ep, rows[:c], w[:c], inside[:c], keep[:c])

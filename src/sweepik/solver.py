@@ -199,7 +199,7 @@ def _solve_chunk(
     n_samples: int,
     use_fallback: bool = True,
 ) -> Block:
-    if len(poses) == 1 and strategy == "precise" and use_fallback and red.uses_kernel and not red.closed_form:
+    if len(poses) == 1 and strategy == "precise" and use_fallback and red.uses_kernel:
         block = _settled_single(robot, red, poses, limits, n_samples)
         if block is not None:
             return block
@@ -369,12 +369,18 @@ def _solve_chunk(
 
 def _settled_single(robot: Robot, red: Reduction, poses: Array, limits: bool, n_samples: int) -> Block | None:
     """``_solve_chunk`` of one pose in one compiled call (``fastsolve``), the same values; None where the pose needs
-    one of its rarer steps (a polish, families, special solutions, a continuum along another joint, the fallback)."""
+    one of its rarer steps (a polish, families, special solutions, a continuum along another joint, the fallback,
+    branches of a closed form that meet)."""
     chain = _chain_poses(robot, poses)
-    lo, hi = _theta_range(robot, red, chain)
     params = red.kernel_params(chain)
     bounds, reach = _settle_bounds(robot), _snap_reach(robot)
-    out = fastsolve.settle_one(robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL)
+    if red.closed_form:
+        out = fastsolve.settle_closed(robot, red, poses, params, bounds, reach)
+        if out is not None and not out.keep.all():  # (merged into one solution of higher multiplicity)
+            return None
+    else:
+        lo, hi = _theta_range(robot, red, chain)
+        out = fastsolve.settle_one(robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL)
     if out is None or out.status != fastsolve.OK or out.rows.size > MAX_ISOLATED_SOLUTIONS:
         return None
     special = red.special_solutions(chain)
