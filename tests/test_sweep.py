@@ -627,3 +627,34 @@ def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeyp
     assert (counts > cut).any() and (counts <= cut).any()
     monkeypatch.setattr(fastsweep, "MAX_CAND", cut)
     _same_search(fastsweep.search(red, chain, lo, hi, n), fastsweep.search(red, chain, lo, hi, n, one_pass=False))
+
+
+def test_residual_rows_is_the_residual_of_those_rows() -> None:
+    """``Reduction.residual_rows`` (the NumPy engine's residual of poses picked by index, from parameters kept for
+    the poses) gives what ``residual`` gives on the picked poses, value for value: a generic sweep, its margins,
+    and a subclass with a residual of its own (which must be the one called)."""
+    from sweepik.reductions.generic import GeometricReduction, _Margins
+
+    robot = load_robot("fanuc_crx10ia")
+    red = sweepik.get_reduction(robot, None)
+    assert isinstance(red, GeometricReduction)
+    rng = np.random.default_rng(3)
+    poses = robot.fk(rng.uniform(robot.lower, robot.upper, (12, 6)))
+    rows = rng.integers(0, 12, 30)
+    theta = rng.uniform(-np.pi, np.pi, (30, 5))
+    branch = rng.integers(0, red.n_branches, 30)[:, None]
+    margins = _Margins(red, np.zeros((12, 0)), poses)
+    for r, b in ((red, branch), (margins, branch % 3)):
+        want = r.residual(poses[rows], theta, np.broadcast_to(b, theta.shape))
+        got = r.residual_rows(poses, rows, theta, np.broadcast_to(b, theta.shape))
+        assert got is not None and want is not None and np.isfinite(want).any()
+        np.testing.assert_array_equal(got, want)
+
+    class Shifted(GeometricReduction):
+        def residual(self, poses: Any, theta: Any, branch: Any = None) -> Any:
+            out = super().residual(poses, theta, branch)
+            return None if out is None else out + 1.0
+
+    shifted = Shifted(robot, red.plan)
+    got = shifted.residual_rows(poses, rows, theta, np.broadcast_to(branch, theta.shape))
+    np.testing.assert_array_equal(got, red.residual(poses[rows], theta, np.broadcast_to(branch, theta.shape)) + 1.0)

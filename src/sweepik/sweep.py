@@ -240,7 +240,7 @@ class _Search:
 
     def residual(self, pose: IntArray, branch: IntArray, theta: Array) -> Array:
         """Residual ``(K, M)`` of one branch per row."""
-        r = self.red.residual(self.poses[pose], theta, np.broadcast_to(branch[:, None], theta.shape))
+        r = self.red.residual_rows(self.poses, pose, theta, np.broadcast_to(branch[:, None], theta.shape))
         assert r is not None
         return r
 

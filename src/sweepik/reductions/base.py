@@ -140,6 +140,12 @@ class Reduction(ABC):
         """
         return None
 
+    def residual_rows(self, poses: Array, rows: IntArray, theta: Array, branch: IntArray) -> Array | None:
+        """``residual(poses[rows], theta, branch)`` ``(K, M)``: the residual of chain poses picked by index, one branch
+        per sample. The NumPy engine asks for a few rows of the same poses over and over (refinements, probes); a
+        reduction that derives per-pose parameters from them can keep those rather than derive them each time."""
+        return self.residual(poses[rows], theta, branch)
+
     def sample_hints(self, poses: Array) -> Array | None:
         """Extra theta* samples ``(N, K)`` (NaN-padded): branch-domain edges, branch swaps, places where the
         residual bends sharply. Roots next to a domain edge are only bracketed if the edge is a sample.

@@ -484,8 +484,24 @@ class GeometricReduction(Reduction):
         geometric.evaluate(fn, params, pose, th, br, out)
         return out.reshape(theta.shape if branch is not None else (*theta.shape, n_branches))
 
+    def _evaluate_rows(self, fn: Any, poses: Array, rows: IntArray, theta: Array, branch: IntArray) -> Array:
+        """``_evaluate`` of ``poses[rows]`` with one branch per sample, from the rows of ``kernel_params(poses)`` (kept
+        for the last ``poses``: the NumPy engine asks for rows of the same poses over and over)."""
+        params = self.kernel_params(poses)
+        pose = np.repeat(np.asarray(rows, dtype=np.int64), theta.shape[1])
+        th = np.asarray(theta).astype(np.float64).reshape(-1)  # (copies: the kernel takes writable arrays)
+        br = np.broadcast_to(branch, theta.shape).astype(np.int64).reshape(-1)
+        out = np.empty(th.shape[0])
+        geometric.evaluate(fn, params, pose, th, br, out)
+        return out.reshape(theta.shape)
+
     def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
         return self._evaluate(self._kernels[0], poses, theta, branch, self.n_branches)
+
+    def residual_rows(self, poses: Array, rows: IntArray, theta: Array, branch: IntArray) -> Array | None:
+        if type(self).residual is not GeometricReduction.residual:  # (a subclass's own residual)
+            return super().residual_rows(poses, rows, theta, branch)
+        return self._evaluate_rows(self._kernels[0], poses, rows, theta, branch)
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         params, pose, th, br = self._flat(poses, theta, branch)
@@ -555,6 +571,9 @@ class _Margins(Reduction):
 
     def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
         return self.red._evaluate(self.red._case_kernels.pair_margin, poses, theta, branch, self.n_branches)
+
+    def residual_rows(self, poses: Array, rows: IntArray, theta: Array, branch: IntArray) -> Array | None:
+        return self.red._evaluate_rows(self.red._case_kernels.pair_margin, poses, rows, theta, branch)
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         raise NotImplementedError("margins have no configurations")
