@@ -219,3 +219,49 @@ def test_closed_form_reports_a_double_root_as_the_sweeps_do(name: str, seed: int
         k = _index_of(closed, qs)
         assert k is not None and closed.multiplicity[k] == m
     assert closed.multiplicity[_index_of(closed, q)] == 2
+
+
+@pytest.mark.parametrize("family", ["three_parallel", "three_parallel_offset", "slide_parallel"])
+def test_closed_form_elbow_double_root_is_one_solution_at_the_root(family: str) -> None:
+    """An elbow stretched straight (joint 3 at 0) on closed-form arms of random dimensions: the elbow's two branches
+    meet there, a double root. The closed form's cosine lands at 1 only up to rounding magnified by the arm's
+    lengths (up to ~1e-12: two certified roots ~1e-6 rad either side); they are reported as one solution of
+    multiplicity 2 at the root: IK(FK(q)) holds q to 1e-6."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_any_arm import FAMILIES, _arm
+
+    for seed in range(10):
+        rng = np.random.default_rng(seed + 100)
+        robot = _arm(FAMILIES[family](rng), rng, "standard")
+        q = rng.uniform(robot.lower, robot.upper, (8, 6))
+        q[:, 2] = 0.0
+        for qq, sols in zip(q, [solve(robot, T) for T in robot.fk(q)], strict=True):
+            d = joint_distance(robot, sols.q, qq) / np.where(robot.is_revolute, 1.0, robot.length_scale)
+            k = int(np.argmin(d.max(axis=-1)))
+            assert d[k].max() < 1e-6, (family, seed, qq.tolist(), d[k].max())
+            assert sols.multiplicity[k] >= 2
+
+
+def test_near_pairs_compiled_is_the_reference(rng: np.random.Generator) -> None:
+    """``dedupe.near_pairs`` (compiled) finds the pairs its NumPy reference finds: rows of one pose within a reach
+    per joint, revolute ones modulo 2 pi (pairs straddling +-pi included), dropped rows left out."""
+    from sweepik import dedupe
+
+    robot = load_robot("stanford")  # (a slide among the joints)
+    K = 400
+    pose = rng.integers(0, 60, K)
+    w = rng.uniform(-np.pi, np.pi, (K, 6))
+    near = rng.choice(K, 80, replace=False)
+    for a in near:  # a partner close to row a, of the same pose, some across +-pi
+        w = np.vstack([w, w[a] + rng.normal(scale=3e-5, size=6)])
+        pose = np.append(pose, pose[a])
+    w[K::3, 0] = np.where(w[K::3, 0] > 0, w[K::3, 0] - 2 * np.pi, w[K::3, 0] + 2 * np.pi)
+    keep = rng.random(w.shape[0]) > 0.1
+    reach = np.full(6, 1e-4)
+    got = dedupe.near_pairs(robot, pose, w, keep, reach)
+    want = dedupe._near_pairs(robot, pose, w, keep, reach)
+    assert want.shape[0] > 40
+    np.testing.assert_array_equal(got, want)

@@ -29,7 +29,16 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 
-__all__ = ["finish", "settle", "wrap_inside", "limit_args", "merged_multiplicity", "DEDUPE_ANGLE", "DEDUPE_LENGTH_REL"]
+__all__ = [
+    "finish",
+    "settle",
+    "wrap_inside",
+    "limit_args",
+    "merged_multiplicity",
+    "near_pairs",
+    "DEDUPE_ANGLE",
+    "DEDUPE_LENGTH_REL",
+]
 
 #: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
 DEDUPE_ANGLE = 1e-6
@@ -175,6 +184,43 @@ def merged_multiplicity(
     return out
 
 
+def near_pairs(
+    robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_], reach: Array
+) -> NDArray[np.intp]:
+    """``(P, 2)`` pairs of kept candidates of one pose (``keep``) whose every joint is within ``reach (n,)`` of the
+    other's (revolute ones modulo 2 pi), in order of their first row: compiled, one pass over each pose's pairs."""
+    K = w.shape[0]
+    if not (AVAILABLE and K):
+        return _near_pairs(robot, pose_idx, w, keep, reach)
+    out = np.empty((max(K, 1) * 4, 2), dtype=np.int64)
+    count = np.zeros(1, dtype=np.int64)
+    w = np.ascontiguousarray(w, dtype=np.float64)
+    _near_compiled(pose_idx.astype(np.int64), w, keep, limit_args(robot)[0], reach, out, count)
+    if count[0] > out.shape[0]:  # (more than the buffer holds: a continuum's many candidates)
+        return _near_pairs(robot, pose_idx, w, keep, reach)
+    pairs = out[: count[0]].astype(np.intp)
+    return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))] if pairs.shape[0] > 1 else pairs
+
+
+def _near_pairs(
+    robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_], reach: Array
+) -> NDArray[np.intp]:
+    """``near_pairs`` in NumPy (the reference): the pairs of each pose, compared joint by joint."""
+    kept = np.nonzero(keep)[0]
+    order = kept[np.argsort(pose_idx[kept], kind="stable")]
+    p = pose_idx[order]
+    pairs = []
+    for d in range(1, order.size):  # (a pose's rows are adjacent in ``order``)
+        same = np.nonzero(p[d:] == p[:-d])[0]
+        if same.size == 0:
+            break
+        a, b = order[same], order[same + d]
+        close = np.all(joint_distance(robot, w[a], w[b]) <= reach, axis=-1)
+        pairs.append(np.sort(np.stack([a[close], b[close]], axis=1), axis=1))
+    out = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.intp)
+    return out[np.lexsort((out[:, 1], out[:, 0]))].astype(np.intp)
+
+
 def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:
     """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one, ties going to
     the earlier candidate (the reference of the compiled ``_dedupe_compiled``: every pair of a pose compared).
@@ -287,6 +333,43 @@ if AVAILABLE:
             order[start[g]] = k
             start[g] += 1
         return order
+
+    @lazy_njit(
+        (int64[::1], float64[:, ::1], boolean[::1], boolean[::1], float64[::1], int64[:, ::1], int64[::1]), cache=True
+    )
+    def _near_compiled(pose, w, keep, rev, reach, out, count):  # pragma: no cover
+        """``near_pairs``: the pairs into ``out`` (their number into ``count``, counted past the buffer too)."""
+        K, n = w.shape
+        two_pi = 2.0 * math.pi
+        order = _group_order(pose)
+        c = 0
+        start = 0
+        while start < K:
+            stop = start + 1
+            while stop < K and pose[order[stop]] == pose[order[start]]:
+                stop += 1
+            for x in range(start, stop):
+                a = order[x]
+                if not keep[a]:
+                    continue
+                for y in range(x + 1, stop):
+                    b = order[y]
+                    if not keep[b]:
+                        continue
+                    close = True
+                    for j in range(n):
+                        d = abs(w[a, j] - w[b, j])
+                        if rev[j]:
+                            d = min(d, abs(two_pi - d)) if d <= two_pi else abs(wrap_pi(w[a, j] - w[b, j]))
+                        if not d <= reach[j]:
+                            close = False
+                            break
+                    if close:
+                        if c < out.shape[0]:
+                            out[c, 0], out[c, 1] = min(a, b), max(a, b)
+                        c += 1
+            start = stop
+        count[0] = c
 
     @lazy_njit((int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True)
     def _dedupe_compiled(pose, q, score, rev, tol, keep):  # pragma: no cover

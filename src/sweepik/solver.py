@@ -19,7 +19,7 @@ from . import fastcertify, fastsolve, fastsweep, parallel
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch
 from .continuation import continuum_families
-from .dedupe import finish, merged_multiplicity, settle, wrap_inside
+from .dedupe import finish, merged_multiplicity, near_pairs, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from .families import MAX_ISOLATED_SOLUTIONS, collapse_continua, families_of, off_families, unique_families
 from .origin_axis import HeldJoints, hold_joints
@@ -307,6 +307,11 @@ def _solve_chunk(
     assert err_geo is not None and err_paper is not None  # (both paths set them)
     if closed and not keep.all():  # branches of the closed form that meet: one solution, a multiple root
         mult = merged_multiplicity(robot, pose_idx, q, keep, mult)
+    if closed:  # ... and those whose meeting the closed form's rounding split in two
+        pair = _meeting_pairs(robot, pose_idx, q, keep)
+        if pair.size:
+            q, mult = q.copy(), mult.copy()
+            _merge_meeting(robot, poses, pair, q, err_geo, err_paper, inside, keep, mult, pose_idx)
     if strategy == "precise" and pose_idx.size > MAX_ISOLATED_SOLUTIONS:  # (fewer: no pose can hold a continuum)
         # a numerical continuum of certified solutions is reported once
         keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
@@ -367,6 +372,58 @@ def _solve_chunk(
     )
 
 
+#: Two certified solutions of a closed form this close (every joint, radians; relative to the length scale for a
+#: slide) may be one double root that the closed form's rounding split in two: where two branches meet, a step's
+#: cosine sits at +-1 up to rounding magnified by the arm's geometry (1e-12 gives two roots 1.6e-6 rad apart, each
+#: certified, as the pose error grows only quadratically along them). Their midpoint is the root.
+MEET_REL = 1e-4
+
+
+def _meeting_pairs(robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_]) -> NDArray[np.intp]:
+    """``(P, 2)`` pairs of kept rows of one pose whose configurations ``w`` (wrapped) are within ``MEET_REL``."""
+    return near_pairs(robot, pose_idx, w, keep, _meet_reach(robot))
+
+
+@lru_cache(maxsize=64)
+def _meet_reach(robot: Robot) -> Array:
+    """``MEET_REL`` per joint (times the length scale for a slide)."""
+    return np.where(robot.is_revolute, MEET_REL, MEET_REL * robot.length_scale)
+
+
+def _merge_meeting(
+    robot: Robot,
+    poses: Array,
+    pair: NDArray[np.intp],
+    w: Array,
+    err_geo: Array,
+    err_paper: Array,
+    inside: NDArray[np.bool_],
+    keep: NDArray[np.bool_],
+    mult: NDArray[np.intp],
+    pose_idx: NDArray[np.intp],
+) -> None:
+    """In place: each pair of ``_meeting_pairs`` whose midpoint (polished) solves the pose better than either of them
+    becomes that midpoint (its errors, its limit check, the pair's multiplicities summed), the second row dropped.
+    Two distinct roots this close (a pose next to the singular set) keep apart: between them the pose error grows
+    quadratically, far above theirs."""
+    weight = orientation_weight(robot.length_unit)
+    for a, b in pair.tolist():
+        if not (keep[a] and keep[b]):
+            continue
+        d = w[b] - w[a]
+        d = np.where(robot.is_revolute, np.mod(d + np.pi, 2.0 * np.pi) - np.pi, d)
+        target = poses[pose_idx[a]][None]
+        # (polished: the pair's other joints carry rounding of their own, which moves the pose linearly)
+        mid, mid_inside = wrap_inside(robot, polish(robot, (w[a] + 0.5 * d)[None], target, weight, SNAP_ITERATIONS))
+        eg, ep = _errors(robot, mid, target, weight)
+        # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``)
+        best = max(min(err_geo[a], err_geo[b]), POLISH_ABOVE_REL * robot.length_scale)
+        if eg[0] <= best and (mid_inside[0] or not (inside[a] or inside[b])):
+            w[a], err_geo[a], err_paper[a], inside[a] = mid[0], eg[0], ep[0], mid_inside[0]
+            mult[a] += mult[b]
+            keep[b] = False
+
+
 def _settled_single(robot: Robot, red: Reduction, poses: Array, limits: bool, n_samples: int) -> Block | None:
     """``_solve_chunk`` of one pose in one compiled call (``fastsolve``), the same values; None where the pose needs
     one of its rarer steps (a polish, families, special solutions, a continuum along another joint, the fallback,
@@ -376,8 +433,11 @@ def _settled_single(robot: Robot, red: Reduction, poses: Array, limits: bool, n_
     bounds, reach = _settle_bounds(robot), _snap_reach(robot)
     if red.closed_form:
         out = fastsolve.settle_closed(robot, red, poses, params, bounds, reach)
-        if out is not None and not out.keep.all():  # (merged into one solution of higher multiplicity)
-            return None
+        # (branches that meet: merged into one solution of higher multiplicity, the general way)
+        if out is not None:
+            pose = np.zeros(out.rows.size, dtype=np.intp)
+            if not out.keep.all() or _meeting_pairs(robot, pose, out.w, out.keep).size:
+                return None
     else:
         lo, hi = _theta_range(robot, red, chain)
         out = fastsolve.settle_one(robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL)
