@@ -18,6 +18,7 @@ from sweepik.reductions import get_reduction
 from sweepik.robot_file import robot_from_dict
 from sweepik.solutions import joint_distance
 from sweepik.solver import ACCEPT_TOL_REL, _chain_poses
+from sweepik.units import orientation_weight
 
 CARM = load_robot("carm")
 #: "the same configuration": every joint within this (mm, radians modulo 2 pi)
@@ -46,7 +47,7 @@ def member_of(robot, sol, q: np.ndarray) -> bool:
 def assert_members_certified(robot, sol, T: np.ndarray, count: int = 25, limits: bool = True) -> None:
     for f in sol.families:
         m = f.sample(count)
-        err = pose_error_geodesic(robot.fk(m), np.broadcast_to(T, (count, 4, 4)))
+        err = pose_error_geodesic(robot.fk(m), np.broadcast_to(T, (count, 4, 4)), orientation_weight(robot.length_unit))
         # (the solver's acceptance, with room for this test's own forward kinematics: a different rounding)
         assert err.max() <= 4.0 * ACCEPT_TOL_REL * robot.length_scale
         assert np.all(robot.within_limits(m)) or not limits
@@ -193,3 +194,45 @@ def test_wrist_continuum_the_fallback_sweep_cuts(limits: bool) -> None:
     for i in range(2):
         assert member_of(robot, sols[i], q[i])
         assert_members_certified(robot, sols[i], robot.fk(q[i]), limits=limits)
+
+
+def _stanford_like(rng: np.random.Generator, slide: tuple[float, float] = (-0.5, 1.5)) -> object:
+    """RRP + spherical wrist (the Stanford arm's structure) of random lengths, its slide's travel through 0: there
+    the wrist centre sits on joint 2's axis."""
+    L = [float(x) for x in rng.uniform(0.1, 0.8, 3)]
+    rows = [
+        ("revolute", 0.0, -90.0, L[0], 0.0),
+        ("revolute", 0.0, 90.0, L[1], 0.0),
+        ("prismatic", 0.0, 0.0, 0.0, 0.0),
+        ("revolute", 0.0, -90.0, 0.0, 0.0),
+        ("revolute", 0.0, 90.0, 0.0, 0.0),
+        ("revolute", 0.0, 0.0, L[2], 0.0),
+    ]
+    joints = [
+        {"name": f"j{i + 1}", "type": t, "limits": list(slide) if t == "prismatic" else [-180.0, 180.0]}
+        | {"a": a, "alpha": al, "d": d, "theta": th}
+        for i, (t, a, al, d, th) in enumerate(rows)
+    ]
+    return robot_from_dict({"name": "rrp", "dh_convention": "standard", "length_unit": "m", "joints": joints})
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_final_step_continuum_of_a_stanford_like_arm(seed: int) -> None:
+    """The slide at 0 puts the wrist centre on joint 2's axis, which the closed form turns last (sp1): joint 2 is free
+    as far as the wrist centre goes, and the spherical wrist follows it, a continuum along joint 2. It is reported as
+    families along joint 2 holding the generating configuration, every member certified (before: two or four
+    isolated members of it). A pose off that set has no family."""
+    rng = np.random.default_rng(seed)
+    robot = _stanford_like(rng)
+    q = rng.uniform(robot.lower, robot.upper, (4, 6))
+    q[:, 2] = 0.0
+    q[:, 4] = np.where(np.abs(q[:, 4]) < 0.2, 0.5, q[:, 4])  # (off the wrist's own singularity)
+    for qq in q:
+        T = robot.fk(qq)
+        sol = solve(robot, T)
+        assert sol.families and all(f.free_joint == 1 for f in sol.families)
+        assert member_of(robot, sol, qq)
+        assert_members_certified(robot, sol, T)
+    off = q[0].copy()
+    off[2] = 0.3
+    assert not solve(robot, robot.fk(off)).families

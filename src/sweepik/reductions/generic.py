@@ -19,7 +19,7 @@ from ..chain import Chain
 from ..robot import Robot
 from . import geometric
 from .base import Array, IntArray, Reduction
-from .position import CASES, STEP_JOINTS
+from .position import CASES, FINAL_JOINTS, STEP_JOINTS
 
 #: A candidate where a step's amplitude (``amplitude`` of ``geometric.case_kernels``) is below this fraction of the
 #: step's typical amplitude leaves that step's joint free (``continuum_joints``). On the C-Arm's theta2 self-motion
@@ -216,22 +216,25 @@ class GeometricReduction(Reduction):
 
     @cached_property
     def _step_scales(self) -> Array:
-        """The typical amplitude of each step ``k = 0, 1, 2`` (as ``amplitude`` numbers them): its median over random
-        poses and theta* values; inf for a step with one solution."""
-        a = np.abs(self._probe(self._case_kernels.amplitude, 3)).reshape(-1, 3)
-        return np.array([np.median(c[np.isfinite(c)]) if np.isfinite(c).any() else np.inf for c in a.T])
+        """The typical amplitude of each step ``k = 0, 1, 2`` (as ``amplitude`` numbers them), then the final step's
+        gap (``amplitude``'s k = 3 .. 6, the position branches): each its median over random poses and theta* values;
+        inf for a step with one solution, or no final step."""
+        a = np.abs(self._probe(self._case_kernels.amplitude, 7)).reshape(-1, 7)
+        cols = [a[:, 0], a[:, 1], a[:, 2], a[:, 3:].ravel()]
+        return np.array([np.median(c[np.isfinite(c)]) if np.isfinite(c).any() else np.inf for c in cols])
 
     @cached_property
-    def _step_joints(self) -> tuple[int, int]:
-        """The robot joints that the position case's first and second two-solution steps turn (-1: no such step)."""
+    def _step_joints(self) -> tuple[int, int, int]:
+        """The robot joints that the position case's first and second two-solution steps turn, and the one its final
+        step turns (``FINAL_JOINTS``); -1: no such step."""
         others = [i for i in range(4) if i != self.plan.free]
-        return tuple(  # type: ignore[return-value]
-            -1 if x is None else self.plan.joint(others["abc".index(x)]) for x in STEP_JOINTS[self.plan.case]
-        )
+        letters = (*STEP_JOINTS[self.plan.case], FINAL_JOINTS[self.plan.case])
+        return tuple(-1 if x is None else self.plan.joint(others["abc".index(x)]) for x in letters)  # type: ignore[return-value]
 
     @cached_property
     def _continuum_thresholds(self) -> Array:
-        """Below these amplitudes (steps ``k = 0, 1, 2``) a step leaves its joint free (``CONTINUUM_AMPLITUDE``)."""
+        """Below these amplitudes (steps ``k = 0, 1, 2``, then the final step's gap) a step leaves its joint free
+        (``CONTINUUM_AMPLITUDE``)."""
         return np.ascontiguousarray(CONTINUUM_AMPLITUDE * self._step_scales)
 
     @cached_property

@@ -56,7 +56,7 @@ from .kernels import (
     as_residuals,
     lazy_njit,
 )
-from .position import BOTH, NEITHER, angle, motion, place, reduce_chain
+from .position import BOTH, CASES, FINAL_JOINTS, NEITHER, angle, motion, move, place, reduce_chain
 
 Array = NDArray[np.float64]
 
@@ -120,14 +120,37 @@ def _mat_t(p, v):
     )
 
 
+#: ``position.FINAL_JOINTS`` by case code: 0, 1, 2 for joints a, b, c of the reduced chain, -1 for none.
+_FINAL = tuple(-1 if FINAL_JOINTS[c] is None else "abc".index(FINAL_JOINTS[c]) for c in CASES)
+
+
+@inlined
+def _final_gap(fx, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, ma, mb, mc):
+    """The distance of ``W`` from the axis of the joint the case turns last (``fx``: 0, 1, 2 for a, b, c), given the
+    motions of the reduced chain's joints (``W - o_a = T_a(pab + T_b(pbc + T_c(pcw)))``): inf where there is no such
+    joint or it is a slide. Where it vanishes, that joint turns ``W`` about itself: free as far as ``W`` goes."""
+    u = pcw
+    h, r = hc, rc
+    if fx <= 1:
+        u = add(pbc, move(hc, rc, mc, u))
+        h, r = hb, rb
+        if fx == 0:
+            u = add(pab, move(hb, rb, mb, u))
+            h, r = ha, ra
+    if fx < 0 or not r:
+        return math.inf
+    return norm(sub(u, scale(dot(u, h), h)))
+
+
 @inlined
 def _arm(p, x, b1, b2, case, f, rev):
     """The first four joints with joint ``free`` at ``x``, on branch ``b1`` of the position case's first step and
     ``b2`` of its second (``position.place``: 0, 1, both or neither): ``(A, B, c1, c2, a1, a2)`` with ``A`` the
     motions ``(m0, m1, m2, m3)`` (``position.motion``) of branch ``2 b1``, ``B`` those of branch ``2 b1 + 1``, the
-    cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the case's steps. ``case`` (the position case), ``f``
-    (theta*'s index among the first four joints) and ``rev`` (their types, True: revolute): constants of the kernel
-    (see ``case_kernels``)."""
+    cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the case's steps, and the final step's gaps ``(g1, g2)`` on
+    branches ``2 b1`` and ``2 b1 + 1`` (``_final_gap``; NaN where ``b2`` did not ask for the branch). ``case`` (the
+    position case), ``f`` (theta*'s index among the first four joints) and ``rev`` (their types, True: revolute):
+    constants of the kernel (see ``case_kernels``)."""
     h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
     r0, r1, r2, r3 = rev
     s0, s1, s2, s3 = _v(p, _P), _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
@@ -150,13 +173,16 @@ def _arm(p, x, b1, b2, case, f, rev):
             o = rot_cs(h1, mx[0], mx[1], o)
     ra, rb, rc = rev[a], rev[b], rev[c]
     ma, mb, mc, na, nb, nc, c1, c2, a1, a2 = place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+    fx = _FINAL[case] if 0 <= case < len(_FINAL) else -1
+    g1 = _final_gap(fx, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, ma, mb, mc)
+    g2 = _final_gap(fx, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, na, nb, nc)
     if f == 0:
-        return (mx, ma, mb, mc), (mx, na, nb, nc), c1, c2, a1, a2
+        return (mx, ma, mb, mc), (mx, na, nb, nc), c1, c2, a1, a2, g1, g2
     if f == 1:
-        return (ma, mx, mb, mc), (na, mx, nb, nc), c1, c2, a1, a2
+        return (ma, mx, mb, mc), (na, mx, nb, nc), c1, c2, a1, a2, g1, g2
     if f == 2:
-        return (ma, mb, mx, mc), (na, nb, mx, nc), c1, c2, a1, a2
-    return (ma, mb, mc, mx), (na, nb, nc, mx), c1, c2, a1, a2
+        return (ma, mb, mx, mc), (na, nb, mx, nc), c1, c2, a1, a2, g1, g2
+    return (ma, mb, mc, mx), (na, nb, nc, mx), c1, c2, a1, a2, g1, g2
 
 
 @inlined
@@ -546,8 +572,11 @@ def _continuum_rows(amp, params, pose, theta, branch, err, tol, div, thr, joints
         if not err[k] <= tol:
             continue
         p = params[pose[k]]
+        pb = branch[k] // div  # (the position branch)
+        if joints[2] >= 0 and amp(p, theta[k], 3 + pb) < thr[3]:
+            out[k] = joints[2]
         if joints[1] >= 0:
-            s = 1 + (branch[k] // div) // 2
+            s = 1 + pb // 2
             if amp(p, theta[k], s) < thr[s]:
                 out[k] = joints[1]
         if joints[0] >= 0 and amp(p, theta[k], 0) < thr[0]:
@@ -559,9 +588,9 @@ def _continuum_rows(amp, params, pose, theta, branch, err, tol, div, thr, joints
 def continuum_rows(amplitude, params, pose, theta, branch, err, tol, div, thr, joints, out):
     """For candidates ``(pose[k], theta[k], branch[k])`` with ``err[k] <= tol`` (the others: -1): ``out[k]`` the
     joint that a step of the position case leaves free there (its amplitude, ``amplitude`` of ``case_kernels`` given
-    by its address, ``kernels.address_of``, below ``thr[step]``; ``joints``: the first and second steps' joints, -1
-    for none; the first step's wins), else -1. ``div``: branches per position branch (2 for the wrist family).
-    Returns the number of rows flagged."""
+    by its address, ``kernels.address_of``, below ``thr[step]``; ``joints``: the first and second steps' joints and
+    the final step's, -1 for none, its gap below ``thr[3]``; the first step's wins), else -1. ``div``: branches per
+    position branch (2 for the wrist family). Returns the number of rows flagged."""
     return _continuum_rows(amplitude, params, pose, theta, branch, err, tol, div, thr, joints, out)
 
 
@@ -680,7 +709,12 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
                 out[2] = 1.0 - arm[3] * arm[3]
 
         def amplitude(p, x, k):
-            """Amplitude of step k (see ``margin``)."""
+            """Amplitude of step k (see ``margin``); for k >= 3 the final step's gap on position branch k - 3
+            (``_final_gap``)."""
+            if k >= 3:
+                pb = k - 3
+                arm = _arm(p, x, pb // 2, pb % 2, case, free, rev)
+                return arm[6] if pb % 2 == 0 else arm[7]
             arm = _arm(p, x, 0 if k == 0 else k - 1, NEITHER + 0 * k, case, free, rev)
             return arm[4] if k == 0 else arm[5]
 
@@ -752,6 +786,8 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
                     for j in range(2):
                         if 2 * b1 + j >= nb:
                             break
+                        if (arm[6] if j == 0 else arm[7]) < thr[3]:
+                            low[i] = True
                         m0, m1, m2, m3 = arm[0] if j == 0 else arm[1]
                         if _missing(m0, m1, m2, m3) or not (in_domain(arm[2]) and in_domain(arm[3])):
                             continue

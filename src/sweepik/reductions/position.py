@@ -49,6 +49,7 @@ __all__ = [
     "CASES",
     "BRANCHES",
     "STEP_JOINTS",
+    "FINAL_JOINTS",
     "BOTH",
     "NEITHER",
     "reduce_chain",
@@ -85,6 +86,19 @@ STEP_JOINTS = {
     "ppr": (None, "c"),
     "ac_par": (None, "c"),
     "rpp": (None, "a"),
+}
+#: The joint each case turns last by ``sp1`` (None: none, or a slide solved linearly). Where ``W`` lies on its axis
+#: (``geometric._final_gap`` vanishes) the step no longer involves it: the joint is free as far as ``W`` goes (the
+#: Stanford arm's shoulder joint 2 with its slide at 0, an arm whose wrist centre reaches its shoulder's axis).
+FINAL_JOINTS = {
+    "ab_par": "a",
+    "bc_par": "b",
+    "ab_int": "b",
+    "bc_int": "c",
+    "ppp": None,
+    "ppr": None,
+    "ac_par": "a",
+    "rpp": None,
 }
 
 
