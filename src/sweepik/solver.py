@@ -402,8 +402,9 @@ def _merge_meeting(
     mult: NDArray[np.intp],
     pose_idx: NDArray[np.intp],
 ) -> None:
-    """In place: each pair of ``_meeting_pairs`` whose midpoint (polished) solves the pose better than either of them
-    becomes that midpoint (its errors, its limit check, the pair's multiplicities summed), the second row dropped.
+    """In place: each pair of ``_meeting_pairs`` whose midpoint (polished) solves the pose as well as the better of
+    them, or at rounding level (``POLISH_ABOVE_REL``), becomes that midpoint (its errors, its limit check, the pair's
+    multiplicities summed), the second row dropped.
     Two distinct roots this close (a pose next to the singular set) keep apart: between them the pose error grows
     quadratically, far above theirs."""
     weight = orientation_weight(robot.length_unit)

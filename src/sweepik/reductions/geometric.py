@@ -121,7 +121,7 @@ def _mat_t(p, v):
 
 
 #: ``position.FINAL_JOINTS`` by case code: 0, 1, 2 for joints a, b, c of the reduced chain, -1 for none.
-_FINAL = tuple(-1 if FINAL_JOINTS[c] is None else "abc".index(FINAL_JOINTS[c]) for c in CASES)
+_FINAL = tuple(-1 if (x := FINAL_JOINTS[c]) is None else "abc".index(x) for c in CASES)
 
 
 @inlined
@@ -148,9 +148,9 @@ def _arm(p, x, b1, b2, case, f, rev):
     ``b2`` of its second (``position.place``: 0, 1, both or neither): ``(A, B, c1, c2, a1, a2)`` with ``A`` the
     motions ``(m0, m1, m2, m3)`` (``position.motion``) of branch ``2 b1``, ``B`` those of branch ``2 b1 + 1``, the
     cosines ``(c1, c2)`` and amplitudes ``(a1, a2)`` of the case's steps, and the final step's gaps ``(g1, g2)`` on
-    branches ``2 b1`` and ``2 b1 + 1`` (``_final_gap``; NaN where ``b2`` did not ask for the branch). ``case`` (the
-    position case), ``f`` (theta*'s index among the first four joints) and ``rev`` (their types, True: revolute):
-    constants of the kernel (see ``case_kernels``)."""
+    branches ``2 b1`` and ``2 b1 + 1`` (``_final_gap``; meaningless where ``b2`` did not ask for the branch).
+    ``case`` (the position case), ``f`` (theta*'s index among the first four joints) and ``rev`` (their types, True:
+    revolute): constants of the kernel (see ``case_kernels``)."""
     h0, h1, h2, h3 = _h(p, 0), _h(p, 1), _h(p, 2), _h(p, 3)
     r0, r1, r2, r3 = rev
     s0, s1, s2, s3 = _v(p, _P), _v(p, _P + 3), _v(p, _P + 6), _v(p, _P + 9)
