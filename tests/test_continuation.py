@@ -236,3 +236,20 @@ def test_final_step_continuum_of_a_stanford_like_arm(seed: int) -> None:
     off = q[0].copy()
     off[2] = 0.3
     assert not solve(robot, robot.fk(off)).families
+
+
+def test_traced_family_passes_where_another_singular_set_crosses() -> None:
+    """carm_swapped at theta3 = 0 (its theta2 self-motion) with theta2 = -90 deg: there the continuum crosses another
+    singular set, where Newton converges only linearly. The traced families still pass through theta2 = -90 deg (the
+    tracing used to stop ~1e-3 short of it on both sides, and the members in between went missing), and their
+    members there are certified."""
+    robot = load_robot("carm_swapped")
+    q = np.array([1723.468, -np.pi / 2, 0.0, -2.2781, -1.8677, -0.6575])
+    T = robot.fk(q)
+    sol = solve(robot, T, limits=False)
+    assert sol.families
+    for f in sol.families:
+        assert f.free_joint == 1 and f.interval[0] <= -np.pi / 2 <= f.interval[1]
+        m = f.at(-np.pi / 2)
+        err = pose_error_geodesic(robot.fk(m[None]), T[None], orientation_weight(robot.length_unit))
+        assert err[0] <= 4.0 * ACCEPT_TOL_REL * robot.length_scale

@@ -37,8 +37,10 @@ TRACE_HALVINGS = 14
 #: A corrected member farther than this from its prediction (``solutions.weighted_joint_distance``: radians, and
 #: 100 mm of a slide per radian) is refused: the correction jumped to another piece of the solution set.
 TRACE_JUMP = 0.25
-#: Newton steps per correction.
-TRACE_NEWTON = 6
+#: Newton steps per correction (at most: a member stops once within rounding). Where the continuum crosses another
+#: singular set (carm_swapped's theta2 self-motion at theta2 = -90 deg) Newton converges only linearly: with 6 steps
+#: the tracing stopped ~1e-3 short of the crossing on both sides, and the solutions in that gap went missing.
+TRACE_NEWTON = 20
 #: A seed is followed only where a continuum can pass along the joint: the arm's Jacobian (lengths over the arm's
 #: length scale) has its smallest singular value below this fraction of its largest (members of a continuum: ~1e-17,
 #: and ~1e-9 where two singular directions meet and the member is pinned down only to the root of the rounding;
