@@ -1,12 +1,14 @@
 """One pose from its chain pose to its final candidates in one compiled call: the search (``fastsweep``'s one-pass
-kernels), the certification (``fastcertify``) and the settling (``dedupe.settle``: limits, duplicates) chained.
+kernels), the certification (``fastcertify``) and the settling (``dedupe.settle``: limits, duplicates) chained
+(``settle_one``); for a closed form, its all-branch certification and the settling (``settle_closed``).
 
-Each of the three, called from Python, costs more in Python steps around its kernel (buffers, argument checks,
+Each of these, called from Python, costs more in Python steps around its kernel (buffers, argument checks,
 candidate records) than the kernel's own work takes for one pose: ~50 of a C-Arm pose's ~100 us. Here one call
-takes every argument, allocates the buffers in compiled code, and calls the three kernels by their addresses
-(``kernels.address_of``: they are not linked in and recompiled, so this module compiles in about a second). What
-it cannot settle on its own it says, and the solver takes that pose the general way (``solver._solve_chunk``):
-family spans, a candidate buffer overflow, a multiple root at a limit of theta*, a candidate due a polish.
+takes every argument, allocates the buffers in compiled code, and calls the kernels by their addresses
+(``kernels.address_of``: they are not linked in and recompiled, so each kernel here compiles in 1-2 s on a fresh
+install). What it cannot settle on its own it says, and the solver takes that pose the general way
+(``solver._solve_chunk``): family spans, a candidate buffer overflow, a multiple root at a limit of theta*, a
+candidate due a polish or a snap to a limit.
 """
 
 from __future__ import annotations
