@@ -118,3 +118,18 @@ def test_a_pose_due_a_polish_goes_the_general_way(monkeypatch: pytest.MonkeyPatc
     for a, b in zip(fast, _general(monkeypatch, robot, poses), strict=True):
         _assert_same(a, b)
         assert len(a) > 0
+
+
+@pytest.mark.parametrize(
+    ("name", "n_samples", "one_call"), [("carm", 17, True), ("carm", 100, True), ("xarm6", 100, False)]
+)
+def test_other_sample_counts(name: str, n_samples: int, one_call: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Another ``n_samples``: a hints kernel's one-pass search takes any (its grid kept per count), a generic sweep's
+    only its own (the pose goes the general way); the same solutions either way."""
+    robot = load_robot(name)
+    poses = _poses(robot, 9)[::4]
+    seen = _counted(monkeypatch)
+    fast = [sweepik.solve(robot, T, n_samples=n_samples) for T in poses]
+    assert (seen[fastsolve.OK] > 0) == one_call
+    for a, b in zip(fast, _general(monkeypatch, robot, poses, n_samples=n_samples), strict=True):
+        _assert_same(a, b)
