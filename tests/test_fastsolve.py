@@ -62,6 +62,16 @@ def _counted(monkeypatch: pytest.MonkeyPatch) -> Counter[int]:
     return seen
 
 
+def _both_ways(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, poses: np.ndarray, **kw: Any) -> Counter[int]:
+    """Solves ``poses`` the one-call way and the general way, asserts the same solutions, and returns the one-call
+    statuses seen."""
+    seen = _counted(monkeypatch)
+    fast = [sweepik.solve(robot, T, **kw) for T in poses]
+    for a, b in zip(fast, _general(monkeypatch, robot, poses, **kw), strict=True):
+        _assert_same(a, b)
+    return seen
+
+
 @pytest.mark.parametrize(
     ("name", "reduction"),
     [
@@ -84,11 +94,8 @@ def test_one_call_is_the_general_path(
     theta* revolute and prismatic, a hints kernel (carm-d1), generic sweeps, closed forms."""
     robot = load_robot(name)
     poses = _poses(robot, 5)
-    seen = _counted(monkeypatch)
-    fast = [sweepik.solve(robot, T, reduction=reduction, limits=limits) for T in poses]
+    seen = _both_ways(monkeypatch, robot, poses, reduction=reduction, limits=limits)
     assert seen[fastsolve.OK] >= len(poses) // 2  # (the one-call path is what is tested)
-    for a, b in zip(fast, _general(monkeypatch, robot, poses, reduction=reduction, limits=limits), strict=True):
-        _assert_same(a, b)
 
 
 def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -97,12 +104,8 @@ def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch)
     robot = load_robot("fanuc_crx10ia")
     poses = _poses(robot, 6)[::6]
     monkeypatch.setattr(fastsweep, "MAX_CAND", 1)
-    seen = _counted(monkeypatch)
-    fast = [sweepik.solve(robot, T) for T in poses]
-    assert seen == {fastsolve.SEARCH_ELSEWHERE: len(poses)}
-    for a, b in zip(fast, _general(monkeypatch, robot, poses), strict=True):
-        _assert_same(a, b)
-        assert len(a) > 0
+    assert _both_ways(monkeypatch, robot, poses) == {fastsolve.SEARCH_ELSEWHERE: len(poses)}
+    assert all(len(sweepik.solve(robot, T)) > 0 for T in poses)
 
 
 def test_a_pose_due_a_polish_goes_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -112,12 +115,8 @@ def test_a_pose_due_a_polish_goes_the_general_way(monkeypatch: pytest.MonkeyPatc
     poses = _poses(robot, 7)[20:26]
     monkeypatch.setattr(solver, "POLISH_ABOVE_REL", 0.0)
     monkeypatch.setattr(solver, "POLISH_PAPER_ABOVE_REL", 0.0)
-    seen = _counted(monkeypatch)
-    fast = [sweepik.solve(robot, T) for T in poses]
-    assert seen == {fastsolve.DUE: len(poses)}
-    for a, b in zip(fast, _general(monkeypatch, robot, poses), strict=True):
-        _assert_same(a, b)
-        assert len(a) > 0
+    assert _both_ways(monkeypatch, robot, poses) == {fastsolve.DUE: len(poses)}
+    assert all(len(sweepik.solve(robot, T)) > 0 for T in poses)
 
 
 @pytest.mark.parametrize(
@@ -128,8 +127,4 @@ def test_other_sample_counts(name: str, n_samples: int, one_call: bool, monkeypa
     only its own (the pose goes the general way); the same solutions either way."""
     robot = load_robot(name)
     poses = _poses(robot, 9)[::4]
-    seen = _counted(monkeypatch)
-    fast = [sweepik.solve(robot, T, n_samples=n_samples) for T in poses]
-    assert (seen[fastsolve.OK] > 0) == one_call
-    for a, b in zip(fast, _general(monkeypatch, robot, poses, n_samples=n_samples), strict=True):
-        _assert_same(a, b)
+    assert (_both_ways(monkeypatch, robot, poses, n_samples=n_samples)[fastsolve.OK] > 0) == one_call

@@ -339,8 +339,7 @@ if AVAILABLE:
     )
     def _near_compiled(pose, w, keep, rev, reach, out, count):  # pragma: no cover
         """``near_pairs``: the pairs into ``out`` (their number into ``count``, counted past the buffer too)."""
-        K, n = w.shape
-        two_pi = 2.0 * math.pi
+        K = w.shape[0]
         order = _group_order(pose)
         c = 0
         start = 0
@@ -356,15 +355,7 @@ if AVAILABLE:
                     b = order[y]
                     if not keep[b]:
                         continue
-                    close = True
-                    for j in range(n):
-                        d = abs(w[a, j] - w[b, j])
-                        if rev[j]:
-                            d = min(d, abs(two_pi - d)) if d <= two_pi else abs(wrap_pi(w[a, j] - w[b, j]))
-                        if not d <= reach[j]:
-                            close = False
-                            break
-                    if close:
+                    if _rows_within(w, a, b, rev, reach):
                         if c < out.shape[0]:
                             out[c, 0], out[c, 1] = min(a, b), max(a, b)
                         c += 1
@@ -375,11 +366,26 @@ if AVAILABLE:
     def _dedupe_compiled(pose, q, score, rev, tol, keep):  # pragma: no cover
         _dedupe_rows(pose, q, score, rev, tol, keep)
 
+    @inlined
+    def _rows_within(q, a, b, rev, tol):  # pragma: no cover
+        """Every joint of rows ``a`` and ``b`` of ``q`` within ``tol`` (per joint) of the other's, revolute ones modulo
+        2 pi."""
+        two_pi = 2.0 * math.pi
+        for j in range(q.shape[1]):
+            d = q[a, j] - q[b, j]
+            if rev[j]:
+                # (clearly apart modulo 2 pi: the wrap, a costly float modulo, would not change that)
+                if 2.0 * tol[j] < abs(d) < two_pi - 2.0 * tol[j]:
+                    return False
+                d = wrap_pi(d)
+            if not abs(d) <= tol[j]:
+                return False
+        return True
+
     @internal
     def _dedupe_rows(pose, q, score, rev, tol, keep):  # pragma: no cover
         """Step 3 (``keep``) for candidates ``q`` (wrapped) of poses ``pose`` with scores ``score``."""
-        K, n = q.shape
-        two_pi = 2.0 * math.pi
+        K = q.shape[0]
         for k in range(K):
             keep[k] = True
         order = _group_order(pose)
@@ -394,19 +400,7 @@ if AVAILABLE:
                     m = order[b]
                     if b == a or not (score[m] < score[i] or (score[m] == score[i] and m < i)):
                         continue
-                    same = True
-                    for j in range(n):
-                        d = q[i, j] - q[m, j]
-                        if rev[j]:
-                            # (clearly apart modulo 2 pi: the wrap, a costly float modulo, would not change that)
-                            if 2.0 * tol[j] < abs(d) < two_pi - 2.0 * tol[j]:
-                                same = False
-                                break
-                            d = wrap_pi(d)
-                        if not abs(d) <= tol[j]:
-                            same = False
-                            break
-                    if same:
+                    if _rows_within(q, i, m, rev, tol):
                         keep[i] = False
                         break
             start = stop

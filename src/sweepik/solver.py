@@ -141,9 +141,16 @@ def _settle_bounds(robot: Robot) -> tuple[float, float, float, float]:
 
 
 @lru_cache(maxsize=64)
+def _per_joint(robot: Robot, value: float) -> Array:
+    """``value`` per joint: as it is for a revolute one (radians), times the length scale for a prismatic one. Cached
+    (robots are values; the solver asks for the same ones on every chunk; the compiled kernels take it, writable, and
+    do not write it)."""
+    return np.where(robot.is_revolute, value, value * robot.length_scale)
+
+
 def _snap_reach(robot: Robot) -> Array:
-    """``SNAP_REACH`` per joint (times the length scale for a prismatic one)."""
-    return np.where(robot.is_revolute, SNAP_REACH, SNAP_REACH * robot.length_scale)
+    """``SNAP_REACH`` per joint."""
+    return _per_joint(robot, SNAP_REACH)
 
 
 def _snap_to_limits(
@@ -199,11 +206,11 @@ def _solve_chunk(
     n_samples: int,
     use_fallback: bool = True,
 ) -> Block:
+    chain = _chain_poses(robot, poses)  # (one array: the reduction keeps its parameters for it)
     if len(poses) == 1 and strategy == "precise" and use_fallback and red.uses_kernel:
-        block = _settled_single(robot, red, poses, limits, n_samples)
+        block = _settled_single(robot, red, poses, chain, limits, n_samples)
         if block is not None:
             return block
-    chain = _chain_poses(robot, poses)
     closed = red.closed_form
     if not closed:  # (a closed form sweeps nothing)
         lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
@@ -381,13 +388,7 @@ MEET_REL = 1e-4
 
 def _meeting_pairs(robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_]) -> NDArray[np.intp]:
     """``(P, 2)`` pairs of kept rows of one pose whose configurations ``w`` (wrapped) are within ``MEET_REL``."""
-    return near_pairs(robot, pose_idx, w, keep, _meet_reach(robot))
-
-
-@lru_cache(maxsize=64)
-def _meet_reach(robot: Robot) -> Array:
-    """``MEET_REL`` per joint (times the length scale for a slide)."""
-    return np.where(robot.is_revolute, MEET_REL, MEET_REL * robot.length_scale)
+    return near_pairs(robot, pose_idx, w, keep, _per_joint(robot, MEET_REL))
 
 
 def _merge_meeting(
@@ -425,20 +426,21 @@ def _merge_meeting(
             keep[b] = False
 
 
-def _settled_single(robot: Robot, red: Reduction, poses: Array, limits: bool, n_samples: int) -> Block | None:
-    """``_solve_chunk`` of one pose in one compiled call (``fastsolve``), the same values; None where the pose needs
-    one of its rarer steps (a polish, families, special solutions, a continuum along another joint, the fallback,
-    branches of a closed form that meet)."""
-    chain = _chain_poses(robot, poses)
+def _settled_single(
+    robot: Robot, red: Reduction, poses: Array, chain: Array, limits: bool, n_samples: int
+) -> Block | None:
+    """``_solve_chunk`` of one pose (``chain``: its chain pose) in one compiled call (``fastsolve``), the same values;
+    None where the pose needs one of its rarer steps (a polish, families, special solutions, a continuum along
+    another joint, the fallback, branches of a closed form that meet)."""
     params = red.kernel_params(chain)
     bounds, reach = _settle_bounds(robot), _snap_reach(robot)
     if red.closed_form:
         out = fastsolve.settle_closed(robot, red, poses, params, bounds, reach)
         # (branches that meet: merged into one solution of higher multiplicity, the general way)
-        if out is not None:
-            pose = np.zeros(out.rows.size, dtype=np.intp)
-            if not out.keep.all() or _meeting_pairs(robot, pose, out.w, out.keep).size:
-                return None
+        if out is not None and (
+            not out.keep.all() or _meeting_pairs(robot, np.zeros(out.rows.size, np.intp), out.w, out.keep).size
+        ):
+            return None
     else:
         lo, hi = _theta_range(robot, red, chain)
         out = fastsolve.settle_one(robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL)
@@ -494,7 +496,7 @@ def _cut_short(robot: Robot, family: Family, target: Array, limits: bool) -> boo
     inner = (np.abs(ends - span[0]) > _AT_LIMIT) & (np.abs(ends - span[1]) > _AT_LIMIT)
     if limits:
         m = robot.wrap(family.at(ends))
-        slack = np.where(robot.is_revolute, _AT_LIMIT, _AT_LIMIT * robot.length_scale)
+        slack = _per_joint(robot, _AT_LIMIT)
         inner &= ~np.any((np.abs(m - robot.lower) <= slack) | (np.abs(m - robot.upper) <= slack), axis=-1)
     if not inner.any():
         return False

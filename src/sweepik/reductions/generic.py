@@ -464,39 +464,45 @@ class GeometricReduction(Reduction):
         return row
 
     def _flat(
-        self, poses: Array, theta: Array, branch: IntArray | None, n_branches: int | None = None
+        self,
+        poses: Array,
+        theta: Array,
+        branch: IntArray | None,
+        n_branches: int | None = None,
+        rows: IntArray | None = None,
     ) -> tuple[Array, IntArray, Array, IntArray]:
+        """The kernels' flat arguments for ``theta (N, M)`` of chain poses ``poses`` (``rows``: of ``poses[rows]``,
+        from the parameters of ``poses``, kept for the last ``poses``: the NumPy engine asks for rows of the same
+        poses over and over)."""
         N, M = theta.shape
         params = self.kernel_params(poses)
+        index = np.arange(N) if rows is None else np.asarray(rows)
         if branch is None:
             B = self.n_branches if n_branches is None else n_branches
-            pose = np.repeat(np.arange(N), M * B)
+            pose = np.repeat(index, M * B)
             th = np.repeat(theta.reshape(-1), B)
             br = np.tile(np.arange(B), N * M)
         else:
-            pose = np.repeat(np.arange(N), M)
+            pose = np.repeat(index, M)
             th = theta.reshape(-1)
             br = np.broadcast_to(branch, theta.shape).reshape(-1)
         return params, pose.astype(np.int64), np.ascontiguousarray(th, dtype=np.float64), br.astype(np.int64)
 
-    def _evaluate(self, fn: Any, poses: Array, theta: Array, branch: IntArray | None, n_branches: int) -> Array:
+    def _evaluate(
+        self,
+        fn: Any,
+        poses: Array,
+        theta: Array,
+        branch: IntArray | None,
+        n_branches: int,
+        rows: IntArray | None = None,
+    ) -> Array:
         """Compiled scalar ``fn(params, theta*, branch)`` over ``theta (N, M)``: ``(N, M, B)``, or ``(N, M)``
-        with ``branch``."""
-        params, pose, th, br = self._flat(poses, theta, branch, n_branches)
+        with ``branch`` (``rows``: of ``poses[rows]``, see ``_flat``)."""
+        params, pose, th, br = self._flat(poses, theta, branch, n_branches, rows)
         out = np.empty(th.shape[0])
         geometric.evaluate(fn, params, pose, th, br, out)
         return out.reshape(theta.shape if branch is not None else (*theta.shape, n_branches))
-
-    def _evaluate_rows(self, fn: Any, poses: Array, rows: IntArray, theta: Array, branch: IntArray) -> Array:
-        """``_evaluate`` of ``poses[rows]`` with one branch per sample, from the rows of ``kernel_params(poses)`` (kept
-        for the last ``poses``: the NumPy engine asks for rows of the same poses over and over)."""
-        params = self.kernel_params(poses)
-        pose = np.repeat(np.asarray(rows, dtype=np.int64), theta.shape[1])
-        th = np.asarray(theta).astype(np.float64).reshape(-1)  # (copies: the kernel takes writable arrays)
-        br = np.broadcast_to(branch, theta.shape).astype(np.int64).reshape(-1)
-        out = np.empty(th.shape[0])
-        geometric.evaluate(fn, params, pose, th, br, out)
-        return out.reshape(theta.shape)
 
     def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array | None:
         return self._evaluate(self._kernels[0], poses, theta, branch, self.n_branches)
@@ -504,7 +510,7 @@ class GeometricReduction(Reduction):
     def residual_rows(self, poses: Array, rows: IntArray, theta: Array, branch: IntArray) -> Array | None:
         if type(self).residual is not GeometricReduction.residual:  # (a subclass's own residual)
             return super().residual_rows(poses, rows, theta, branch)
-        return self._evaluate_rows(self._kernels[0], poses, rows, theta, branch)
+        return self._evaluate(self._kernels[0], poses, theta, branch, self.n_branches, rows)
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         params, pose, th, br = self._flat(poses, theta, branch)
@@ -576,7 +582,7 @@ class _Margins(Reduction):
         return self.red._evaluate(self.red._case_kernels.pair_margin, poses, theta, branch, self.n_branches)
 
     def residual_rows(self, poses: Array, rows: IntArray, theta: Array, branch: IntArray) -> Array | None:
-        return self.red._evaluate_rows(self.red._case_kernels.pair_margin, poses, rows, theta, branch)
+        return self.red._evaluate(self.red._case_kernels.pair_margin, poses, theta, branch, self.n_branches, rows)
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         raise NotImplementedError("margins have no configurations")
