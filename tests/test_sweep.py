@@ -658,3 +658,29 @@ def test_residual_rows_is_the_residual_of_those_rows() -> None:
     shifted = Shifted(robot, red.plan)
     got = shifted.residual_rows(poses, rows, theta, np.broadcast_to(branch, theta.shape))
     np.testing.assert_array_equal(got, red.residual(poses[rows], theta, np.broadcast_to(branch, theta.shape)) + 1.0)
+
+
+@pytest.mark.parametrize("engine", ["compiled", "numpy"])
+def test_edge_samples_far_from_zero_are_no_candidates(engine: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A sample next to a branch-domain edge or at the range's ends is a candidate only where its residual is within
+    ``FAR_NOISE`` x noise of zero (as an extremum): a root there would make it small. Every candidate the search
+    gives is then that close to zero; before, over half the CRX-10iA's candidates were such samples, far from it.
+    (Next to a family's samples they stay candidates: the C-Arm's grid poses are unchanged, see docs/performance.md.)
+    """
+    from sweepik import solver, sweep
+
+    if engine == "compiled" and not fastsweep.AVAILABLE:
+        pytest.skip("numba not installed")
+    if engine == "numpy":
+        monkeypatch.setattr(fastsweep, "AVAILABLE", False)
+    robot = load_robot("fanuc_crx10ia")
+    red = sweepik.get_reduction(robot, None)
+    chain = solver._chain_poses(robot, robot.fk(np.random.default_rng(4).uniform(robot.lower, robot.upper, (30, 6))))
+    lo, hi = solver._theta_range(robot, red, chain)
+    if engine == "compiled":
+        cand, _ = fastsweep.search(red, chain, lo, hi, sweep.N_SAMPLES)
+    else:
+        cand, _ = sweep.find_candidates(red, chain, lo, hi, sweep.N_SAMPLES)
+    f = red.residual(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+    assert cand.theta.size >= 4 * len(chain)  # (the arm's roots: 7.8 solutions a pose on average)
+    assert np.all(np.abs(f) <= sweep.FAR_NOISE * red.residual_noise)

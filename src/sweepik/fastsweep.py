@@ -290,11 +290,12 @@ if AVAILABLE:
     @internal
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
-        wv, wx, wdd, res_all, n_all, edge_f, edge_ok,
+        wv, wx, wdd, res_all, n_all, edge_f, edge_ok, fmask,
     ):  # fmt: skip
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
         hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
-        coordinate judges curvature (NaN: theta), as in sweep._Search.scan."""
+        coordinate judges curvature (NaN: theta), ``fmask``: the samples masked as a family's (read at level 0
+        only), as in sweep._Search.scan."""
         M = th.shape[0]
         valid = wv[:M]  # work arrays of the pose (no allocation per sequence)
         for j in range(M):
@@ -325,7 +326,16 @@ if AVAILABLE:
             hi_open = (j == M - 1 and level == 0) or (j < M - 1 and not valid[j + 1])
             nr = abs(f[j + 1]) if (j < M - 1 and valid[j + 1]) else np.inf
             nl = abs(f[j - 1]) if (j > 0 and valid[j - 1]) else np.inf
-            if (lo_open and abs(f[j]) <= nr) or (hi_open and abs(f[j]) <= nl):
+            at_l = lo_open and abs(f[j]) <= nr
+            at_r = hi_open and abs(f[j]) <= nl
+            if not (at_l or at_r):
+                continue
+            # (far from zero: no candidate, but next to a family's samples: sweep.FAR_NOISE)
+            if (
+                abs(f[j]) <= FAR_NOISE * noise
+                or (at_l and level == 0 and j > 0 and fmask[j - 1])
+                or (at_r and level == 0 and j < M - 1 and fmask[j + 1])
+            ):
                 _push(out_t, out_b, cnt, th[j], b)
         # second divided differences, in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate)
         x = wx[:M]
@@ -498,6 +508,7 @@ if AVAILABLE:
         own_edge_f = np.empty((M, SUB + 1, nb_all))  # all-branch sub-samples of edge intervals (level 0)
         own_edge_ok = np.empty(M, dtype=np.bool_)
         own_f = np.empty(M)
+        own_fm = np.empty(M, dtype=np.bool_)
         own_top = np.empty(1, dtype=np.int64)
         own_probes = np.empty((out_t.shape[1], 2))
         # ... and the work arrays too (their owners are used at the end, ``alive``: they outlive the views)
@@ -505,7 +516,7 @@ if AVAILABLE:
         stk_c, no_ctx, wv, wx = unowned(own_stk_c), unowned(own_no_ctx), unowned(own_wv), unowned(own_wx)
         wdd, buf_t, buf_f, buf_c = unowned(own_wdd), unowned(own_buf_t), unowned(own_buf_f), unowned(own_buf_c)
         f_all, edge_f, edge_ok, f = unowned(own_f_all), unowned(own_edge_f), unowned(own_edge_ok), unowned(own_f)
-        top, probes = unowned(own_top), unowned(own_probes)
+        top, probes, fm = unowned(own_top), unowned(own_probes), unowned(own_fm)
         for i in range(start, stop):
             p = params[i]
             M = n_grid[i]
@@ -526,6 +537,8 @@ if AVAILABLE:
                     for j in range(M):
                         f[j] = res(p, th[j], b)
                 # families: runs of vanishing samples
+                for j in range(M):
+                    fm[j] = False
                 j = 0
                 while j < M:
                     if not math.isnan(f[j]) and abs(f[j]) <= FAMILY_TOL:
@@ -545,6 +558,7 @@ if AVAILABLE:
                             fcnt[i] += 1
                             for m in range(j, k + 1):
                                 f[m] = np.nan
+                                fm[m] = True
                         # (a short run of coinciding samples is left to the scan: one root)
                         j = k + 1
                     else:
@@ -558,7 +572,8 @@ if AVAILABLE:
                 seq_t, seq_f, ctx, xe = th, f[:M], no_ctx, np.nan
                 while True:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
-                          c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd, res_all, n_all, edge_f, edge_ok)  # fmt: skip
+                          c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd, res_all, n_all, edge_f, edge_ok,
+                          fm)  # fmt: skip
                     if top[0] == 0:
                         break
                     top[0] -= 1
@@ -620,7 +635,7 @@ if AVAILABLE:
                 else:
                     out_m[i, k] = 1
         alive(own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx, own_wdd)
-        alive(own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top, own_probes)
+        alive(own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top, own_probes, own_fm)
 
     @lazy_njit(RESIDUALS_SIG, cache=True)
     def _no_residuals(params, theta, out):  # pragma: no cover - never called (n_all = 0)

@@ -93,8 +93,9 @@ MULT_MAX = 8
 #: samples) is not a candidate: 1e-2 for residuals of O(1) sines and cosines (noise 1e-14; C-Arm: the sine of the
 #: wrist's misalignment), 1e-2 of the arm's size for the pose-error residual; far above what certification
 #: (2e-13 of the arm's size) or the Newton polish (candidates within 1e-6 of it) accept. Extrema found that far
-#: after their first location are not located further. (Samples next to a NaN stay candidates whatever their
-#: residual: next to a family's samples, masked as NaN, their flat-stretch probe can join two pieces of it.)
+#: after their first location are not located further. Samples next to a domain edge or at the range's ends
+#: farther from zero are no candidates either; next to a family's samples (masked as NaN) they stay candidates
+#: whatever their residual: their flat-stretch probe can join two pieces of the family.
 FAR_NOISE = 1e12
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
 XTOL_REL = 1e-16
@@ -261,6 +262,7 @@ class _Search:
         edge_right: NDArray[np.bool_] | None = None,
         ctx: tuple[Array, Array, Array, Array] | None = None,
         edge_x: Array | None = None,
+        family: NDArray[np.bool_] | None = None,
     ) -> None:
         """Find candidates on sequences ``th, f (S, M)`` (``valid``: usable samples); recurse into bends.
 
@@ -270,6 +272,7 @@ class _Search:
         a double root just beside a parent sample lies in the first or last sub-interval at every level.
         ``edge_x (S,)``: the domain edge whose neighbouring interval this sequence resamples (NaN if none): there
         curvature is judged in the coordinate sqrt(|theta - edge|) (see ``_edge_coordinate``).
+        ``family (S, M)``: the samples masked as a family's (level 0 only; see ``FAR_NOISE``).
         """
         S, M = f.shape
         if edge_left is None or edge_right is None:
@@ -330,7 +333,13 @@ class _Search:
         nb_l = np.concatenate([np.full((S, 1), np.inf), absf[:, :-1]], axis=1)
         nb_r = np.where(np.isfinite(nb_r), nb_r, np.inf)
         nb_l = np.where(np.isfinite(nb_l), nb_l, np.inf)
-        edge = valid & ((left_open & (absf <= nb_r)) | (right_open & (absf <= nb_l)))
+        edge_l, edge_r = left_open & (absf <= nb_r), right_open & (absf <= nb_l)
+        near = absf <= self.far
+        if family is not None:  # (next to a family's samples: whatever the residual)
+            no = np.zeros((S, 1), dtype=bool)
+            near |= edge_l & np.concatenate([no, family[:, :-1]], axis=1)
+            near |= edge_r & np.concatenate([family[:, 1:], no], axis=1)
+        edge = valid & (edge_l | edge_r) & near
         d_i, d_j = np.nonzero(edge)
         self._root(p[d_i], b[d_i], th[d_i, d_j])
         # 5) intervals that may hide a pair of roots (besides a sign change they may have) are resampled;
@@ -660,7 +669,8 @@ def find_candidates(
     b = np.tile(np.arange(B), N)
     fs = f.transpose(0, 2, 1).reshape(N * B, M)
     vs = valid.transpose(0, 2, 1).reshape(N * B, M)
-    search.scan(p, b, theta[p], fs, vs, 0)
+    fam = in_family.transpose(0, 2, 1).reshape(N * B, M)
+    search.scan(p, b, theta[p], fs, vs, 0, family=fam if fam.any() else None)
     cand = search.finish()
     return cand, Spans.concat([spans, search.spans])
 
