@@ -8,7 +8,8 @@ takes every argument, allocates the buffers in compiled code, and calls the kern
 (``kernels.address_of``: they are not linked in and recompiled, so each kernel here compiles in 1-2 s on a fresh
 install). What it cannot settle on its own it says, and the solver takes that pose the general way
 (``solver._solve_chunk``): family spans, a candidate buffer overflow, a multiple root at a limit of theta*, a
-candidate due a polish or a snap to a limit.
+candidate due a polish or a snap to a limit, a candidate where a continuum may run along another joint
+(``Reduction.continuum_kernel``).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from .reductions.kernels import CONFIGURATION_SIG, CONFIGURATIONS_SIG, address_o
 from .sweep import _unit_grid
 from .units import orientation_weight
 
-__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "Settled", "settle_one", "settle_closed"]
+__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "CONTINUUM", "Settled", "settle_one", "settle_closed"]
 
 Array = NDArray[np.float64]
 
@@ -35,8 +36,10 @@ Array = NDArray[np.float64]
 OK = 0
 #: ... its search needs the general path (family spans, a buffer overflow, a multiple root at a limit of theta*) ...
 SEARCH_ELSEWHERE = 1
-#: ... a candidate is due one of the solver's rarer steps (a polish, a snap to a limit).
+#: ... a candidate is due one of the solver's rarer steps (a polish, a snap to a limit) ...
 DUE = 2
+#: ... or a continuum may run along another joint through a certified one (``Reduction.continuum_joints``).
+CONTINUUM = 3
 
 
 class Settled(NamedTuple):
@@ -65,14 +68,16 @@ if AVAILABLE:
     from .dedupe import _SETTLE_SIG, _settle
     from .fastcertify import _CERTIFY_EVERY_SIG, _CERTIFY_SIG, _certify, _certify_every_branch
     from .fastsweep import _ONE_PASS_SIG
+    from .reductions.geometric import _CONTINUUM_SIG, _continuum_rows
 
     _ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG = _void(*_ONE_PASS_SIG), _void(*_CERTIFY_SIG), _void(*_SETTLE_SIG)
-    _EVERY_FN_SIG = _void(*_CERTIFY_EVERY_SIG)
-    _as_one_pass, _as_certify, _as_settle, _as_every = (
-        function_at(s) for s in (_ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG, _EVERY_FN_SIG)
+    _EVERY_FN_SIG, _CONTINUUM_FN_SIG = _void(*_CERTIFY_EVERY_SIG), int64(*_CONTINUUM_SIG)
+    _as_one_pass, _as_certify, _as_settle, _as_every, _as_continuum = (
+        function_at(s) for s in (_ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG, _EVERY_FN_SIG, _CONTINUUM_FN_SIG)
     )
-    #: The kernels' addresses in ``addr``.
-    _A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG = range(4)
+    #: The kernels' addresses in ``addr``, and ``continuum_rows``' (0: no continuum check) with its fixed integers
+    #: (the amplitude kernel's address, branches per position branch), ``Reduction.continuum_kernel``'s.
+    _A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG, _A_ROWS, _A_AMP, _A_DIV, _A_SIZE = range(8)
 
     @internal
     def _settled(settle, q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale):
@@ -100,17 +105,19 @@ if AVAILABLE:
         + (float64[::1], float64[::1], float64[::1], float64[::1], float64[::1], int64[:, ::1], int64, int64)
         + (float64[::1], float64, float64[:, :, ::1], float64[:, ::1], float64[:, ::1], boolean[::1])
         + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-        + (float64[::1], float64[::1], float64),
+        + (float64[::1], float64[::1], float64, int64[::1], float64[::1]),
         cache=True,
         nogil=True,
     )
     def _settle_one(
         addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
         limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
+        c_joints, c_thr,
     ):  # pragma: no cover  # fmt: skip
         """``settle_one``'s kernel: pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``),
         certified and settled; ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped
-        to them (``solver._limit_copies``: the general path's)."""
+        to them (``solver._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of
+        the continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds."""
         # (np.empty and explicit loops: np.zeros, slice copies and the like each add to the first compilation)
         n = rev.shape[0]
         out_t = np.empty((1, max_cand))
@@ -150,6 +157,14 @@ if AVAILABLE:
         )
         if due and status == OK:
             status, c = DUE, 0
+        if status == OK and addr[_A_ROWS] != 0 and K > 0:
+            free = np.empty(K, dtype=np.int64)
+            nt = c_thr.shape[0] - 1
+            flagged = _as_continuum(addr[_A_ROWS])(
+                addr[_A_AMP], params, pose, theta, branch, eg, c_thr[nt], addr[_A_DIV], c_thr[:nt], c_joints, free
+            )
+            if flagged > 0:
+                status, c = CONTINUUM, 0
         return status, c, theta, branch, mult, q, eg, ep, rows, w, inside, keep
 
     @lazy_njit(
@@ -183,7 +198,7 @@ class _Fixed(NamedTuple):
     head: tuple[Any, ...]  # the arguments before the pose's own (addresses, plan, ...)
     middle: tuple[Any, ...]  # between them (the unit grid, theta*'s ends, the twins)
     limits: Array  # theta*'s limits
-    tail: tuple[Any, ...]  # after the target: ``_tail``
+    tail: tuple[Any, ...]  # after the target: ``_tail``, then the continuum check's joints and thresholds
     hint_range: Any  # ``EdgeSearch.hint_range`` (the margins' range of a pose), or None: the search's own
 
 
@@ -213,26 +228,44 @@ def _tail(robot: Any, thresholds: tuple[float, ...], reach: Array) -> tuple[Any,
     return (H, P, crev, R_end, weight, *settling)
 
 
-def _fixed(robot: Any, red: Any, n_samples: int, thresholds: tuple[float, ...], reach: Array) -> _Fixed | None:
-    """The fixed arguments of ``_settle_one`` for ``red`` (None: it has no one-pass search for ``n_samples``)."""
+def _owner(red: Any, name: str) -> type | None:
+    return next((c for c in type(red).__mro__ if name in vars(c)), None)
+
+
+def _fixed(
+    robot: Any, red: Any, n_samples: int, thresholds: tuple[float, ...], reach: Array, seed_tol: float
+) -> _Fixed | None:
+    """The fixed arguments of ``_settle_one`` for ``red`` (None: it has no one-pass search for ``n_samples``, or
+    checks its continua in Python only: it overrides ``continuum_joints`` and not ``continuum_kernel``)."""
 
     def make() -> _Fixed | None:
         plan = _plan(red)
         one = plan.one_pass
         if one is None or not (one.n_samples is None or one.n_samples == n_samples):
             return None
-        addr = np.zeros(4, dtype=np.int64)
+        if _owner(red, "continuum_joints") is not _owner(red, "continuum_kernel"):
+            return None
+        addr = np.zeros(_A_SIZE, dtype=np.int64)
         addr[_A_SEARCH] = address_of(one.kernel, _ONE_PASS_FN_SIG)
         addr[_A_CERTIFY] = address_of(_certify, _CERTIFY_FN_SIG)
         addr[_A_SETTLE] = address_of(_settle, _SETTLE_FN_SIG)
         addr[_A_CFG] = address_of(red.kernel[1], CONFIGURATION_SIG)
+        c_joints, c_thr = np.zeros(0, dtype=np.int64), np.zeros(1)
+        cont = red.continuum_kernel()
+        if cont is not None:  # (the solver's seed tolerance after the thresholds)
+            amplitude, div, c_thr, c_joints = cont
+            addr[_A_ROWS] = address_of(_continuum_rows, _CONTINUUM_FN_SIG)
+            addr[_A_AMP], addr[_A_DIV] = amplitude, div
+            c_thr = np.append(c_thr, seed_tol)
+            c_joints = np.ascontiguousarray(c_joints, dtype=np.int64)
         j = red.free_joint
         head = (addr, one.ints[1], plan.branches, one.margin_branches, one.steps, one.noise)
         limits = np.array([robot.lower[j], robot.upper[j]], dtype=np.float64)
         middle = (_unit_grid(n_samples), plan.ends, one.twins)
-        return _Fixed(head, middle, limits, _tail(robot, thresholds, reach), one.hint_range)
+        tail = (*_tail(robot, thresholds, reach), c_joints, c_thr)
+        return _Fixed(head, middle, limits, tail, one.hint_range)
 
-    return _kept(red, ("sweep", n_samples, thresholds), make)
+    return _kept(red, ("sweep", n_samples, thresholds, seed_tol), make)
 
 
 def settle_one(
@@ -247,14 +280,16 @@ def settle_one(
     thresholds: tuple[float, float, float, float],
     reach: Array,
     clip_rel: float,
+    seed_tol: float,
 ) -> Settled | None:
     """The one pose of ``chain``/``world (1, 4, 4)`` searched over ``[lo, hi]`` (``(1,)`` each), certified and settled
     in one compiled call, as the solver's general path does it (the same values); None where ``red`` has no one-pass
     search for ``n_samples`` (or without Numba). ``thresholds`` and ``reach``: ``dedupe.settle``'s; ``clip_rel``: the
-    reach (relative to ``hi - lo``) within which a multiple root outside theta*'s limits is clipped to them."""
+    reach (relative to ``hi - lo``) within which a multiple root outside theta*'s limits is clipped to them;
+    ``seed_tol``: the pose error within which a candidate is checked for a continuum (``continuum_joints``)."""
     if not AVAILABLE:
         return None
-    fixed = _fixed(robot, red, n_samples, thresholds, reach)
+    fixed = _fixed(robot, red, n_samples, thresholds, reach, seed_tol)
     if fixed is None:
         return None
     lo, hi = writable(lo), writable(hi)

@@ -443,13 +443,16 @@ def _settled_single(
             return None
     else:
         lo, hi = _theta_range(robot, red, chain)
-        out = fastsolve.settle_one(robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL)
+        seed_tol = SEED_TOL_REL * robot.length_scale  # (its continua: checked in the call)
+        out = fastsolve.settle_one(
+            robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL, seed_tol
+        )
     if out is None or out.status != fastsolve.OK or out.rows.size > MAX_ISOLATED_SOLUTIONS:
         return None
     special = red.special_solutions(chain)
     if special is not None and np.isfinite(special[0] if isinstance(special, tuple) else special).all(-1).any():
         return None
-    if type(red).continuum_joints is not Reduction.continuum_joints:
+    if red.closed_form and type(red).continuum_joints is not Reduction.continuum_joints:
         pose = np.zeros(out.theta.size, dtype=np.intp)
         free = red.continuum_joints(chain, pose, out.theta, out.branch, out.err_geo, SEED_TOL_REL * robot.length_scale)
         if free is not None and bool((free >= 0).any()):
@@ -932,10 +935,30 @@ def _solve_one(
     locked: object = None,
 ) -> Solutions:
     """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly."""
+    if (
+        reduction is None
+        and free_joint is None
+        and locked is None
+        and limits is True
+        and type(strategy) is str
+        and strategy == "precise"
+        and type(n_samples) is int
+        and n_samples == N_SAMPLES
+        and isinstance(robot, Robot)
+    ):  # (the default options: their checks done once per robot)
+        red = _default_reduction(robot)
+        return _solve_chunk(robot, red, P, "precise", True, N_SAMPLES).solutions(0, copy=False)
     held = _held(robot, locked)
     arm = robot if held is None else held.arm
     red, strategy, limits, n_samples, _ = _prepare(arm, P, reduction, strategy, limits, n_samples, 1, free_joint, held)
     return _expanded(_solve_chunk(arm, red, P, strategy, limits, n_samples), held).solutions(0, copy=False)
+
+
+@lru_cache(maxsize=16)
+def _default_reduction(robot: Robot) -> Reduction:
+    """``_prepare``'s reduction for ``robot`` solved with the default options (a solve would spend ~6 us a call
+    checking them again); what ``_prepare`` refuses is not kept, and raises again on the next call."""
+    return _prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1)[0]
 
 
 def solve(

@@ -173,6 +173,13 @@ class Reduction(ABC):
         tell (a reduction then needs ``fallback`` and ``degenerate`` for its blind spots)."""
         return None
 
+    def continuum_kernel(self) -> tuple[int, int, Array, NDArray[np.int64]] | None:
+        """``continuum_joints`` of a sweep's candidates as the arguments of ``geometric.continuum_rows`` that do not
+        change (the amplitude kernel's address, branches per position branch, thresholds, joints), for a compiled
+        caller (``fastsolve.settle_one``); None where it finds none for them. A class that overrides
+        ``continuum_joints`` and not this one has its candidates checked in Python (the general path)."""
+        return None
+
     def search_range(self, poses: Array) -> Array | None:
         """``(N, 2)`` theta* interval that holds every solution, for a prismatic theta* searched without
         joint limits (``limits=False``). ``None``: the joint limits are used.

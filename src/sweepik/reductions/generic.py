@@ -247,6 +247,11 @@ class GeometricReduction(Reduction):
         joints = np.array(self._step_joints, dtype=np.int64)
         return address, 2 if self.plan.closed_form else 1, self._continuum_thresholds, joints
 
+    def continuum_kernel(self) -> tuple[int, int, Array, NDArray[np.int64]] | None:
+        """The swept pair and wrist families' ``_continuum_args`` (a closed form sweeps nothing; the parallel family's
+        steps have no amplitudes)."""
+        return None if self._case is None or self.plan.closed_form else self._continuum_args
+
     def continuum_joints(
         self, poses: Array, pose: IntArray, theta: Array, branch: IntArray, error: Array | None = None, tol: float = 0.0
     ) -> IntArray | None:
@@ -433,7 +438,23 @@ class GeometricReduction(Reduction):
 
     def _params(self, poses: Array, probing: bool = False) -> Array:
         """The rows; ``probing``: for ``_probe``, which finds the twins and steps that the rows' ``need`` fields
-        name (all of them there)."""
+        name (all of them there). Compiled (``geometric.pose_rows``); ``_params_numpy`` is the same in NumPy."""
+        out = np.empty((poses.shape[0], geometric.N_PARAMS))
+        robot = self.robot
+        geometric.pose_rows(
+            poses if poses.dtype == np.float64 and poses.flags.c_contiguous else np.ascontiguousarray(poses, np.float64),
+            robot.T_world_base,
+            robot.T_flange_tool,
+            bool(self.plan.reversed),
+            self._chain.R_end,
+            self._w_tool,
+            self._row if probing else self._solving_row,
+            out,
+        )
+        return out
+
+    def _params_numpy(self, poses: Array, probing: bool = False) -> Array:
+        """``_params`` with NumPy (a test's reference)."""
         robot = self.robot
         world = poses
         if not robot.base_is_identity:

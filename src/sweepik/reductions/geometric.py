@@ -594,6 +594,39 @@ def continuum_rows(amplitude, params, pose, theta, branch, err, tol, div, thr, j
     return _continuum_rows(amplitude, params, pose, theta, branch, err, tol, div, thr, joints, out)
 
 
+@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
+def pose_rows(poses, base, tool, reverse, r_end, w_tool, row, out):
+    """The parameter rows ``out (N, N_PARAMS)`` of chain poses ``(N, 4, 4)``: ``row`` (the arm's fixed part) with the
+    target orientation ``R r_end^T`` and wrist centre ``p + R w_tool`` of ``base @ pose @ tool`` (its inverse for a
+    ``reverse``d chain), as ``GeometricReduction._params`` computes them with NumPy (one call instead of ~10 NumPy
+    calls on small arrays: ~10 us of a one-pose solve)."""
+    R, Rt, p, q = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(3)
+    for i in range(poses.shape[0]):
+        T = poses[i]
+        for a in range(3):  # base @ pose (rotation, then translation)
+            for c in range(3):
+                R[a, c] = base[a, 0] * T[0, c] + base[a, 1] * T[1, c] + base[a, 2] * T[2, c]
+            p[a] = base[a, 0] * T[0, 3] + base[a, 1] * T[1, 3] + base[a, 2] * T[2, 3] + base[a, 3]
+        for a in range(3):  # ... @ tool
+            for c in range(3):
+                Rt[a, c] = R[a, 0] * tool[0, c] + R[a, 1] * tool[1, c] + R[a, 2] * tool[2, c]
+            p[a] = R[a, 0] * tool[0, 3] + R[a, 1] * tool[1, 3] + R[a, 2] * tool[2, 3] + p[a]
+        if reverse:  # the inverse transform
+            for a in range(3):
+                q[a] = -(Rt[0, a] * p[0] + Rt[1, a] * p[1] + Rt[2, a] * p[2])
+            for a in range(3):
+                p[a] = q[a]
+                for c in range(a + 1, 3):
+                    Rt[a, c], Rt[c, a] = Rt[c, a], Rt[a, c]
+        o = out[i]
+        for k in range(row.shape[0]):
+            o[k] = row[k]
+        for a in range(3):
+            for c in range(3):
+                o[_M + 3 * a + c] = Rt[a, 0] * r_end[c, 0] + Rt[a, 1] * r_end[c, 1] + Rt[a, 2] * r_end[c, 2]
+            o[_T + a] = p[a] + (Rt[a, 0] * w_tool[0] + Rt[a, 1] * w_tool[1] + Rt[a, 2] * w_tool[2])
+
+
 #: A closed form's wrist is singular (joint 6's target axis along joint 4's, or along the parallel axes: a continuum
 #: of solutions) when the sine of the angle between them is below 1e-9; within this of it the closed form's angles
 #: carry the square root of the rounding (~1e-8) and can miss the pose by far more than the certification accepts.
