@@ -442,7 +442,7 @@ class GeometricReduction(Reduction):
         out = np.empty((poses.shape[0], geometric.N_PARAMS))
         robot = self.robot
         geometric.pose_rows(
-            poses if poses.dtype == np.float64 and poses.flags.c_contiguous else np.ascontiguousarray(poses, np.float64),
+            np.ascontiguousarray(poses, dtype=np.float64),
             robot.T_world_base,
             robot.T_flange_tool,
             bool(self.plan.reversed),
