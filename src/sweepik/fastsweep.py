@@ -290,7 +290,7 @@ if AVAILABLE:
     @internal
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
-        wv, wx, wdd, res_all, n_all, edge_f, edge_ok, fmask,
+        wv, wx, res_all, n_all, edge_f, edge_ok, fmask,
     ):  # fmt: skip
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
         hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
@@ -298,10 +298,10 @@ if AVAILABLE:
         only), as in sweep._Search.scan."""
         M = th.shape[0]
         valid = wv[:M]  # work arrays of the pose (no allocation per sequence)
-        for j in range(M):
-            valid[j] = not math.isnan(f[j])
-        for j in range(M):  # samples on a root (the ends of a resampled interval are its parent's)
-            if valid[j] and abs(f[j]) <= noise and (level == 0 or 0 < j < M - 1):
+        for j in range(M):  # (and the samples on a root: the ends of a resampled interval are its parent's)
+            v = not math.isnan(f[j])
+            valid[j] = v
+            if v and abs(f[j]) <= noise and (level == 0 or 0 < j < M - 1):
                 _push(out_t, out_b, cnt, th[j], b)
         j0, j1 = (0, M) if level > 0 else (1, M - 1)
         for j in range(j0, j1):  # extrema of |f| without a sign change (the ends with their context)
@@ -337,20 +337,20 @@ if AVAILABLE:
                 or (at_r and level == 0 and j < M - 1 and fmask[j + 1])
             ):
                 _push(out_t, out_b, cnt, th[j], b)
-        # second divided differences, in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate)
+        # second divided differences (dd), in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate), worked out
+        # as the intervals are walked: c1, c2 at the interval's samples (NaN at the ends and next to a NaN sample)
         x = wx[:M]
         for j in range(M):
             x[j] = th[j] if math.isnan(xe) else math.sqrt(abs(th[j] - xe))
-        dd = wdd[:M]
-        for j in range(M):
-            dd[j] = np.nan
-        for j in range(1, M - 1):
-            if valid[j - 1] and valid[j] and valid[j + 1]:
-                hl = x[j] - x[j - 1]
-                hr = x[j + 1] - x[j]
-                if hl != 0.0 and hr != 0.0:  # (decreasing where the edge is on the right: same dd)
-                    dd[j] = 2.0 * ((f[j + 1] - f[j]) / hr - (f[j] - f[j - 1]) / hl) / (hl + hr)
+        c2 = np.nan
         for j in range(M - 1):
+            c1 = c2
+            c2 = np.nan
+            if j + 2 < M and valid[j] and valid[j + 1] and valid[j + 2]:
+                hl = x[j + 1] - x[j]
+                hr = x[j + 2] - x[j + 1]
+                if hl != 0.0 and hr != 0.0:  # (decreasing where the edge is on the right: same dd)
+                    c2 = 2.0 * ((f[j + 2] - f[j + 1]) / hr - (f[j + 1] - f[j]) / hl) / (hl + hr)
             if not (valid[j] and valid[j + 1] and th[j + 1] > th[j]):
                 continue
             prod = f[j] * f[j + 1]
@@ -359,7 +359,6 @@ if AVAILABLE:
             open_r = er if j + 1 == M - 1 else not valid[j + 2]
             near_edge = open_l or open_r
             if level < MAX_LEVELS and abs(f[j]) + abs(f[j + 1]) > 0:
-                c1, c2 = dd[j], dd[j + 1]
                 curv = np.nan
                 if not math.isnan(c1):
                     curv = abs(c1)
@@ -499,7 +498,6 @@ if AVAILABLE:
         W = M if M > SUB + 2 else SUB + 2
         own_wv = np.empty(W, dtype=np.bool_)
         own_wx = np.empty(W)
-        own_wdd = np.empty(W)
         own_buf_t = np.empty(SUB + 2)
         own_buf_f = np.empty(SUB + 2)
         own_buf_c = np.empty(4)
@@ -514,7 +512,7 @@ if AVAILABLE:
         # ... and the work arrays too (their owners are used at the end, ``alive``: they outlive the views)
         c, stk_t, stk_f, stk_i = unowned(own_c), unowned(own_stk_t), unowned(own_stk_f), unowned(own_stk_i)
         stk_c, no_ctx, wv, wx = unowned(own_stk_c), unowned(own_no_ctx), unowned(own_wv), unowned(own_wx)
-        wdd, buf_t, buf_f, buf_c = unowned(own_wdd), unowned(own_buf_t), unowned(own_buf_f), unowned(own_buf_c)
+        buf_t, buf_f, buf_c = unowned(own_buf_t), unowned(own_buf_f), unowned(own_buf_c)
         f_all, edge_f, edge_ok, f = unowned(own_f_all), unowned(own_edge_f), unowned(own_edge_ok), unowned(own_f)
         top, probes, fm = unowned(own_top), unowned(own_probes), unowned(own_fm)
         for i in range(start, stop):
@@ -530,15 +528,10 @@ if AVAILABLE:
                     res_all(p, th[j], f_all[j])
             for bi in range(branches.shape[0]):
                 b = branches[bi]
-                if n_all > 0:
-                    for j in range(M):
-                        f[j] = f_all[j, b]
-                else:
-                    for j in range(M):
-                        f[j] = res(p, th[j], b)
-                # families: runs of vanishing samples
                 for j in range(M):
+                    f[j] = f_all[j, b] if n_all > 0 else res(p, th[j], b)
                     fm[j] = False
+                # families: runs of vanishing samples
                 j = 0
                 while j < M:
                     if not math.isnan(f[j]) and abs(f[j]) <= FAMILY_TOL:
@@ -572,7 +565,7 @@ if AVAILABLE:
                 seq_t, seq_f, ctx, xe = th, f[:M], no_ctx, np.nan
                 while True:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
-                          c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, wdd, res_all, n_all, edge_f, edge_ok,
+                          c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, res_all, n_all, edge_f, edge_ok,
                           fm)  # fmt: skip
                     if top[0] == 0:
                         break
@@ -634,7 +627,7 @@ if AVAILABLE:
                     )
                 else:
                     out_m[i, k] = 1
-        alive(own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx, own_wdd)
+        alive(own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx)
         alive(own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top, own_probes, own_fm)
 
     @lazy_njit(RESIDUALS_SIG, cache=True)
