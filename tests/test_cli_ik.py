@@ -137,6 +137,30 @@ def test_bench_arms_small(capsys: pytest.CaptureFixture[str]) -> None:
     assert table.splitlines()[0].startswith("arm") and "ur5" in table and "ssik single/batched" in table
 
 
+def test_bench_times_the_solvers_of_an_arm_in_turn() -> None:
+    """``bench._side_by_side`` times each pose, then each batched run, by every solver in turn (so that the machine's
+    drifting speed falls on all of them alike), after one warm-up call of each; medians and bests per solver."""
+    import numpy as np
+
+    from sweepik.bench import _side_by_side
+
+    calls: list[tuple[str, str, int]] = []
+
+    def solver(name: str) -> tuple[object, object]:
+        return (lambda T: calls.append((name, "one", int(T[0, 0])))), (lambda Ts: calls.append((name, "many", len(Ts))))
+
+    poses = np.arange(20, dtype=float)[:, None, None] * np.ones((1, 4, 4))
+    out = _side_by_side({"a": solver("a"), ("peer", "b"): solver("b")}, poses, single=3, batch=12, repeats=2)
+    singles = [c for c in calls if c[1] == "one"]
+    assert singles == [("a", "one", 0), ("b", "one", 0)] + [(n, "one", i) for i in range(3) for n in "ab"]
+    batches = [c for c in calls if c[1] == "many"]
+    assert batches == [("a", "many", 8), ("b", "many", 8)] + [(n, "many", 12) for _ in range(2) for n in "ab"]
+    assert set(out) == {"a", ("peer", "b")} and all(v["single_us"] > 0 and v["batched_us"] > 0 for v in out.values())
+    calls.clear()
+    none = _side_by_side({"a": solver("a")}, poses, single=0, batch=12, repeats=1)
+    assert none["a"]["single_us"] is None and not [c for c in calls if c[1] == "one"]
+
+
 def test_bench_arms_unknown_robot_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["bench", "--arms", "ur5", "nosuchbot", "--single", "1"]) == 2
     captured = capsys.readouterr()

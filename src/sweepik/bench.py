@@ -8,7 +8,7 @@ On the bundled C-Arm (the default):
 
 On every bundled arm (``sweepik bench --arms``, :func:`bench_arms`): single-pose median, batched time per pose and
 peak memory, side by side with the other all-solutions solvers installed (:mod:`sweepik.peers`) on the same poses,
-each row flagged against the speed targets (``ARM_TARGETS``).
+timed in turn with them (``_side_by_side``), each row flagged against the speed targets (``ARM_TARGETS``).
 
 Benchmarks are not tests: nothing here asserts a speed.
 """
@@ -245,12 +245,38 @@ ARM_TARGETS = {
 }
 
 
-def _median_us(fn: Any, poses: Array) -> float:
-    return float(np.median(_latencies(fn, poses)) * 1e6)
-
-
-def _batch_us(fn: Any, poses: Array, repeats: int) -> float:
-    return _best_seconds(fn, poses, repeats) / len(poses) * 1e6
+def _side_by_side(
+    solvers: dict[Any, tuple[Any, Any]], poses: Array, single: int, batch: int, repeats: int
+) -> dict[Any, dict[str, Any]]:
+    """``{label: {"single_us", "batched_us"}}`` of ``solvers`` (``{label: (one pose -> ..., poses -> ...)}``) on the
+    same poses, timed in turn rather than one after the other: each pose of the latency test by each solver in turn
+    (median of ``single`` poses; None for 0), each batched run of ``batch`` poses likewise (best of ``repeats``).
+    The machine's speed drifts over minutes (by up to ~1.8x on the development machine); interleaved, the ratio of
+    two solvers' times is that of the same moments."""
+    lat = {k: np.empty(single) for k in solvers}
+    for one, _ in solvers.values():  # (warm-up: imports, compilation, caches)
+        if single:
+            one(poses[0])
+    for i, T in enumerate(poses[:single]):
+        for k, (one, _) in solvers.items():
+            t0 = time.perf_counter()
+            one(T)
+            lat[k][i] = time.perf_counter() - t0
+    for _, many in solvers.values():
+        many(poses[:8])
+    best = dict.fromkeys(solvers, np.inf)
+    for _ in range(repeats):
+        for k, (_, many) in solvers.items():
+            t0 = time.perf_counter()
+            many(poses[:batch])
+            best[k] = min(best[k], time.perf_counter() - t0)
+    return {
+        k: {
+            "single_us": float(np.median(lat[k]) * 1e6) if single else None,
+            "batched_us": best[k] / batch * 1e6,
+        }
+        for k in solvers
+    }
 
 
 def _flags(
@@ -322,22 +348,20 @@ def bench_arms(
         variants: dict[str, dict[str, Any]] = {"sweepik": {"reduction": "auto", "locked": locked}}
         if robot.default_reduction:
             variants[f"sweepik {robot.default_reduction}"] = {"reduction": robot.default_reduction}
-        for label, kw in variants.items():
-            row[label] = {
-                "single_us": _median_us(lambda T, kw=kw, r=robot: solve(r, T, **kw), poses[:single])
-                if single
-                else None,
-                "batched_us": _batch_us(lambda Ts, kw=kw, r=robot: solve_many(r, Ts, **kw), poses[:batch], repeats),
-            }
-        fastest = min((row[v] for v in variants), key=lambda c: c["batched_us"])
+        solvers = {
+            label: (
+                lambda T, kw=kw, r=robot: solve(r, T, **kw),
+                lambda Ts, kw=kw, r=robot: solve_many(r, Ts, **kw),
+            )
+            for label, kw in variants.items()
+        }
         solved = hold_joints(robot, locked).arm if locked else robot
         row["ssik"] = ssik_status(solved)
-        peers = {}
-        for peer, (one, many) in peers_for(solved).items():
-            peers[peer] = {
-                "single_us": _median_us(one, poses[:single]) if single else None,
-                "batched_us": _batch_us(many, poses[:batch], repeats),
-            }
+        theirs = peers_for(solved)
+        timed = _side_by_side({**solvers, **{("peer", p): f for p, f in theirs.items()}}, poses, single, batch, repeats)
+        row.update({label: timed[label] for label in variants})
+        fastest = min((row[v] for v in variants), key=lambda c: c["batched_us"])
+        peers = {peer: timed[("peer", peer)] for peer in theirs}
         row["peers"] = peers
         if memory and not locked and isinstance(arm, str):  # (the child process loads the arm by name or path)
             row["peak_rss_mib"] = bench_memory(memory, arm)["peak_rss_mib"]
