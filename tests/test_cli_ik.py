@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import load_robot
+from sweepik import bench, load_robot
 from sweepik.cli import main
 from sweepik.pose import xyz_zyz_from_pose
 
@@ -137,12 +137,15 @@ def test_bench_arms_small(capsys: pytest.CaptureFixture[str]) -> None:
     assert table.splitlines()[0].startswith("arm") and "ur5" in table and "ssik single/batched" in table
 
 
-def test_bench_times_the_solvers_of_an_arm_in_turn() -> None:
-    """``bench._side_by_side`` times each pose, then each batched run, by every solver in turn (so that the machine's
-    drifting speed falls on all of them alike), after one warm-up call of each; medians and bests per solver."""
+def test_bench_times_the_solvers_of_an_arm_in_turn(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``bench._side_by_side`` times blocks of poses, then each batched run, by every solver in turn (so that the
+    machine's drifting speed falls on all of them alike), after one warm-up call of each; medians and bests per
+    solver."""
     import numpy as np
 
     from sweepik.bench import _side_by_side
+
+    monkeypatch.setattr(bench, "SINGLE_BLOCK", 2)
 
     calls: list[tuple[str, str, int]] = []
 
@@ -152,7 +155,8 @@ def test_bench_times_the_solvers_of_an_arm_in_turn() -> None:
     poses = np.arange(20, dtype=float)[:, None, None] * np.ones((1, 4, 4))
     out = _side_by_side({"a": solver("a"), ("peer", "b"): solver("b")}, poses, single=3, batch=12, repeats=2)
     singles = [c for c in calls if c[1] == "one"]
-    assert singles == [("a", "one", 0), ("b", "one", 0)] + [(n, "one", i) for i in range(3) for n in "ab"]
+    blocks = [("a", "one", 0), ("a", "one", 1), ("b", "one", 0), ("b", "one", 1), ("a", "one", 2), ("b", "one", 2)]
+    assert singles == [("a", "one", 0), ("b", "one", 0), *blocks]
     batches = [c for c in calls if c[1] == "many"]
     assert batches == [("a", "many", 8), ("b", "many", 8)] + [(n, "many", 12) for _ in range(2) for n in "ab"]
     assert set(out) == {"a", ("peer", "b")} and all(v["single_us"] > 0 and v["batched_us"] > 0 for v in out.values())

@@ -245,23 +245,30 @@ ARM_TARGETS = {
 }
 
 
+#: Poses a solver solves one by one before the next solver's turn (``_side_by_side``).
+SINGLE_BLOCK = 25
+
+
 def _side_by_side(
     solvers: dict[Any, tuple[Any, Any]], poses: Array, single: int, batch: int, repeats: int
 ) -> dict[Any, dict[str, Any]]:
     """``{label: {"single_us", "batched_us"}}`` of ``solvers`` (``{label: (one pose -> ..., poses -> ...)}``) on the
-    same poses, timed in turn rather than one after the other: each pose of the latency test by each solver in turn
-    (median of ``single`` poses; None for 0), each batched run of ``batch`` poses likewise (best of ``repeats``).
-    The machine's speed drifts over minutes (by up to ~1.8x on the development machine); interleaved, the ratio of
-    two solvers' times is that of the same moments."""
+    same poses, timed in turn rather than one after the other: the latency test's poses in blocks of ``SINGLE_BLOCK``,
+    each block by each solver in turn (median of ``single`` poses; None for 0), each batched run of ``batch`` poses
+    likewise (best of ``repeats``). The machine's speed drifts over minutes (by up to ~1.8x on the development
+    machine); interleaved, the ratio of two solvers' times is that of the same moments. (Pose by pose, each solver
+    would evict the other's code and data from the caches between two calls: blocks keep single calls warm.)"""
     lat = {k: np.empty(single) for k in solvers}
     for one, _ in solvers.values():  # (warm-up: imports, compilation, caches)
         if single:
             one(poses[0])
-    for i, T in enumerate(poses[:single]):
+    for s in range(0, single, SINGLE_BLOCK):
+        block = poses[s : min(s + SINGLE_BLOCK, single)]
         for k, (one, _) in solvers.items():
-            t0 = time.perf_counter()
-            one(T)
-            lat[k][i] = time.perf_counter() - t0
+            for i, T in enumerate(block, s):
+                t0 = time.perf_counter()
+                one(T)
+                lat[k][i] = time.perf_counter() - t0
     for _, many in solvers.values():
         many(poses[:8])
     best = dict.fromkeys(solvers, np.inf)
