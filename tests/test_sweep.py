@@ -684,3 +684,19 @@ def test_edge_samples_far_from_zero_are_no_candidates(engine: str, monkeypatch: 
     f = red.residual(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
     assert cand.theta.size >= 4 * len(chain)  # (the arm's roots: 7.8 solutions a pose on average)
     assert np.all(np.abs(f) <= sweep.FAR_NOISE * red.residual_noise)
+
+
+@pytest.mark.parametrize("name", ["xarm6", "kuka_kr6_r900", "kinova_jaco2", "fanuc_crx10ia", "ur5"])
+def test_compiled_parameter_rows_are_the_numpy_ones(name: str) -> None:
+    """A generic sweep's parameter rows (``geometric.pose_rows``) are those NumPy computes, to rounding (the sums run
+    in another order), on arms with a reversed chain (xArm 6), a base and a tool transform (KR6 R900), a base
+    (JACO2), a tool (CRX-10iA) or neither (UR5); the probing rows too."""
+    from sweepik import solver
+
+    robot = load_robot(name)
+    red = sweepik.get_reduction(robot, "auto")
+    chain = solver._chain_poses(robot, robot.fk(np.random.default_rng(9).uniform(robot.lower, robot.upper, (40, 6))))
+    for probing in (False, True):
+        fast, ref = red._params(chain, probing), red._params_numpy(chain, probing)
+        assert fast.shape == ref.shape
+        np.testing.assert_allclose(fast, ref, rtol=0, atol=1e-14 * max(1.0, robot.length_scale))
