@@ -334,6 +334,14 @@ if AVAILABLE:
             start[g] += 1
         return order
 
+    @inlined
+    def _group_stop(pose, order, start):  # pragma: no cover
+        """The end of the pose's group that starts at ``start`` in ``_group_order``'s ``order``."""
+        stop = start + 1
+        while stop < order.shape[0] and pose[order[stop]] == pose[order[start]]:
+            stop += 1
+        return stop
+
     @lazy_njit(
         (int64[::1], float64[:, ::1], boolean[::1], boolean[::1], float64[::1], int64[:, ::1], int64[::1]), cache=True
     )
@@ -344,9 +352,7 @@ if AVAILABLE:
         c = 0
         start = 0
         while start < K:
-            stop = start + 1
-            while stop < K and pose[order[stop]] == pose[order[start]]:
-                stop += 1
+            stop = _group_stop(pose, order, start)
             for x in range(start, stop):
                 a = order[x]
                 if not keep[a]:
@@ -391,9 +397,7 @@ if AVAILABLE:
         order = _group_order(pose)
         start = 0
         while start < K:
-            stop = start + 1
-            while stop < K and pose[order[stop]] == pose[order[start]]:
-                stop += 1
+            stop = _group_stop(pose, order, start)
             for a in range(start, stop):
                 i = order[a]
                 for b in range(start, stop):

@@ -24,7 +24,14 @@ from . import fastsweep
 from .dedupe import _tolerance, limit_args
 from .fastcertify import chain_args
 from .fastsweep import AVAILABLE, _plan, writable
-from .reductions.kernels import CONFIGURATION_SIG, CONFIGURATIONS_SIG, address_of, lazy_njit, owned_kernel
+from .reductions.kernels import (
+    CONFIGURATION_SIG,
+    CONFIGURATIONS_SIG,
+    address_of,
+    defining_class,
+    lazy_njit,
+    owned_kernel,
+)
 from .sweep import _unit_grid
 from .units import orientation_weight
 
@@ -228,10 +235,6 @@ def _tail(robot: Any, thresholds: tuple[float, ...], reach: Array) -> tuple[Any,
     return (H, P, crev, R_end, weight, *settling)
 
 
-def _owner(red: Any, name: str) -> type | None:
-    return next((c for c in type(red).__mro__ if name in vars(c)), None)
-
-
 def _fixed(
     robot: Any, red: Any, n_samples: int, thresholds: tuple[float, ...], reach: Array, seed_tol: float
 ) -> _Fixed | None:
@@ -243,7 +246,8 @@ def _fixed(
         one = plan.one_pass
         if one is None or not (one.n_samples is None or one.n_samples == n_samples):
             return None
-        if _owner(red, "continuum_joints") is not _owner(red, "continuum_kernel"):
+        cls = red.__class__
+        if defining_class(cls, "continuum_joints") is not defining_class(cls, "continuum_kernel"):
             return None
         addr = np.zeros(_A_SIZE, dtype=np.int64)
         addr[_A_SEARCH] = address_of(one.kernel, _ONE_PASS_FN_SIG)

@@ -946,11 +946,13 @@ def _solve_one(
         and n_samples == N_SAMPLES
         and isinstance(robot, Robot)
     ):  # (the default options: their checks done once per robot)
-        red = _default_reduction(robot)
-        return _solve_chunk(robot, red, P, "precise", True, N_SAMPLES).solutions(0, copy=False)
-    held = _held(robot, locked)
-    arm = robot if held is None else held.arm
-    red, strategy, limits, n_samples, _ = _prepare(arm, P, reduction, strategy, limits, n_samples, 1, free_joint, held)
+        held, arm, red = None, robot, _default_reduction(robot)
+    else:
+        held = _held(robot, locked)
+        arm = robot if held is None else held.arm
+        red, strategy, limits, n_samples, _ = _prepare(
+            arm, P, reduction, strategy, limits, n_samples, 1, free_joint, held
+        )
     return _expanded(_solve_chunk(arm, red, P, strategy, limits, n_samples), held).solutions(0, copy=False)
 
 

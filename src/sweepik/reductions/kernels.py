@@ -218,9 +218,14 @@ def owned_kernel(reduction: Any, name: str) -> Any:
 
 
 @cache
+def defining_class(cls: type, name: str) -> type | None:
+    """The class of ``cls``'s MRO that sets ``name`` (None: none does). Cached: every solve asks."""
+    return next((c for c in cls.__mro__ if name in vars(c)), None)
+
+
 def kernel_owner(cls: type) -> type | None:
-    """The class of ``cls``'s MRO that sets ``kernel`` (None: none does). Cached: every solve asks."""
-    return next((c for c in cls.__mro__ if "kernel" in vars(c)), None)
+    """The class of ``cls``'s MRO that sets ``kernel`` (None: none does)."""
+    return defining_class(cls, "kernel")
 
 
 _ADDRESSES: dict[Any, tuple[int, Any, set[int]]] = {}
