@@ -686,6 +686,50 @@ def test_edge_samples_far_from_zero_are_no_candidates(engine: str, monkeypatch: 
     assert np.all(np.abs(f) <= sweep.FAR_NOISE * red.residual_noise)
 
 
+@pytest.mark.parametrize("name", ["fanuc_crx10ia", "xarm6"])
+def test_edge_intervals_left_alone_hide_no_roots(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """An interval beside a branch-domain edge that sits at a sample is resampled at the first level only where it
+    bends in that edge's coordinate (``sweep.EDGE_PROBE_REL``). Those left alone hide no pair of roots: sampled
+    densely (in the edge's coordinate, where a pair would sit), the residual changes sign exactly as often as its two
+    ends show (once or not at all), and comes no nearer zero than they do unless it crosses. Random poses and poses
+    on the singular set (joints at 0 and 90 deg)."""
+    from sweepik import solver, sweep
+
+    monkeypatch.setattr(fastsweep, "AVAILABLE", False)
+    robot = load_robot(name)
+    red = sweepik.get_reduction(robot, None)
+    rng = np.random.default_rng(8)
+    q = rng.uniform(robot.lower, robot.upper, (40, 6))
+    q[20:30, 4] = 0.0
+    q[30:, 2] = np.pi / 2
+    chain = solver._chain_poses(robot, robot.fk(q))
+    lo, hi = solver._theta_range(robot, red, chain)
+    seen: list[tuple[Any, ...]] = []
+    judge = sweep._Search._edge_at_sample
+
+    def recorded(self: Any, p: Any, b: Any, th: Any, fin: Any, *rest: Any) -> Any:
+        judged, bent = judge(self, p, b, th, fin, *rest)
+        i, j = np.nonzero(judged & ~bent)
+        seen.append((p[i], b[i], th[i, j], th[i, j + 1], fin[i, j], fin[i, j + 1], rest[2][i, j + 1]))
+        return judged, bent
+
+    monkeypatch.setattr(sweep._Search, "_edge_at_sample", recorded)
+    sweep.find_candidates(red, chain, lo, hi, sweep.N_SAMPLES)
+    p, b, t0, t1, f0, f1, right = (np.concatenate(c) for c in zip(*seen, strict=True))
+    assert p.size >= len(chain)  # (most edges' intervals are left alone: the test is not vacuous)
+    # dense samples, uniform in sqrt(|theta - edge|)
+    edge, other = np.where(right, t1, t0), np.where(right, t0, t1)
+    x = np.linspace(0.0, 1.0, 2001)[None, :] ** 2
+    dense = edge[:, None] + (other - edge)[:, None] * x
+    f = red.residual(chain[p], dense, np.broadcast_to(b[:, None], dense.shape))
+    assert np.isfinite(f).all()
+    changes = np.count_nonzero(np.sign(f[:, 1:]) * np.sign(f[:, :-1]) < 0, axis=1)
+    crosses = f0 * f1 < 0
+    np.testing.assert_array_equal(changes, crosses.astype(int))
+    ends = np.minimum(np.abs(f0), np.abs(f1))
+    assert np.all(crosses | (np.abs(f).min(axis=1) >= 0.5 * ends))
+
+
 @pytest.mark.parametrize("name", ["xarm6", "kuka_kr6_r900", "kinova_jaco2", "fanuc_crx10ia", "ur5"])
 def test_compiled_parameter_rows_are_the_numpy_ones(name: str) -> None:
     """A generic sweep's parameter rows (``geometric.pose_rows``) are those NumPy computes, to rounding (the sums run

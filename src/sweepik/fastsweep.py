@@ -65,6 +65,7 @@ JUMP_NOISE = _ref.JUMP_NOISE
 MULT_LEVEL = _ref.MULT_LEVEL
 MULT_MAX = _ref.MULT_MAX
 FAR_NOISE = _ref.FAR_NOISE
+EDGE_PROBE_REL = _ref.EDGE_PROBE_REL
 #: Candidates and family spans kept per pose (the C-Arm has at most 8 rail positions; edges and near misses add
 #: candidates). Overflow is reported and the pose is redone by the NumPy engine.
 MAX_CAND = 256
@@ -287,6 +288,28 @@ if AVAILABLE:
                 side = 1
         return x
 
+    @inlined
+    def _edge_bent(res, p, b, th, f, valid, fmask, j, right, span, otherwise):
+        """Level 0: whether interval j, next to one domain edge (on its ``right`` or left), is resampled, as
+        ``sweep._Search._edge_at_sample``: where the edge sits at its open-side sample (the residual just past it is
+        NaN), by the bend test in that edge's coordinate; elsewhere ``otherwise``."""
+        M = th.shape[0]
+        if right:
+            e, n1, n2, side = j + 1, j, j - 1, 1.0
+            masked = j + 2 < M and fmask[j + 2]
+        else:
+            e, n1, n2, side = j, j + 1, j + 2, -1.0
+            masked = j >= 1 and fmask[j - 1]
+        if masked or n2 < 0 or n2 >= M or not valid[n2]:
+            return otherwise
+        te = th[e]
+        x1 = math.sqrt(abs(th[n1] - te))
+        x2 = math.sqrt(abs(th[n2] - te))
+        dd = 2.0 * ((f[n2] - f[n1]) / (x2 - x1) - (f[n1] - f[e]) / x1) / x2
+        if not math.isfinite(dd) or not math.isnan(res(p, te + side * EDGE_PROBE_REL * span, b)):
+            return otherwise
+        return min(abs(f[e]), abs(f[n1])) <= BEND * abs(dd) * x1 * x1
+
     @internal
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
@@ -369,6 +392,8 @@ if AVAILABLE:
                 bend = (not math.isnan(curv)) and lowest <= BEND * curv * h * h
                 own_edge = (open_l and th[j] == xe and not open_r) or (open_r and th[j + 1] == xe and not open_l)
                 refine = bend or (near_edge and not own_edge)
+                if level == 0 and open_l != open_r:  # (one edge: at a sample, judged in its coordinate)
+                    refine = _edge_bent(res, p, b, th, f, valid, fmask, j, open_r, span, refine)
             if refine:
                 if top[0] >= stk_t.shape[0]:
                     cnt[0] += out_t.shape[0] + 1  # overflow: the caller redoes this pose with NumPy

@@ -44,10 +44,11 @@ N_SAMPLES = 64
 SUB_SAMPLES = 8
 MAX_LEVELS = 4
 #: An interval is resampled when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola dips h^2 |f''| / 8
-#: below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step), and always next to
-#: a domain edge at the first level (square-root behaviour there: no curvature estimate in theta). Below that,
-#: curvature is judged in the coordinate sqrt(|theta - edge|), in which the residual is smooth
-#: (``_edge_coordinate``): the intervals next to the edge are resampled only where that test says so.
+#: below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step). Next to a domain edge
+#: (square-root behaviour: no curvature estimate in theta) curvature is judged in the coordinate
+#: sqrt(|theta - edge|), in which the residual is smooth (``_edge_coordinate``), and the interval is resampled only
+#: where that test says so; at the first level only where the edge sits at a sample (``EDGE_PROBE_REL``), else
+#: always.
 BEND = 1.0
 #: An interior extremum of |residual| is examined only if its sample is within EXTREMUM_REACH |f''| h^2 of
 #: zero: 8 times the deepest dip a parabola through the three samples can have (|f''| h^2 / 2).
@@ -97,6 +98,10 @@ MULT_MAX = 8
 #: farther from zero are no candidates either; next to a family's samples (masked as NaN) they stay candidates
 #: whatever their residual: their flat-stretch probe can join two pieces of the family.
 FAR_NOISE = 1e12
+#: A domain edge sits at a sample (a generic sweep's margins' zeros are samples) when its branch's residual is NaN
+#: this far past it (relative to the theta* range): the first level then judges the interval beside it in that
+#: edge's coordinate, as the levels below do (``BEND``).
+EDGE_PROBE_REL = 1e-9
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
 XTOL_REL = 1e-16
 #: Half-step of the central difference used to locate extrema, relative to the theta* range.
@@ -238,6 +243,8 @@ class _Search:
         self.spans = Spans.empty()
         #: |residual| above which a sample or extremum is no candidate (see ``FAR_NOISE``)
         self.far = FAR_NOISE * reduction.residual_noise
+        #: a signed residual (analytic along a branch), not the pose error's norm (kinked where it vanishes)
+        self.signed = not isinstance(reduction, PoseErrorResidual)
 
     def residual(self, pose: IntArray, branch: IntArray, theta: Array) -> Array:
         """Residual ``(K, M)`` of one branch per row."""
@@ -370,7 +377,11 @@ class _Search:
                     open_r[:, 1:] & (t1 == ex) & ~open_l[:, :-1]
                 )
             nonzero = np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0
-            refine = both & nonzero & (bend | (near_edge & ~own_edge))
+            refine = bend | (near_edge & ~own_edge)
+            if level == 0 and self.signed:  # (an edge at a sample: in its coordinate)
+                judged, bent = self._edge_at_sample(p, b, th, fin, both, open_l, open_r, family)
+                refine = np.where(judged, bent, refine)
+            refine &= both & nonzero
         else:
             refine = np.zeros_like(both)
         s_i, s_j = np.nonzero(both & ~refine & (prod < 0))
@@ -401,6 +412,57 @@ class _Search:
         el, er = open_l[r_i, r_j], open_r[r_i, r_j + 1]
         ex = np.where(el & ~er, th[r_i, r_j], np.where(er & ~el, th[r_i, r_j + 1], np.where(el, np.nan, edge_x[r_i])))
         self.scan(pp, bb, sub, fs, vs, level + 1, el, er, (cl_t, cl_f, cr_t, cr_f), ex)
+
+    def _edge_at_sample(
+        self,
+        p: IntArray,
+        b: IntArray,
+        th: Array,
+        fin: Array,
+        both: NDArray[np.bool_],
+        open_l: NDArray[np.bool_],
+        open_r: NDArray[np.bool_],
+        family: NDArray[np.bool_] | None,
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+        """Level-0 intervals ``(S, M - 1)`` next to one domain edge that sits at their open-side sample (the residual
+        just past it is NaN), and which of them bend in that edge's coordinate (judged from the interval and its
+        other neighbour: the test the interval's sub-intervals get, ``_edge_coordinate``)."""
+        S, M = th.shape
+        judged = np.zeros((S, M - 1), dtype=bool)
+        bent_out = np.zeros((S, M - 1), dtype=bool)
+        if M < 3:
+            return judged, bent_out
+        o_l, o_r = open_l[:, :-1], open_r[:, 1:]
+        if family is not None:  # (a family's masked samples are no domain edge)
+            no = np.zeros((S, 1), dtype=bool)
+            o_l = o_l & ~np.concatenate([no, family[:, :-2]], axis=1)
+            o_r = o_r & ~np.concatenate([family[:, 2:], no], axis=1)
+        right = both & o_r & ~open_l[:, :-1]  # interval j's sample j + 1 borders the edge
+        left = both & o_l & ~open_r[:, 1:]
+        right[:, 0] = False  # (the sample on the other side is needed)
+        left[:, -1] = False
+        i_r, j_r = np.nonzero(right)
+        i_l, j_l = np.nonzero(left)
+        i = np.concatenate([i_r, i_l])
+        e = np.concatenate([j_r + 1, j_l])  # the sample at the edge
+        n1 = np.concatenate([j_r, j_l + 1])  # its neighbour, then the next one
+        n2 = np.concatenate([j_r - 1, j_l + 2])
+        side = np.concatenate([np.ones(j_r.size), -np.ones(j_l.size)])  # the edge's side
+        if i.size == 0:
+            return judged, bent_out
+        ok = np.isfinite(fin[i, n2])
+        te = th[i, e]
+        x1, x2 = np.sqrt(np.abs(th[i, n1] - te)), np.sqrt(np.abs(th[i, n2] - te))
+        f0, f1, f2 = fin[i, e], fin[i, n1], fin[i, n2]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dd = 2.0 * ((f2 - f1) / (x2 - x1) - (f1 - f0) / x1) / x2
+            bent = np.minimum(np.abs(f0), np.abs(f1)) <= BEND * np.abs(dd) * x1 * x1
+        step = EDGE_PROBE_REL * self.span[p[i]]
+        past = self.residual(p[i], b[i], (te + side * step)[:, None])[:, 0]
+        at = ok & np.isfinite(dd) & ~np.isfinite(past)
+        judged[i_r, j_r], judged[i_l, j_l] = at[: j_r.size], at[j_r.size :]
+        bent_out[i_r, j_r], bent_out[i_l, j_l] = bent[: j_r.size], bent[j_r.size :]
+        return judged, bent_out
 
     def _extrema(
         self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array, fa: Array, fb: Array
