@@ -292,7 +292,7 @@ if AVAILABLE:
     def _edge_bent(res, p, b, th, f, valid, fmask, j, right, span, otherwise):
         """Level 0: whether interval j, next to one domain edge (on its ``right`` or left), is resampled, as
         ``sweep._Search._edge_at_sample``: where the edge sits at its open-side sample (the residual just past it is
-        NaN), by the bend test in that edge's coordinate; elsewhere ``otherwise``."""
+        not finite), by the bend test in that edge's coordinate; elsewhere ``otherwise``."""
         M = th.shape[0]
         if right:
             e, n1, n2, side = j + 1, j, j - 1, 1.0
@@ -306,7 +306,7 @@ if AVAILABLE:
         x1 = math.sqrt(abs(th[n1] - te))
         x2 = math.sqrt(abs(th[n2] - te))
         dd = 2.0 * ((f[n2] - f[n1]) / (x2 - x1) - (f[n1] - f[e]) / x1) / x2
-        if not math.isfinite(dd) or not math.isnan(res(p, te + side * EDGE_PROBE_REL * span, b)):
+        if not math.isfinite(dd) or math.isfinite(res(p, te + side * EDGE_PROBE_REL * span, b)):
             return otherwise
         return min(abs(f[e]), abs(f[n1])) <= BEND * abs(dd) * x1 * x1
 
