@@ -1,5 +1,5 @@
 """The one-call path of a single pose (``fastsolve.settle_one``, ``fastsolve.settle_closed``,
-``solver._settled_single``) gives what the general path gives, bit for bit, and hands the poses it cannot settle
+``solver._settled``) gives what the general path gives, bit for bit, and hands the poses it cannot settle
 to it."""
 
 from __future__ import annotations
@@ -39,11 +39,12 @@ def _assert_same(a: sweepik.Solutions, b: sweepik.Solutions) -> None:
         np.testing.assert_array_equal(x, y)
     assert len(a.families) == len(b.families)
     assert a.reason == b.reason
+    np.testing.assert_array_equal(a.pose, b.pose)
 
 
 def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, poses: np.ndarray, **kw: Any) -> list[Any]:
     with monkeypatch.context() as m:
-        m.setattr(solver, "_settled_single", lambda *args: None)
+        m.setattr(solver, "_settled", lambda *args: None)
         return [sweepik.solve(robot, T, **kw) for T in poses]
 
 
@@ -96,6 +97,25 @@ def test_one_call_is_the_general_path(
     poses = _poses(robot, 5)
     seen = _both_ways(monkeypatch, robot, poses, reduction=reduction, limits=limits)
     assert seen[fastsolve.OK] >= len(poses) // 2  # (the one-call path is what is tested)
+
+
+@pytest.mark.parametrize("name", ["ur5", "fanuc_crx10ia", "carm"])
+def test_unreachable_poses_and_meeting_branches(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A pose out of reach gets the general path's empty solutions and reason from the one call; a closed form's
+    branches that meet (UR5 with joint 3 at 0: the elbow straight, a double root the closed form's rounding splits
+    in two) are handed over (``MEET``) and merged the general way into one solution of multiplicity 2."""
+    robot = load_robot(name)
+    far = np.eye(4)
+    far[:3, 3] = 10.0 * robot.length_scale
+    seen = _both_ways(monkeypatch, robot, far[None])
+    assert seen[fastsolve.OK] == 1
+    sol = sweepik.solve(robot, far)
+    assert len(sol) == 0 and sol.reason is not None and "unreachable" in sol.reason
+    if name == "ur5":
+        q = np.random.default_rng(13).uniform(robot.lower, robot.upper, (6, 6))
+        q[:, 2] = 0.0
+        assert _both_ways(monkeypatch, robot, robot.fk(q)) == {fastsolve.MEET: len(q)}
+        assert all((sweepik.solve(robot, T).multiplicity == 2).any() for T in robot.fk(q))
 
 
 def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -31,6 +31,13 @@ __all__ = ["SolutionBatch", "Block"]
 UNREACHABLE = "unreachable: no configuration of the arm reaches this pose"
 
 
+def no_solution_reason(n_reachable: int) -> str:
+    """Why a pose has no solution (nor family), given how many solutions it has before the joint limits."""
+    if n_reachable > 0:
+        return f"out of joint limits: {n_reachable} solution(s) reach the pose but violate the limits"
+    return UNREACHABLE
+
+
 @dataclass(frozen=True, eq=False)
 class Block:
     """The solutions of a chunk of ``n`` poses, rows sorted by pose: pose ``i`` owns rows
@@ -60,9 +67,7 @@ class Block:
             return None
         if self.empty_reason is not None:
             return self.empty_reason
-        if self.n_reachable[i] > 0:
-            return f"out of joint limits: {self.n_reachable[i]} solution(s) reach the pose but violate the limits"
-        return UNREACHABLE
+        return no_solution_reason(int(self.n_reachable[i]))
 
     def solutions(self, i: int, copy: bool = True) -> Solutions:
         """The :class:`Solutions` of pose ``i``: arrays copied (the block stays as it is), or views of the block's

@@ -35,7 +35,7 @@ from .reductions.kernels import (
 from .sweep import _unit_grid
 from .units import orientation_weight
 
-__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "CONTINUUM", "Settled", "settle_one", "settle_closed"]
+__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "CONTINUUM", "MEET", "Settled", "settle_one", "settle_closed"]
 
 Array = NDArray[np.float64]
 
@@ -45,26 +45,31 @@ OK = 0
 SEARCH_ELSEWHERE = 1
 #: ... a candidate is due one of the solver's rarer steps (a polish, a snap to a limit) ...
 DUE = 2
-#: ... or a continuum may run along another joint through a certified one (``Reduction.continuum_joints``).
+#: ... or a continuum may run along another joint through a certified one (``Reduction.continuum_joints``) ...
 CONTINUUM = 3
+#: ... or two branches of a closed form meet (one dropped as the other's duplicate, or two kept within the reach
+#: given, ``solver.MEET_REL``): the solver merges them into one solution of higher multiplicity.
+MEET = 4
 
 
 class Settled(NamedTuple):
-    """``settle_one``'s result: the candidates (theta*, branch, multiplicity), their configurations and errors
-    (``q``, ``err_geo``, ``err_paper``), and of the certified ones (``rows``, in order) the wrapped configurations
-    ``w``, ``inside`` the limits and ``keep`` (not a duplicate); all empty unless ``status`` is ``OK``."""
+    """``settle_one``'s result: the pose's solutions as the solver's block holds them (``q`` wrapped, ``error``,
+    ``error_geodesic``, ``within_limits``, ``multiplicity``: the certified candidates that are no duplicate, in order,
+    with ``only_inside`` those within the limits), how many certified candidates there were (``certified``) and how
+    many of them are no duplicate (``reachable``); all empty unless ``status`` is ``OK``. A closed form's also has
+    every branch's theta* (0), branch and geodesic error (``theta``, ``branch``, ``err_all``; empty for a sweep)."""
 
     status: int
+    certified: int
+    reachable: int
+    q: Array
+    error: Array
+    error_geodesic: Array
+    within_limits: NDArray[np.bool_]
+    multiplicity: NDArray[np.int64]
     theta: Array
     branch: NDArray[np.int64]
-    mult: NDArray[np.int64]
-    q: Array
-    err_geo: Array
-    err_paper: Array
-    rows: NDArray[np.int64]
-    w: Array
-    inside: NDArray[np.bool_]
-    keep: NDArray[np.bool_]
+    err_all: Array
 
 
 if AVAILABLE:
@@ -72,7 +77,7 @@ if AVAILABLE:
     from numba import void as _void
 
     from ._jit import function_at, internal
-    from .dedupe import _SETTLE_SIG, _settle
+    from .dedupe import _SETTLE_SIG, _rows_within, _settle
     from .fastcertify import _CERTIFY_EVERY_SIG, _CERTIFY_SIG, _certify, _certify_every_branch
     from .fastsweep import _ONE_PASS_SIG
     from .reductions.geometric import _CONTINUUM_SIG, _continuum_rows
@@ -107,24 +112,51 @@ if AVAILABLE:
         )  # fmt: skip
         return due[0], ints[2], rows, w, inside, keep
 
+    @internal
+    def _final(c, rows, w, inside, keep, eg, ep, mult, only_inside):
+        """The solutions of the ``c`` settled candidates (``_settled``'s): the rows kept (with ``only_inside``, those
+        within the limits too), in order, as the solver's block holds them; and how many were kept."""
+        n = w.shape[1]
+        reachable, m = 0, 0
+        for k in range(c):
+            if keep[k]:
+                reachable += 1
+                if inside[k] or not only_inside:
+                    m += 1
+        q = np.empty((m, n))
+        e_p = np.empty(m)
+        e_g = np.empty(m)
+        ins = np.empty(m, dtype=np.bool_)
+        mu = np.empty(m, dtype=np.int64)
+        m = 0
+        for k in range(c):
+            if keep[k] and (inside[k] or not only_inside):
+                r = rows[k]
+                for j in range(n):
+                    q[m, j] = w[k, j]
+                e_p[m], e_g[m], ins[m], mu[m] = ep[r], eg[r], inside[k], mult[r]
+                m += 1
+        return reachable, q, e_p, e_g, ins, mu
+
     @lazy_njit(
         (int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], float64[::1], float64[:, ::1], float64[::1])
         + (float64[::1], float64[::1], float64[::1], float64[::1], float64[::1], int64[:, ::1], int64, int64)
         + (float64[::1], float64, float64[:, :, ::1], float64[:, ::1], float64[:, ::1], boolean[::1])
         + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-        + (float64[::1], float64[::1], float64, int64[::1], float64[::1]),
+        + (float64[::1], float64[::1], float64, int64[::1], float64[::1], boolean),
         cache=True,
         nogil=True,
     )
     def _settle_one(
         addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
         limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
-        c_joints, c_thr,
+        c_joints, c_thr, only_inside,
     ):  # pragma: no cover  # fmt: skip
         """``settle_one``'s kernel: pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``),
         certified and settled; ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped
         to them (``solver._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of
-        the continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds."""
+        the continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``only_inside``:
+        the solutions within the limits only (``_final``)."""
         # (np.empty and explicit loops: np.zeros, slice copies and the like each add to the first compilation)
         n = rev.shape[0]
         out_t = np.empty((1, max_cand))
@@ -172,31 +204,55 @@ if AVAILABLE:
             )
             if flagged > 0:
                 status, c = CONTINUUM, 0
-        return status, c, theta, branch, mult, q, eg, ep, rows, w, inside, keep
+        reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
+        return status, c, reachable, qf, e_p, e_g, ins, mu
 
     @lazy_njit(
         (int64[::1], float64[:, ::1], float64[:, :, ::1], int64, float64[:, ::1], float64[:, ::1], boolean[::1])
         + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-        + (float64[::1], float64[::1], float64),
+        + (float64[::1], float64[::1], float64, float64[::1], boolean),
         cache=True,
         nogil=True,
     )
     def _settle_closed(
-        addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
-    ):  # pragma: no cover
+        addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
+        meet, only_inside,
+    ):  # pragma: no cover  # fmt: skip
         """``settle_closed``'s kernel: every branch of pose 0 of ``params``/``world`` (the all-branch configuration
-        kernel at ``addr[_A_CFG]``) certified and settled."""
+        kernel at ``addr[_A_CFG]``) certified and settled; ``MEET`` where a branch is dropped as another's duplicate
+        or two kept ones are within ``meet`` (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``)."""
         q = np.empty((nb, rev.shape[0]))
         eg = np.empty(nb)
         ep = np.empty(nb)
         _as_every(addr[_A_CERTIFY])(addr[_A_CFG], params, world, nb, H, P, rev, R_end, weight, q, eg, ep, 0, 1)
         pose = np.empty(nb, dtype=np.int64)
+        mult = np.empty(nb, dtype=np.int64)
         for k in range(nb):
-            pose[k] = 0
+            pose[k], mult[k] = 0, 1
         due, c, rows, w, inside, keep = _settled(
             addr[_A_SETTLE], q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
         )
-        return (DUE if due else OK), (0 if due else c), q, eg, ep, rows, w, inside, keep
+        status = DUE if due else OK
+        for a in range(c if status == OK else 0):
+            if not keep[a]:
+                status = MEET
+                break
+            for b in range(a + 1, c):
+                if _rows_within(w, a, b, lrev, meet):
+                    status = MEET
+                    break
+            if status == MEET:
+                break
+        if status != OK:
+            c = 0
+        reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
+        return status, c, reachable, qf, e_p, e_g, ins, mu, eg
+
+
+_NONE = np.zeros(0)
+_NO_BRANCH = np.zeros(0, dtype=np.int64)
+for _a in (_NONE, _NO_BRANCH):
+    _a.flags.writeable = False
 
 
 class _Fixed(NamedTuple):
@@ -285,12 +341,14 @@ def settle_one(
     reach: Array,
     clip_rel: float,
     seed_tol: float,
+    only_inside: bool,
 ) -> Settled | None:
     """The one pose of ``chain``/``world (1, 4, 4)`` searched over ``[lo, hi]`` (``(1,)`` each), certified and settled
     in one compiled call, as the solver's general path does it (the same values); None where ``red`` has no one-pass
     search for ``n_samples`` (or without Numba). ``thresholds`` and ``reach``: ``dedupe.settle``'s; ``clip_rel``: the
     reach (relative to ``hi - lo``) within which a multiple root outside theta*'s limits is clipped to them;
-    ``seed_tol``: the pose error within which a candidate is checked for a continuum (``continuum_joints``)."""
+    ``seed_tol``: the pose error within which a candidate is checked for a continuum (``continuum_joints``);
+    ``only_inside``: the solutions within the joint limits only (the solver's ``limits``)."""
     if not AVAILABLE:
         return None
     fixed = _fixed(robot, red, n_samples, thresholds, reach, seed_tol)
@@ -301,17 +359,26 @@ def settle_one(
     clip = float(clip_rel * (hi[0] - lo[0]))
     p = np.ascontiguousarray(params, dtype=np.float64)
     buffers = (fastsweep.MAX_CAND, fastsweep.MAX_FAM)  # (read here: a test may cut them)
-    status, c, theta, branch, mult, q, eg, ep, rows, w, inside, keep = _settle_one(
-        *fixed.head, p, hlo, hhi, lo, hi, *fixed.middle, *buffers, fixed.limits, clip, writable(world), *fixed.tail
-    )
-    return Settled(status, theta, branch, mult, q, eg, ep, rows[:c], w[:c], inside[:c], keep[:c])
+    status, c, reachable, q, ep, eg, inside, mult = _settle_one(
+        *fixed.head, p, hlo, hhi, lo, hi, *fixed.middle, *buffers, fixed.limits, clip, writable(world), *fixed.tail,
+        bool(only_inside),
+    )  # fmt: skip
+    return Settled(status, c, reachable, q, ep, eg, inside, mult, _NONE, _NO_BRANCH, _NONE)
 
 
 def settle_closed(
-    robot: Any, red: Any, world: Array, params: Array, thresholds: tuple[float, float, float, float], reach: Array
+    robot: Any,
+    red: Any,
+    world: Array,
+    params: Array,
+    thresholds: tuple[float, float, float, float],
+    reach: Array,
+    meet: Array,
+    only_inside: bool,
 ) -> Settled | None:
     """A closed form's one pose ``world (1, 4, 4)``: every branch (in order: ``Settled.branch``) certified and settled
-    in one compiled call, as ``settle_one``; None where ``red`` has no all-branch configuration kernel."""
+    in one compiled call, as ``settle_one``; ``MEET`` where two branches meet (``meet``: the reach per joint within
+    which two kept ones do); None where ``red`` has no all-branch configuration kernel."""
     if not AVAILABLE:
         return None
 
@@ -325,12 +392,14 @@ def settle_closed(
         addr[_A_CFG] = address_of(cfgs, CONFIGURATIONS_SIG)
         nb = int(red.n_branches)
         branches = np.arange(nb, dtype=np.int64)
-        return addr, nb, np.zeros(nb), branches, np.ones(nb, dtype=np.int64), _tail(robot, thresholds, reach)
+        return addr, nb, np.zeros(nb), branches, _tail(robot, thresholds, reach)
 
     fixed = _kept(red, ("closed", thresholds), make)
     if fixed is None:
         return None
-    addr, nb, theta, branch, mult, tail = fixed
+    addr, nb, theta, branch, tail = fixed
     p = np.ascontiguousarray(params, dtype=np.float64)
-    status, c, q, eg, ep, rows, w, inside, keep = _settle_closed(addr, p, writable(world), nb, *tail)
-    return Settled(status, theta, branch, mult, q, eg, ep, rows[:c], w[:c], inside[:c], keep[:c])
+    status, c, reachable, q, ep, eg, inside, mu, err_all = _settle_closed(
+        addr, p, writable(world), nb, *tail, writable(meet), bool(only_inside)
+    )
+    return Settled(status, c, reachable, q, ep, eg, inside, mu, theta, branch, err_all)

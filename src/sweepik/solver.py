@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import fastcertify, fastsolve, fastsweep, parallel
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
-from .batch import Block, SolutionBatch
+from .batch import Block, SolutionBatch, no_solution_reason
 from .continuation import continuum_families
 from .dedupe import finish, merged_multiplicity, near_pairs, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
@@ -205,9 +205,12 @@ def _solve_chunk(
     limits: bool,
     n_samples: int,
     use_fallback: bool = True,
+    one_call: bool = True,
 ) -> Block:
+    """The solutions of the chunk ``poses``; ``one_call``: a single pose may take the one compiled call (False: the
+    caller found that it cannot)."""
     chain = _chain_poses(robot, poses)  # (one array: the reduction keeps its parameters for it)
-    if len(poses) == 1 and strategy == "precise" and use_fallback and red.uses_kernel:
+    if len(poses) == 1 and strategy == "precise" and use_fallback and one_call and red.uses_kernel:
         block = _settled_single(robot, red, poses, chain, limits, n_samples)
         if block is not None:
             return block
@@ -430,55 +433,56 @@ def _settled_single(
     robot: Robot, red: Reduction, poses: Array, chain: Array, limits: bool, n_samples: int
 ) -> Block | None:
     """``_solve_chunk`` of one pose (``chain``: its chain pose) in one compiled call (``fastsolve``), the same values;
-    None where the pose needs one of its rarer steps (a polish, families, special solutions, a continuum along
-    another joint, the fallback, branches of a closed form that meet)."""
+    None where the pose needs one of its rarer steps (``_settled``)."""
+    out = _settled(robot, red, poses, chain, limits, n_samples)
+    if out is None:
+        return None
+    return Block(
+        robot=robot,
+        poses=poses.copy(),
+        bounds=np.array([0, out.q.shape[0]], dtype=np.intp),
+        q=out.q,
+        error=out.error,
+        error_geodesic=out.error_geodesic,
+        within_limits=out.within_limits,
+        multiplicity=out.multiplicity,
+        families={},
+        n_reachable=np.array([out.reachable], dtype=np.intp),
+        empty_reason=None,
+    )
+
+
+def _settled(
+    robot: Robot, red: Reduction, poses: Array, chain: Array, limits: bool, n_samples: int
+) -> fastsolve.Settled | None:
+    """One pose's solutions from the one compiled call (``fastsolve``); None where the pose needs one of its rarer
+    steps (a polish, families, special solutions, a continuum along another joint, the fallback, branches of a
+    closed form that meet)."""
     params = red.kernel_params(chain)
     bounds, reach = _settle_bounds(robot), _snap_reach(robot)
-    if red.closed_form:
-        out = fastsolve.settle_closed(robot, red, poses, params, bounds, reach)
-        # (branches that meet: merged into one solution of higher multiplicity, the general way)
-        if out is not None and (
-            not out.keep.all() or _meeting_pairs(robot, np.zeros(out.rows.size, np.intp), out.w, out.keep).size
-        ):
-            return None
+    if red.closed_form:  # (branches that meet, ``MEET``: merged into one of higher multiplicity, the general way)
+        out = fastsolve.settle_closed(robot, red, poses, params, bounds, reach, _per_joint(robot, MEET_REL), limits)
     else:
         lo, hi = _theta_range(robot, red, chain)
         seed_tol = SEED_TOL_REL * robot.length_scale  # (its continua: checked in the call)
         out = fastsolve.settle_one(
-            robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL, seed_tol
+            robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL, seed_tol, limits
         )
-    if out is None or out.status != fastsolve.OK or out.rows.size > MAX_ISOLATED_SOLUTIONS:
+    if out is None or out.status != fastsolve.OK or out.certified > MAX_ISOLATED_SOLUTIONS:
         return None
     special = red.special_solutions(chain)
     if special is not None and np.isfinite(special[0] if isinstance(special, tuple) else special).all(-1).any():
         return None
     if red.closed_form and type(red).continuum_joints is not Reduction.continuum_joints:
         pose = np.zeros(out.theta.size, dtype=np.intp)
-        free = red.continuum_joints(chain, pose, out.theta, out.branch, out.err_geo, SEED_TOL_REL * robot.length_scale)
+        free = red.continuum_joints(chain, pose, out.theta, out.branch, out.err_all, SEED_TOL_REL * robot.length_scale)
         if free is not None and bool((free >= 0).any()):
             return None
     if red.fallback is not None:
         deg = red.degenerate(chain)
         if deg is not None and bool(deg.any()):
             return None
-    rows, keep, inside = out.rows, out.keep, out.inside
-    n_reachable = np.array([np.count_nonzero(keep)], dtype=np.intp)
-    if limits:
-        keep = keep & inside
-    sel = rows[keep]
-    return Block(
-        robot=robot,
-        poses=poses.copy(),
-        bounds=np.array([0, sel.size], dtype=np.intp),
-        q=out.w[keep],
-        error=out.err_paper[sel],
-        error_geodesic=out.err_geo[sel],
-        within_limits=inside[keep],
-        multiplicity=out.mult[sel].astype(np.intp),
-        families={},
-        n_reachable=n_reachable,
-        empty_reason=None,
-    )
+    return out
 
 
 #: A family's end is at a joint limit when a joint of its member there is this close to it (radians; relative to
@@ -935,6 +939,7 @@ def _solve_one(
     locked: object = None,
 ) -> Solutions:
     """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly."""
+    one_call = True
     if (
         reduction is None
         and free_joint is None
@@ -947,13 +952,30 @@ def _solve_one(
         and isinstance(robot, Robot)
     ):  # (the default options: their checks done once per robot)
         held, arm, red = None, robot, _default_reduction(robot)
+        if red.uses_kernel:  # (its solutions straight from the one compiled call, where it settles the pose)
+            out = _settled(robot, red, P, _chain_poses(robot, P), True, N_SAMPLES)
+            if out is not None:
+                n = out.q.shape[0]
+                return Solutions(
+                    q=out.q,
+                    error=out.error,
+                    error_geodesic=out.error_geodesic,
+                    within_limits=out.within_limits,
+                    multiplicity=out.multiplicity,
+                    families=(),
+                    reason=None if n else no_solution_reason(out.reachable),
+                    pose=P[0].copy(),
+                    robot=robot,
+                )
+            one_call = False
     else:
         held = _held(robot, locked)
         arm = robot if held is None else held.arm
         red, strategy, limits, n_samples, _ = _prepare(
             arm, P, reduction, strategy, limits, n_samples, 1, free_joint, held
         )
-    return _expanded(_solve_chunk(arm, red, P, strategy, limits, n_samples), held).solutions(0, copy=False)
+    block = _solve_chunk(arm, red, P, strategy, limits, n_samples, one_call=one_call)
+    return _expanded(block, held).solutions(0, copy=False)
 
 
 @lru_cache(maxsize=16)
