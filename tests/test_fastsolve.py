@@ -100,10 +100,13 @@ def test_one_call_is_the_general_path(
 
 
 @pytest.mark.parametrize("name", ["ur5", "fanuc_crx10ia", "carm"])
-def test_unreachable_poses_and_meeting_branches(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_unreachable_poses_meeting_branches_singular_wrists(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """A pose out of reach gets the general path's empty solutions and reason from the one call; a closed form's
     branches that meet (UR5 with joint 3 at 0: the elbow straight, a double root the closed form's rounding splits
-    in two) are handed over (``MEET``) and merged the general way into one solution of multiplicity 2."""
+    in two) are handed over (``MEET``) and merged the general way into one solution of multiplicity 2; its poses
+    with a singular wrist (joint 5 at 0) are handed over too (``SINGULAR``: its kernel checks them in the call, where
+    its branches do not meet first) and solved by the fallback sweep, which reports the wrist's continuum as a
+    family."""
     robot = load_robot(name)
     far = np.eye(4)
     far[:3, 3] = 10.0 * robot.length_scale
@@ -116,6 +119,11 @@ def test_unreachable_poses_and_meeting_branches(name: str, monkeypatch: pytest.M
         q[:, 2] = 0.0
         assert _both_ways(monkeypatch, robot, robot.fk(q)) == {fastsolve.MEET: len(q)}
         assert all((sweepik.solve(robot, T).multiplicity == 2).any() for T in robot.fk(q))
+        q[:, 2] = 0.4
+        q[:, 4] = 0.0
+        seen = _both_ways(monkeypatch, robot, robot.fk(q))  # (the wrist's branches meet there too: MEET first)
+        assert fastsolve.OK not in seen and seen[fastsolve.SINGULAR] > 0
+        assert all(sweepik.solve(robot, T).families for T in robot.fk(q))
 
 
 def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:

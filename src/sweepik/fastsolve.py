@@ -35,7 +35,7 @@ from .reductions.kernels import (
 from .sweep import _unit_grid
 from .units import orientation_weight
 
-__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "CONTINUUM", "MEET", "Settled", "settle_one", "settle_closed"]
+__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "CONTINUUM", "MEET", "SINGULAR", "Settled", "settle_one", "settle_closed"]
 
 Array = NDArray[np.float64]
 
@@ -48,8 +48,11 @@ DUE = 2
 #: ... or a continuum may run along another joint through a certified one (``Reduction.continuum_joints``) ...
 CONTINUUM = 3
 #: ... or two branches of a closed form meet (one dropped as the other's duplicate, or two kept within the reach
-#: given, ``solver.MEET_REL``): the solver merges them into one solution of higher multiplicity.
+#: given, ``solver.MEET_REL``): the solver merges them into one solution of higher multiplicity ...
 MEET = 4
+#: ... or a closed form's pose is degenerate, or a step may leave its joint free there (``Reduction.singular_kernel``):
+#: the solver asks ``degenerate`` and ``continuum_joints`` (its fallback sweep, the continua it traces).
+SINGULAR = 5
 
 
 class Settled(NamedTuple):
@@ -57,7 +60,8 @@ class Settled(NamedTuple):
     ``error_geodesic``, ``within_limits``, ``multiplicity``: the certified candidates that are no duplicate, in order,
     with ``only_inside`` those within the limits), how many certified candidates there were (``certified``) and how
     many of them are no duplicate (``reachable``); all empty unless ``status`` is ``OK``. A closed form's also has
-    every branch's theta* (0), branch and geodesic error (``theta``, ``branch``, ``err_all``; empty for a sweep)."""
+    every branch's theta* (0), branch and geodesic error (``theta``, ``branch``, ``err_all``; empty for a sweep), and
+    ``checked``: the call checked the pose's singular set itself (``SINGULAR``)."""
 
     status: int
     certified: int
@@ -70,6 +74,7 @@ class Settled(NamedTuple):
     theta: Array
     branch: NDArray[np.int64]
     err_all: Array
+    checked: bool = False
 
 
 if AVAILABLE:
@@ -81,6 +86,7 @@ if AVAILABLE:
     from .fastcertify import _CERTIFY_EVERY_SIG, _CERTIFY_SIG, _certify, _certify_every_branch
     from .fastsweep import _ONE_PASS_SIG
     from .reductions.geometric import _CONTINUUM_SIG, _continuum_rows
+    from .reductions.kernels import as_singular
 
     _ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG = _void(*_ONE_PASS_SIG), _void(*_CERTIFY_SIG), _void(*_SETTLE_SIG)
     _EVERY_FN_SIG, _CONTINUUM_FN_SIG = _void(*_CERTIFY_EVERY_SIG), int64(*_CONTINUUM_SIG)
@@ -89,7 +95,8 @@ if AVAILABLE:
     )
     #: The kernels' addresses in ``addr``, and ``continuum_rows``' (0: no continuum check) with its fixed integers
     #: (the amplitude kernel's address, branches per position branch), ``Reduction.continuum_kernel``'s.
-    _A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG, _A_ROWS, _A_AMP, _A_DIV, _A_SIZE = range(8)
+    #: ``_A_SING``: a closed form's ``singular_kernel`` (0: none).
+    _A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG, _A_ROWS, _A_AMP, _A_DIV, _A_SING, _A_SIZE = range(9)
 
     @internal
     def _settled(settle, q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale):
@@ -210,17 +217,18 @@ if AVAILABLE:
     @lazy_njit(
         (int64[::1], float64[:, ::1], float64[:, :, ::1], int64, float64[:, ::1], float64[:, ::1], boolean[::1])
         + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-        + (float64[::1], float64[::1], float64, float64[::1], boolean),
+        + (float64[::1], float64[::1], float64, float64[::1], float64[::1], boolean),
         cache=True,
         nogil=True,
     )
     def _settle_closed(
         addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
-        meet, only_inside,
+        s_thr, meet, only_inside,
     ):  # pragma: no cover  # fmt: skip
         """``settle_closed``'s kernel: every branch of pose 0 of ``params``/``world`` (the all-branch configuration
         kernel at ``addr[_A_CFG]``) certified and settled; ``MEET`` where a branch is dropped as another's duplicate
-        or two kept ones are within ``meet`` (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``)."""
+        or two kept ones are within ``meet`` (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``);
+        ``SINGULAR`` where the singular kernel at ``addr[_A_SING]`` (unless 0; thresholds ``s_thr``) flags it."""
         q = np.empty((nb, rev.shape[0]))
         eg = np.empty(nb)
         ep = np.empty(nb)
@@ -243,6 +251,11 @@ if AVAILABLE:
                     break
             if status == MEET:
                 break
+        if status == OK and addr[_A_SING] != 0:
+            flags = np.empty(2, dtype=np.bool_)  # degenerate, a step's amplitude low
+            as_singular(addr[_A_SING])(params, s_thr, flags[0:1], flags[1:2], 0, 1)
+            if flags[0] or flags[1]:
+                status = SINGULAR
         if status != OK:
             c = 0
         reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
@@ -386,20 +399,28 @@ def settle_closed(
         cfgs = owned_kernel(red, "kernel_configurations")
         if cfgs is None:
             return None
-        addr = np.zeros(4, dtype=np.int64)
+        addr = np.zeros(_A_SIZE, dtype=np.int64)
         addr[_A_CERTIFY] = address_of(_certify_every_branch, _EVERY_FN_SIG)
         addr[_A_SETTLE] = address_of(_settle, _SETTLE_FN_SIG)
         addr[_A_CFG] = address_of(cfgs, CONFIGURATIONS_SIG)
+        s_thr = np.zeros(1)
+        cls = red.__class__
+        owner = defining_class(cls, "singular_kernel")
+        sing = None
+        if owner is defining_class(cls, "degenerate") and owner is defining_class(cls, "continuum_joints"):
+            sing = red.singular_kernel()
+        if sing is not None:
+            addr[_A_SING], s_thr = sing[0], np.ascontiguousarray(sing[1], dtype=np.float64)
         nb = int(red.n_branches)
         branches = np.arange(nb, dtype=np.int64)
-        return addr, nb, np.zeros(nb), branches, _tail(robot, thresholds, reach)
+        return addr, nb, np.zeros(nb), branches, _tail(robot, thresholds, reach), s_thr
 
     fixed = _kept(red, ("closed", thresholds), make)
     if fixed is None:
         return None
-    addr, nb, theta, branch, tail = fixed
+    addr, nb, theta, branch, tail, s_thr = fixed
     p = np.ascontiguousarray(params, dtype=np.float64)
     status, c, reachable, q, ep, eg, inside, mu, err_all = _settle_closed(
-        addr, p, writable(world), nb, *tail, writable(meet), bool(only_inside)
+        addr, p, writable(world), nb, *tail, s_thr, writable(meet), bool(only_inside)
     )
-    return Settled(status, c, reachable, q, ep, eg, inside, mu, theta, branch, err_all)
+    return Settled(status, c, reachable, q, ep, eg, inside, mu, theta, branch, err_all, bool(addr[_A_SING] != 0))

@@ -473,6 +473,8 @@ def _settled(
     special = red.special_solutions(chain)
     if special is not None and np.isfinite(special[0] if isinstance(special, tuple) else special).all(-1).any():
         return None
+    if out.checked:  # (its singular set, checked in the call: ``Reduction.singular_kernel``)
+        return out
     if red.closed_form and type(red).continuum_joints is not Reduction.continuum_joints:
         pose = np.zeros(out.theta.size, dtype=np.intp)
         free = red.continuum_joints(chain, pose, out.theta, out.branch, out.err_all, SEED_TOL_REL * robot.length_scale)

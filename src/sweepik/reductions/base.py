@@ -180,6 +180,14 @@ class Reduction(ABC):
         ``continuum_joints`` and not this one has its candidates checked in Python (the general path)."""
         return None
 
+    def singular_kernel(self) -> tuple[int, Array] | None:
+        """For a compiled caller (``fastsolve.settle_closed``): a closed form's ``degenerate`` poses and those where
+        ``continuum_joints`` may flag a branch, in one kernel: the address of ``(params, thr, out, low, start, stop)``
+        (``kernels.SINGULAR_SIG``), which sets ``out[i]`` or ``low[i]`` for such a pose i, and its ``thr``. None:
+        the solver asks ``degenerate`` and ``continuum_joints`` in Python (also where a class overrides either of
+        them and not this one)."""
+        return None
+
     def search_range(self, poses: Array) -> Array | None:
         """``(N, 2)`` theta* interval that holds every solution, for a prismatic theta* searched without
         joint limits (``limits=False``). ``None``: the joint limits are used.

@@ -252,6 +252,17 @@ class GeometricReduction(Reduction):
         steps have no amplitudes)."""
         return None if self._case is None or self.plan.closed_form else self._continuum_args
 
+    def singular_kernel(self) -> tuple[int, Array] | None:
+        """A closed form's ``_singular`` kernel (the wrist singular: ``degenerate``; a step's amplitude low: where
+        ``continuum_joints`` may flag a branch) and its thresholds; None for a sweep."""
+        if not self.plan.closed_form:
+            return None
+        from .kernels import SINGULAR_SIG, address_of  # (defined with Numba only)
+
+        if self.plan.family == "parallel":
+            return address_of(geometric.parallel_singular_flags, SINGULAR_SIG), np.zeros(4)
+        return address_of(self._case_kernels.wrist_singular, SINGULAR_SIG), self._continuum_thresholds
+
     def continuum_joints(
         self, poses: Array, pose: IntArray, theta: Array, branch: IntArray, error: Array | None = None, tol: float = 0.0
     ) -> IntArray | None:

@@ -652,6 +652,15 @@ def parallel_singular(params, out, start, stop):
                 out[i] = True
 
 
+@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
+def parallel_singular_flags(params, thr, out, low, start, stop):
+    """``parallel_singular`` with the signature of the other families' ``wrist_singular`` (``kernels.SINGULAR_SIG``):
+    ``low`` all False (the parallel family's steps have no amplitudes), ``thr`` unused."""
+    parallel_singular(params, out, start, stop)
+    for i in range(start, stop):
+        low[i] = False
+
+
 class CaseKernels(NamedTuple):
     """The compiled kernels of the pair and wrist families for one position case (``position.CASES``): Python calls
     ``wrist_singular(params, thr, out, low, start, stop)``; the others are :class:`~.kernels.LazyKernel` objects with

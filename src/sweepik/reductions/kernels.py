@@ -139,6 +139,10 @@ if _njit is not None:
         int64, int64, float64[:, ::1], float64[::1], float64[::1], int64, boolean, int64[::1], float64[:, ::1], int64,
         int64,
     )  # fmt: skip
+    #: ``singular(params, thr, out, low, start, stop)``: a closed form's poses ``start .. stop - 1`` to hand to the
+    #: general path (``out``: ``degenerate``; ``low``: where ``continuum_joints`` may flag a branch; see
+    #: ``Reduction.singular_kernel``).
+    SINGULAR_SIG = void(float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64, int64)
     _elbow = internal(_elbow)
     _d1_position = internal(_d1_position)
     _elbow_residual = internal(_elbow_residual)
@@ -270,6 +274,7 @@ as_configuration: Any = None
 as_configurations: Any = None
 as_hints: Any = None
 as_swing: Any = None
+as_singular: Any = None
 if _njit is not None:
     from .._jit import function_at
 
@@ -280,6 +285,7 @@ if _njit is not None:
     as_configurations = function_at(CONFIGURATIONS_SIG)
     as_hints = function_at(HINTS_SIG)
     as_swing = function_at(SWING_SIG)
+    as_singular = function_at(SINGULAR_SIG)
 
 
 def _carm_configuration(p, x: float, b: int, out, rail: bool) -> None:
