@@ -126,6 +126,29 @@ def test_unreachable_poses_meeting_branches_singular_wrists(name: str, monkeypat
         assert all(sweepik.solve(robot, T).families for T in robot.fk(q))
 
 
+def test_a_class_overriding_the_singular_checks_keeps_them(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A closed form whose class overrides ``degenerate`` (and not ``singular_kernel``) has it asked in Python on every
+    pose the one call settles: here it flags every pose, so each goes to the fallback sweep, the general way."""
+    robot = load_robot("ur5")
+    red = sweepik.get_reduction(robot, None)
+    asked: list[int] = []
+
+    class EveryPoseDegenerate(sweepik.GeometricReduction):
+        def degenerate(self, poses: np.ndarray) -> np.ndarray:
+            asked.append(len(poses))
+            return np.ones(len(poses), dtype=bool)
+
+    own = EveryPoseDegenerate(robot, red.plan)
+    poses = _poses(robot, 14)[24:30]  # (random ones: the kernel would flag none)
+    seen = _counted(monkeypatch)
+    settled: list[object] = []
+    real = solver._settled
+    monkeypatch.setattr(solver, "_settled", lambda *args: settled.append(real(*args)) or settled[-1])
+    for T in poses:
+        assert len(sweepik.solve(robot, T, reduction=own)) > 0
+    assert seen[fastsolve.OK] == len(poses) and asked and settled == [None] * len(poses)
+
+
 def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
     """With the candidate buffer cut to one, every pose overflows it: each goes the general way (whose engine redoes
     it), with the same solutions."""
