@@ -149,6 +149,30 @@ def test_a_class_overriding_the_singular_checks_keeps_them(monkeypatch: pytest.M
     assert seen[fastsolve.OK] == len(poses) and asked and settled == [None] * len(poses)
 
 
+@pytest.mark.parametrize(("name", "names"), [("ur5", ["auto"]), ("carm", ["carm-d1", "d1"])])
+def test_the_default_reduction_named_takes_the_one_call(
+    name: str, names: list[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``reduction`` naming the arm's default (``"auto"`` for an arm whose file names none, the C-Arm's ``carm-d1``
+    or its alias) solves as ``reduction=None`` does, bit for bit, without checking the options again
+    (``reductions.is_default``); another reduction, or an unknown name, is not taken for it."""
+    from sweepik.reductions import is_default
+
+    robot = load_robot(name)
+    poses = _poses(robot, 15)[20:26]
+    want = [sweepik.solve(robot, T) for T in poses]
+    monkeypatch.setattr(solver, "_prepare", lambda *args: pytest.fail("options checked again"))
+    for r in names:
+        assert is_default(robot, r)
+        for a, b in zip([sweepik.solve(robot, T, reduction=r) for T in poses], want, strict=True):
+            _assert_same(a, b)
+    assert not is_default(robot, "carm-theta2" if name == "carm" else "carm-d1")
+    assert not is_default(robot, "no-such-reduction") and not is_default(robot, 3)
+    monkeypatch.undo()
+    with pytest.raises(sweepik.SweepikError, match="unknown reduction"):
+        sweepik.solve(robot, poses[0], reduction="no-such-reduction")
+
+
 def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
     """With the candidate buffer cut to one, every pose overflows it: each goes the general way (whose engine redoes
     it), with the same solutions."""

@@ -26,7 +26,7 @@ from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
 from .polish import geodesic_errors, polish
 from .pose import pose_error_geodesic, pose_error_paper
-from .reductions import Reduction, get_reduction
+from .reductions import Reduction, get_reduction, is_default
 from .reductions.decompose import not_sweepable
 from .reductions.kernels import owned_kernel
 from .robot import Robot
@@ -943,8 +943,7 @@ def _solve_one(
     """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly."""
     one_call = True
     if (
-        reduction is None
-        and free_joint is None
+        free_joint is None
         and locked is None
         and limits is True
         and type(strategy) is str
@@ -952,7 +951,8 @@ def _solve_one(
         and type(n_samples) is int
         and n_samples == N_SAMPLES
         and isinstance(robot, Robot)
-    ):  # (the default options: their checks done once per robot)
+        and is_default(robot, reduction)
+    ):  # (the default options, the default reduction named or not: their checks done once per robot)
         held, arm, red = None, robot, _default_reduction(robot)
         if red.uses_kernel:  # (its solutions straight from the one compiled call, where it settles the pose)
             out = _settled(robot, red, P, _chain_poses(robot, P), True, N_SAMPLES)

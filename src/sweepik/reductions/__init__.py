@@ -12,7 +12,17 @@ from .carm import CArmD1, CArmTheta2
 from .decompose import choose
 from .generic import GeometricReduction, Plan
 
-__all__ = ["Reduction", "CArmD1", "CArmTheta2", "GeometricReduction", "Plan", "REDUCTIONS", "get_reduction", "AUTO"]
+__all__ = [
+    "Reduction",
+    "CArmD1",
+    "CArmTheta2",
+    "GeometricReduction",
+    "Plan",
+    "REDUCTIONS",
+    "get_reduction",
+    "is_default",
+    "AUTO",
+]
 
 #: Name of the reduction derived from the arm's geometry (``reductions.decompose``).
 AUTO = "auto"
@@ -32,9 +42,7 @@ def get_reduction(robot: Robot, reduction: str | Reduction | None, free_joint: i
     index) asks the automatic decomposition for that theta*. NoReductionError when no decomposition applies."""
     if isinstance(reduction, Reduction):
         return reduction
-    if reduction is None:
-        reduction = AUTO if free_joint is not None else (robot.default_reduction or AUTO)
-    name = _ALIASES.get(reduction, reduction)
+    name = _name(robot, reduction, free_joint)
     if name == AUTO:
         return _automatic(robot, free_joint)
     if name not in REDUCTIONS:
@@ -42,6 +50,18 @@ def get_reduction(robot: Robot, reduction: str | Reduction | None, free_joint: i
             f"unknown reduction {reduction!r}; choose one of {sorted(REDUCTIONS) + sorted(_ALIASES) + [AUTO]}"
         )
     return _cached(robot, name)
+
+
+def _name(robot: Robot, reduction: str | None, free_joint: int | None) -> str:
+    """The registry name (or ``AUTO``) that ``reduction`` resolves to (``get_reduction``)."""
+    if reduction is None:
+        reduction = AUTO if free_joint is not None else (robot.default_reduction or AUTO)
+    return _ALIASES.get(reduction, reduction)
+
+
+def is_default(robot: Robot, reduction: object) -> bool:
+    """Whether ``reduction`` (None or a name) resolves to ``robot``'s default reduction, the one None gives."""
+    return reduction is None or (type(reduction) is str and _name(robot, reduction, None) == _name(robot, None, None))
 
 
 @lru_cache(maxsize=64)
