@@ -108,3 +108,45 @@ def test_in_order_nested_in_a_chunk_runs_in_that_chunks_thread():
         return all(t == me for t in parallel.in_order(inner, range(3)))
 
     assert all(parallel.in_order(outer, range(4)))
+
+
+@pytest.mark.parametrize(("name", "split"), [("fanuc_crx10ia", True), ("carm", False), ("ur5", False)])
+def test_a_generic_sweeps_small_batch_is_split_in_two(name: str, split: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A generic sweep's batch of at most ``IN_FLIGHT`` chunks is split evenly into IN_FLIGHT chunks solved side by
+    side, each on its share of the threads (``solver._chunking``); the solutions are one chunk's, bit for bit (each
+    pose is solved on its own). Not below ``IN_FLIGHT x SPLIT_MIN`` poses, nor for a cheaper search (the C-Arm's
+    hints kernel, a closed form), nor on one thread (nothing to overlap)."""
+    import numba
+
+    import sweepik
+    from sweepik import solver
+
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one thread: nothing to split for")
+    robot = sweepik.load_robot(name)
+    n = 3 * solver.SPLIT_MIN + 1
+    T = robot.fk(np.random.default_rng(3).uniform(robot.lower, robot.upper, (n, 6)))
+    seen: list[tuple[int, int]] = []
+    real = solver._solve_chunk
+
+    def chunk(r: object, red: object, P: np.ndarray, *a: object) -> object:
+        seen.append((len(P), parallel.threads()))
+        return real(r, red, P, *a)
+
+    monkeypatch.setattr(solver, "_solve_chunk", chunk)
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = sweepik.solve_many(robot, T)
+        assert seen == [(n, 1)]
+        numba.set_num_threads(2)
+        seen.clear()
+        both = sweepik.solve_many(robot, T)
+        assert sorted(seen) == ([(n // 2, 1), (n - n // 2, 1)] if split else [(n, 2)])
+        seen.clear()
+        sweepik.solve_many(robot, T[: solver.SPLIT_MIN * parallel.IN_FLIGHT - 1])
+        assert seen == [(solver.SPLIT_MIN * parallel.IN_FLIGHT - 1, 2)]
+    finally:
+        numba.set_num_threads(before)
+    for column in ("q", "error", "error_geodesic", "multiplicity", "within_limits", "offsets"):
+        np.testing.assert_array_equal(getattr(both, column), getattr(one, column))

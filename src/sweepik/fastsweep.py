@@ -1077,6 +1077,15 @@ def _one_pass(red, plan: _Plan) -> _OnePass | None:
     )
 
 
+def searches_margins(red) -> bool:
+    """Whether ``red``'s compiled search is a generic sweep's one pass, its margins' search included (``EdgeSearch``):
+    the costliest per pose (40-80 us on the swept 6R arms), where a batch's Python steps are a small part."""
+    if not AVAILABLE or red.closed_form or not red.uses_kernel:
+        return False
+    one = _plan(red).one_pass
+    return one is not None and one.kernel is _edge_search
+
+
 def _with_mult(ints: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """A one-pass plan without and with multiplicities."""
     with_mult = ints.copy()

@@ -103,17 +103,21 @@ def _with_threads(n: int, fn: Callable[[T], R], item: T) -> R:
         _local.threads = None
 
 
-def in_order(fn: Callable[[T], R], items: Sequence[T]) -> Iterator[R]:
+def in_order(fn: Callable[[T], R], items: Sequence[T], share: bool = False) -> Iterator[R]:
     """``fn(item)`` for each item, yielded in order. With two items or more and more than one thread allowed
     (``threads()``), ``IN_FLIGHT`` items are worked on at once in background threads, each seeing the caller's
-    thread setting, and the next one is queued while a result is awaited (called from one of those threads, it
-    runs in that thread). ``fn`` must be safe to run in two threads at once. An exception of ``fn`` is raised where
-    its item's result is due; items not started when the caller stops are dropped."""
+    thread setting (``share``: its share of it, ``threads() // IN_FLIGHT``, for items that start together and take
+    about as long, as a batch split evenly: no core is then oversubscribed, and none idles while the other item
+    runs its Python steps), and the next one is queued while a result is awaited (called from one of those threads,
+    it runs in that thread). ``fn`` must be safe to run in two threads at once. An exception of ``fn`` is raised
+    where its item's result is due; items not started when the caller stops are dropped."""
     nt = threads()
     # (in the calling thread: nothing to overlap, or a chunk's own thread, which must not wait on its own pool)
     if nt <= 1 or len(items) < 2 or getattr(_local, "threads", None) is not None:
         yield from map(fn, items)
         return
+    if share:
+        nt = max(1, nt // IN_FLIGHT)
     pool = _chunk_executor()
     it = iter(items)
     pending: deque[Future[R]] = deque()
