@@ -173,6 +173,27 @@ def test_the_default_reduction_named_takes_the_one_call(
         sweepik.solve(robot, poses[0], reduction="no-such-reduction")
 
 
+@pytest.mark.parametrize("name", ["franka_panda", "kuka_iiwa14"])
+def test_a_locked_arm_takes_the_one_call(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A seven-joint arm with a joint locked (its held arm a closed form) takes the one call too, its solutions full
+    length with the held value in place, the general path's bit for bit; poses with the held arm's wrist singular
+    go the general way."""
+    from sweepik.bench import _bench_lock
+
+    robot = load_robot(name)
+    locked = _bench_lock(robot)
+    assert locked
+    q = np.random.default_rng(16).uniform(robot.lower, robot.upper, (24, robot.n_joints))
+    for j, v in locked.items():
+        q[:, j] = v
+    seen = _both_ways(monkeypatch, robot, robot.fk(q), locked=locked)
+    assert seen[fastsolve.OK] >= len(q) // 2
+    for T, qq in zip(robot.fk(q), q, strict=True):
+        sols = sweepik.solve(robot, T, locked=locked)
+        assert sols.q.shape[1] == robot.n_joints and np.all(sols.q[:, list(locked)] == list(locked.values()))
+        assert np.min(np.max(np.abs(sols.q - qq), axis=1)) < 1e-6
+
+
 def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch) -> None:
     """With the candidate buffer cut to one, every pose overflows it: each goes the general way (whose engine redoes
     it), with the same solutions."""

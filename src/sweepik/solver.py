@@ -964,24 +964,26 @@ def _solve_one(
 ) -> Solutions:
     """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly."""
     one_call = True
-    if (
+    default = (
         free_joint is None
-        and locked is None
         and limits is True
         and type(strategy) is str
         and strategy == "precise"
         and type(n_samples) is int
         and n_samples == N_SAMPLES
         and isinstance(robot, Robot)
-        and is_default(robot, reduction)
-    ):  # (the default options, the default reduction named or not: their checks done once per robot)
-        held, arm, red = None, robot, _default_reduction(robot)
+    )
+    held = _held(robot, locked)
+    arm = robot if held is None else held.arm
+    if default and is_default(arm, reduction):
+        # (the default options, the default reduction named or not: their checks done once per arm)
+        red = _default_reduction(arm)
         if red.uses_kernel:  # (its solutions straight from the one compiled call, where it settles the pose)
-            out = _settled(robot, red, P, _chain_poses(robot, P), True, N_SAMPLES)
+            out = _settled(arm, red, P, _chain_poses(arm, P), True, N_SAMPLES)
             if out is not None:
                 n = out.q.shape[0]
                 return Solutions(
-                    q=out.q,
+                    q=out.q if held is None else held.expand(out.q),
                     error=out.error,
                     error_geodesic=out.error_geodesic,
                     within_limits=out.within_limits,
@@ -993,8 +995,6 @@ def _solve_one(
                 )
             one_call = False
     else:
-        held = _held(robot, locked)
-        arm = robot if held is None else held.arm
         red, strategy, limits, n_samples, _ = _prepare(
             arm, P, reduction, strategy, limits, n_samples, 1, free_joint, held
         )
