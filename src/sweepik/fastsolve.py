@@ -81,7 +81,7 @@ if AVAILABLE:
     from numba import boolean, float64, int64
     from numba import void as _void
 
-    from ._jit import function_at, internal
+    from ._jit import function_at, inlined, internal
     from .dedupe import _SETTLE_SIG, _rows_within, _settle
     from .fastcertify import _CERTIFY_EVERY_SIG, _CERTIFY_SIG, _certify, _certify_every_branch
     from .fastsweep import _ONE_PASS_SIG
@@ -118,6 +118,18 @@ if AVAILABLE:
             keep, ints[0:2], ints[2:3], 0, 1,
         )  # fmt: skip
         return due[0], ints[2], rows, w, inside, keep
+
+    @inlined
+    def _branches_meet(c, w, keep, rev, meet):
+        """Of a closed form's ``c`` settled branches, one was dropped as another's duplicate, or two kept ones are
+        within ``meet`` of each other (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``)."""
+        for a in range(c):
+            if not keep[a]:
+                return True
+            for b in range(a + 1, c):
+                if _rows_within(w, a, b, rev, meet):
+                    return True
+        return False
 
     @internal
     def _final(c, rows, w, inside, keep, eg, ep, mult, only_inside):
@@ -241,16 +253,8 @@ if AVAILABLE:
             addr[_A_SETTLE], q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
         )
         status = DUE if due else OK
-        for a in range(c if status == OK else 0):
-            if not keep[a]:
-                status = MEET
-                break
-            for b in range(a + 1, c):
-                if _rows_within(w, a, b, lrev, meet):
-                    status = MEET
-                    break
-            if status == MEET:
-                break
+        if status == OK and _branches_meet(c, w, keep, lrev, meet):
+            status = MEET
         if status == OK and addr[_A_SING] != 0:
             flags = np.empty(2, dtype=np.bool_)  # degenerate, a step's amplitude low
             as_singular(addr[_A_SING])(params, s_thr, flags[0:1], flags[1:2], 0, 1)

@@ -98,8 +98,8 @@ MULT_MAX = 8
 #: farther from zero are no candidates either; next to a family's samples (masked as NaN) they stay candidates
 #: whatever their residual: their flat-stretch probe can join two pieces of the family.
 FAR_NOISE = 1e12
-#: A domain edge sits at a sample (a generic sweep's margins' zeros are samples) when its branch's residual is NaN
-#: this far past it (relative to the theta* range): the first level then judges the interval beside it in that
+#: A domain edge sits at a sample (a generic sweep's margins' zeros are samples) when its branch's residual is not
+#: finite this far past it (relative to the theta* range): the first level then judges the interval beside it in that
 #: edge's coordinate, as the levels below do (``BEND``).
 EDGE_PROBE_REL = 1e-9
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
@@ -425,7 +425,7 @@ class _Search:
         family: NDArray[np.bool_] | None,
     ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
         """Level-0 intervals ``(S, M - 1)`` next to one domain edge that sits at their open-side sample (the residual
-        just past it is NaN), and which of them bend in that edge's coordinate (judged from the interval and its
+        just past it is not finite), and which of them bend in that edge's coordinate (judged from the interval and its
         other neighbour: the test the interval's sub-intervals get, ``_edge_coordinate``)."""
         S, M = th.shape
         judged = np.zeros((S, M - 1), dtype=bool)
