@@ -310,15 +310,45 @@ if AVAILABLE:
             return otherwise
         return min(abs(f[e]), abs(f[n1])) <= BEND * abs(dd) * x1 * x1
 
+    @inlined
+    def _bends_later(f_all, th, later, j):
+        """Level 0: some branch of ``later`` bends in interval j, away from a domain edge: the first level's bend test
+        (``BEND``, in theta) on the residuals ``f_all`` of every branch (a forecast: the branch's own scan decides)."""
+        M = th.shape[0]
+        h = th[j + 1] - th[j]
+        for bi in range(later.shape[0]):
+            b = later[bi]
+            f0, f1 = f_all[j, b], f_all[j + 1, b]
+            if math.isnan(f0) or math.isnan(f1):
+                continue
+            curv = 0.0
+            if j >= 1:
+                fm = f_all[j - 1, b]
+                if math.isnan(fm):
+                    continue
+                hl, hr = th[j] - th[j - 1], h
+                curv = abs(2.0 * ((f1 - f0) / hr - (f0 - fm) / hl) / (hl + hr))
+            if j + 2 < M:
+                fp = f_all[j + 2, b]
+                if math.isnan(fp):
+                    continue
+                hl, hr = h, th[j + 2] - th[j + 1]
+                curv = max(curv, abs(2.0 * ((fp - f1) / hr - (f1 - f0) / hl) / (hl + hr)))
+            if min(abs(f0), abs(f1)) <= BEND * curv * h * h:
+                return True
+        return False
+
     @internal
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
-        wv, wx, res_all, n_all, edge_f, edge_ok, fmask,
+        wv, wx, res_all, n_all, edge_f, edge_ok, fmask, f_all, later,
     ):  # fmt: skip
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
         hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
         coordinate judges curvature (NaN: theta), ``fmask``: the samples masked as a family's (read at level 0
-        only), as in sweep._Search.scan."""
+        only), as in sweep._Search.scan. Level 0: ``f_all`` the sequence's residuals on every branch, ``later`` the
+        branches searched after this one; ``edge_f``, ``edge_ok`` the all-branch sub-samples of its intervals (next
+        to an edge, then not), and which are known."""
         M = th.shape[0]
         valid = wv[:M]  # work arrays of the pose (no allocation per sequence)
         for j in range(M):  # (and the samples on a root: the ends of a resampled interval are its parent's)
@@ -404,15 +434,17 @@ if AVAILABLE:
                     stk_t[k0, k] = th[j] + (th[j + 1] - th[j]) * us[k]
                 stk_f[k0, 0] = f[j]
                 stk_f[k0, SUB + 1] = f[j + 1]
-                if level == 0 and near_edge and n_all > 0:
-                    # the uniform grid is every branch's, and a domain edge is usually every branch's too: the
-                    # sub-samples of an interval next to one are evaluated for all branches at once (the same values)
-                    if not edge_ok[j]:
+                # the uniform grid is every branch's, and a domain edge is usually every branch's too: the sub-samples
+                # of an interval next to one are evaluated for all branches at once (the same values); so are those of
+                # an interval that a branch still to come bends in too (the all-branch kernel costs less than two)
+                s = 0 if near_edge else 1
+                if level == 0 and n_all > 0 and (near_edge or edge_ok[1, j] or _bends_later(f_all, th, later, j)):
+                    if not edge_ok[s, j]:
                         for k in range(1, SUB + 1):
-                            res_all(p, stk_t[k0, k], edge_f[j, k])
-                        edge_ok[j] = True
+                            res_all(p, stk_t[k0, k], edge_f[s, j, k])
+                        edge_ok[s, j] = True
                     for k in range(1, SUB + 1):
-                        stk_f[k0, k] = edge_f[j, k, b]
+                        stk_f[k0, k] = edge_f[s, j, k, b]
                 else:
                     for k in range(1, SUB + 1):
                         stk_f[k0, k] = res(p, stk_t[k0, k], b)
@@ -528,8 +560,8 @@ if AVAILABLE:
         own_buf_c = np.empty(4)
         nb_all = n_all if n_all > 1 else 1
         own_f_all = np.empty((M, nb_all))
-        own_edge_f = np.empty((M, SUB + 1, nb_all))  # all-branch sub-samples of edge intervals (level 0)
-        own_edge_ok = np.empty(M, dtype=np.bool_)
+        own_edge_f = np.empty((2, M, SUB + 1, nb_all))  # all-branch sub-samples of level-0 intervals (_scan)
+        own_edge_ok = np.empty((2, M), dtype=np.bool_)
         own_f = np.empty(M)
         own_fm = np.empty(M, dtype=np.bool_)
         own_top = np.empty(1, dtype=np.int64)
@@ -547,7 +579,8 @@ if AVAILABLE:
             xtol = XTOL_REL * span[i]
             c[0] = 0
             for j in range(M):
-                edge_ok[j] = False
+                edge_ok[0, j] = False
+                edge_ok[1, j] = False
             if n_all > 0:
                 for j in range(M):
                     res_all(p, th[j], f_all[j])
@@ -591,7 +624,7 @@ if AVAILABLE:
                 while True:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
                           c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, res_all, n_all, edge_f, edge_ok,
-                          fm)  # fmt: skip
+                          fm, f_all, branches[bi + 1 :])  # fmt: skip
                     if top[0] == 0:
                         break
                     top[0] -= 1
