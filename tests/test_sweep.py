@@ -278,7 +278,9 @@ def _pair_reductions() -> list[sweepik.GeometricReduction]:
 def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(red: sweepik.GeometricReduction) -> None:
     """The generic pair family's all-branch residual, margin and amplitude kernels (the position case's branches
     share their first steps) give exactly, bit for bit, what the one-branch kernels give, on the branches and steps
-    the search asks for (twins and constant steps are skipped: their entries are never read)."""
+    the search asks for (twins and constant steps are skipped: their entries are never read); so does the kernel that
+    computes the residuals and margins at once for the engine's uniform samples, where the plan has one
+    (``EdgeSearch.every``)."""
     from sweepik import solver
 
     robot = red.robot
@@ -292,6 +294,9 @@ def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(red: 
     branches, margins, amplitudes = red.search_branches, red._steps[0], red._steps[1]
     assert branches and fastsweep._kernel_residuals(red) is ck.pair_residuals
     out = np.full(max(3, red.n_branches), np.nan)
+    every = red.edge_search().every != 0
+    assert every == (red.n_branches == 4 and {b // 2 for b in branches} == {0, 1})  # (both first-step branches)
+    shared = np.full(red.n_branches + 3, np.nan)
 
     def same(a: float, b: float) -> bool:
         return a == b or (np.isnan(a) and np.isnan(b))
@@ -307,6 +312,12 @@ def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(red: 
             ck.amplitudes(params[i], float(th), out)
             for k in amplitudes:
                 assert same(out[k], ck.amplitude(params[i], float(th), k))
+            if every:
+                ck.pair_every(params[i], float(th), shared)
+                for b in branches:
+                    assert same(shared[b], ck.pair_residual(params[i], float(th), b))
+                for k in margins:
+                    assert same(shared[4 + k], ck.pair_margin(params[i], float(th), k))
 
 
 def _closed_form_reductions() -> list[sweepik.GeometricReduction]:

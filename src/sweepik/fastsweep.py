@@ -361,9 +361,8 @@ if AVAILABLE:
             tm, fm = (th[j - 1], f[j - 1]) if j > 0 else (ctx[0], ctx[1])
             tp, fp = (th[j + 1], f[j + 1]) if j < M - 1 else (ctx[2], ctx[3])
             fc = f[j]
-            if math.isnan(fm) or math.isnan(fc) or math.isnan(fp):
-                continue
-            # (the cheap tests first: a local minimum of |f| without a sign change is rare, its curvature dearer)
+            # (the cheap tests first: a local minimum of |f| without a sign change is rare, its curvature dearer; a
+            # NaN among the three fails them)
             if not (abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0):
                 continue
             hl, hr = th[j] - tm, tp - th[j]
@@ -377,6 +376,8 @@ if AVAILABLE:
                 continue
             lo_open = (j == 0 and level == 0) or (j > 0 and not valid[j - 1])
             hi_open = (j == M - 1 and level == 0) or (j < M - 1 and not valid[j + 1])
+            if not (lo_open or hi_open):
+                continue
             nr = abs(f[j + 1]) if (j < M - 1 and valid[j + 1]) else np.inf
             nl = abs(f[j - 1]) if (j > 0 and valid[j - 1]) else np.inf
             at_l = lo_open and abs(f[j]) <= nr
@@ -392,9 +393,10 @@ if AVAILABLE:
                 _push(out_t, out_b, cnt, th[j], b)
         # second divided differences (dd), in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate), worked out
         # as the intervals are walked: c1, c2 at the interval's samples (NaN at the ends and next to a NaN sample)
-        x = wx[:M]
-        for j in range(M):
-            x[j] = th[j] if math.isnan(xe) else math.sqrt(abs(th[j] - xe))
+        x = th if math.isnan(xe) else wx[:M]
+        if not math.isnan(xe):
+            for j in range(M):
+                x[j] = math.sqrt(abs(th[j] - xe))
         c2 = np.nan
         for j in range(M - 1):
             c1 = c2
@@ -514,6 +516,8 @@ if AVAILABLE:
         float64[:, :, ::1],
         int64[::1],
         boolean,
+        float64[:, :, ::1],
+        int64[:, ::1],
         int64,
         int64,
     )
@@ -521,13 +525,15 @@ if AVAILABLE:
     @lazy_njit(_SEARCH_SIG, cache=True, nogil=True)
     def _search(
         res, res_all, n_all, params, grid, n_grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt,
-        multiplicity, start, stop,
+        multiplicity, known, known_at, start, stop,
     ):  # fmt: skip
         """Poses ``start .. stop - 1`` (threads run parts of a batch side by side: :mod:`sweepik.parallel`), pose i's
         samples the first ``n_grid[i]`` of ``grid[i]`` (``sample_grid``); ``multiplicity`` False: every candidate's
         is given as 1, not worked out (``search``).
         ``res_all``: every branch's residual at once (``Reduction.kernel_residuals``), used for the uniform samples
-        when ``n_all`` (the number of branches it fills) is not 0.
+        when ``n_all`` (the number of branches it fills) is not 0. ``known (P, K, n_all)``: all-branch residuals the
+        caller has already, sample j of pose ``start + m`` being ``known[m, known_at[m, j]]`` where that is not -1
+        (``P = 0``: none).
 
         One function, not a loop calling a function per pose: Numba re-optimises everything a compiled function calls
         when it compiles the caller, and each level costs seconds on a fresh install."""
@@ -583,7 +589,12 @@ if AVAILABLE:
                 edge_ok[1, j] = False
             if n_all > 0:
                 for j in range(M):
-                    res_all(p, th[j], f_all[j])
+                    k = known_at[i - start, j] if known.shape[0] > 0 else -1
+                    if k >= 0:
+                        for b in range(n_all):
+                            f_all[j, b] = known[i - start, k, b]
+                    else:
+                        res_all(p, th[j], f_all[j])
             for bi in range(branches.shape[0]):
                 b = branches[bi]
                 for j in range(M):
@@ -778,7 +789,7 @@ if AVAILABLE:
     _as_search = function_at(_SEARCH_FN_SIG)
     #: The one-pass kernels' plan: the addresses and counts they take as one array (a Python call costs per argument).
     (_E_SEARCH, _E_RES, _E_RES_ALL, _E_N_ALL, _E_MARGIN, _E_MARGINS, _E_M_ALL, _E_SWING, _E_AMP, _E_AMPS, _E_N_SWING,
-     _E_N, _E_PERIODIC, _E_MULT, _E_HINTS, _E_N_HINTS, _E_SIZE) = range(17)  # fmt: skip
+     _E_N, _E_PERIODIC, _E_MULT, _E_HINTS, _E_N_HINTS, _E_EVERY, _E_SIZE) = range(18)  # fmt: skip
     #: ``(plan, branches, margin branches, steps, noise, params, hlo, hhi, lo, hi, unit grid, ends, twins, out_t,
     #: out_b, out_m, cnt, fam, fcnt, redo, start, stop)``: both one-pass kernels' (each ignores what it does not use).
     _ONE_PASS_SIG = (
@@ -809,16 +820,32 @@ if AVAILABLE:
     @inlined
     def _pose_search(
         se, res, res_all, n_all, branches, noise, mult, params, grid, M, n_grid, span, width, out_t, out_b, out_m,
-        cnt, fam, fcnt, i,
+        cnt, fam, fcnt, i, known, known_at,
     ):  # fmt: skip
         """``_search`` of pose ``i`` alone (its rows of the arrays, as arrays of one row) on the first ``M`` samples
-        of ``grid``, over a range ``width`` wide (``n_grid``, ``span``: the caller's work arrays of one)."""
+        of ``grid``, over a range ``width`` wide (``n_grid``, ``span``: the caller's work arrays of one; ``known``,
+        ``known_at``: the pose's, as ``_search`` takes them)."""
         n_grid[0] = M
         span[0] = width
         fcnt[i] = 0
         se(res, res_all, n_all, params[i : i + 1], grid[:M].reshape((1, M)), n_grid, branches, span, noise,
            out_t[i : i + 1], out_b[i : i + 1], out_m[i : i + 1], cnt[i : i + 1], fam[i : i + 1], fcnt[i : i + 1], mult,
-           0, 1)  # fmt: skip
+           known, known_at, 0, 1)  # fmt: skip
+
+    @inlined
+    def _known_at(grid, M, a, b, s, known_at):
+        """``known_at[0, j]`` for the first ``M`` samples of ``grid``: k where sample j is the uniform grid's sample
+        ``a + (b - a) s[k]`` (the same float: ``_merge_row``'s), else -1 (a hint, or a sample a run of equal ones
+        moved). Both are sorted."""
+        w = b - a
+        k = 0
+        for j in range(M):
+            known_at[0, j] = -1
+            while k < s.shape[0] and a + w * s[k] < grid[j]:
+                k += 1
+            if k < s.shape[0] and a + w * s[k] == grid[j]:
+                known_at[0, j] = k
+                k += 1
 
     @inlined
     def _add_swings(row, k, swings):
@@ -870,29 +897,48 @@ if AVAILABLE:
         """``search`` of poses ``start .. stop - 1`` for a reduction with an ``EdgeSearch``, each pose in one pass:
         its swing samples, the margins' search over ``[hlo, hhi]`` sampled with them, then its own search over
         ``[lo, hi]`` sampled with the margins' zeros and the swing samples, as ``sample_hints`` and ``sample_grid``
-        give them (the same samples in the same order, so the same candidates bit for bit). ``plan``: the addresses
-        and counts (``_E_*``); ``noise``: the search's residual noise and the margins'; ``twins``: the candidates'
-        copies to make (``_twin_copies``). A pose whose margins overflow the buffers is marked in ``redo`` (its count
-        0), for ``search`` to redo with the NumPy engine."""
+        give them (the same samples in the same order, so the same candidates bit for bit). With an
+        ``EdgeSearch.every`` kernel, the uniform grid's samples, which the margins' search and (over the same range)
+        its own search both take, are evaluated once for the two, by that kernel: the same values.
+        ``plan``: the addresses and counts (``_E_*``); ``noise``: the search's residual noise and the margins';
+        ``twins``: the candidates' copies to make (``_twin_copies``). A pose whose margins overflow the buffers is
+        marked in ``redo`` (its count 0), for ``search`` to redo with the NumPy engine."""
         se, sw = _as_search(plan[_E_SEARCH]), as_swing(plan[_E_SWING])
         n_swing, n, periodic = plan[_E_N_SWING], plan[_E_N], plan[_E_PERIODIC] != 0
         n_s, n_e, n_c = s.shape[0], ends.shape[0], out_t.shape[1]
+        n_all = plan[_E_N_ALL]
         swings = np.empty((1, n_swing))
         row = np.empty(n_c + n_swing + n_e)
         grid = np.empty(n_s + n_c + n_swing + n_e)
         n_grid = np.empty(1, dtype=np.int64)
         span = np.empty(1)
+        # the uniform samples' residuals and margins (``EdgeSearch.every``; none: P = 0)
+        P = 1 if plan[_E_EVERY] != 0 else 0
+        every = as_residuals(plan[_E_EVERY] if P else plan[_E_RES_ALL])
+        shared = np.empty(n_all + 3)
+        known_r = np.empty((P, n_s, n_all))
+        known_m = np.empty((P, n_s, 3))
+        known_at = np.empty((1, grid.shape[0]), dtype=np.int64)
         for i in range(start, stop):
             redo[i] = False
             for k in range(n_swing):
                 swings[0, k] = np.nan
             sw(plan[_E_AMP], plan[_E_AMPS], params[i : i + 1], hlo[i : i + 1], hhi[i : i + 1], n, periodic, steps,
                swings, 0, 1)  # fmt: skip
+            for k in range(n_s if P else 0):  # (the margins' uniform samples, as ``_merge_row`` places them)
+                every(params[i], hlo[i] + (hhi[i] - hlo[i]) * s[k], shared)
+                for b in range(n_all):
+                    known_r[0, k, b] = shared[b]
+                for m in range(3):
+                    known_m[0, k, m] = shared[n_all + m]
             # the margins' samples: the swing samples and theta*'s ends (``grid_hints`` of the margins)
             k = _with_ends(row, _add_swings(row, 0, swings), ends, periodic)
             M = _merge_row(hlo[i], hhi[i], s, row[:k], grid, True)
+            if P:
+                _known_at(grid, M, hlo[i], hhi[i], s, known_at)
             _pose_search(se, plan[_E_MARGIN], plan[_E_MARGINS], plan[_E_M_ALL], m_branches, noise[1], False, params,
-                         grid, M, n_grid, span, hhi[i] - hlo[i], out_t, out_b, out_m, cnt, fam, fcnt, i)  # fmt: skip
+                         grid, M, n_grid, span, hhi[i] - hlo[i], out_t, out_b, out_m, cnt, fam, fcnt, i, known_m,
+                         known_at)  # fmt: skip
             if cnt[i] > n_c or fcnt[i] > fam.shape[1]:
                 redo[i] = True
                 cnt[i] = 0
@@ -903,9 +949,12 @@ if AVAILABLE:
                 row[j] = out_t[i, j]
             k = _with_ends(row, _add_swings(row, cnt[i], swings), ends, periodic)
             M = _merge_row(lo[i], hi[i], s, row[:k], grid, True)
-            _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
-                         params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt,
-                         i)  # fmt: skip
+            same = P != 0 and lo[i] == hlo[i] and hi[i] == hhi[i]  # (the uniform samples the margins' search had)
+            if same:
+                _known_at(grid, M, lo[i], hi[i], s, known_at)
+            _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], n_all, branches, noise[0], plan[_E_MULT] != 0,
+                         params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt, i,
+                         known_r if same else known_r[:0], known_at)  # fmt: skip
             _twin_copies(out_t, out_b, out_m, cnt, i, twins)
 
     @lazy_njit(_ONE_PASS_SIG, cache=True, nogil=True)
@@ -924,14 +973,15 @@ if AVAILABLE:
         grid = np.empty(s.shape[0] + nh + n_e)
         n_grid = np.empty(1, dtype=np.int64)
         span = np.empty(1)
+        no_known, no_known_at = np.empty((0, 0, 1)), np.empty((0, 0), dtype=np.int64)
         for i in range(start, stop):
             redo[i] = False
             fn(params[i], row[:nh])
             _with_ends(row, nh, ends, periodic)
             M = _merge_row(lo[i], hi[i], s, row, grid, False)
             _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
-                         params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt,
-                         i)  # fmt: skip
+                         params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt, i,
+                         no_known, no_known_at)  # fmt: skip
             _twin_copies(out_t, out_b, out_m, cnt, i, twins)
 
 
@@ -945,6 +995,9 @@ class EdgeSearch(NamedTuple):
     swing: int  # the address of the swing kernel (``kernels.SWING_SIG``)
     amplitude: int  # ... of the amplitude kernels it takes
     amplitudes: int
+    # ... of a kernel computing the residuals and the margins at once (``kernels.RESIDUALS_SIG``: the reduction's
+    # branches, then 3 margins; 0: none), for the uniform samples that both searches take
+    every: int
     steps: NDArray[np.int64]  # the steps whose amplitudes it examines
     n_swing: int  # the samples it writes per pose, at most
     n_samples: int  # its grid's samples (the sweep's default: ``sweep.N_SAMPLES``)
@@ -1102,6 +1155,7 @@ def _one_pass(red, plan: _Plan) -> _OnePass | None:
     margins = _plan(edges.margins)
     ints[_E_MARGIN], ints[_E_MARGINS], ints[_E_M_ALL] = margins.residual, margins.residuals, margins.n_all
     ints[_E_SWING], ints[_E_AMP], ints[_E_AMPS] = edges.swing, edges.amplitude, edges.amplitudes
+    ints[_E_EVERY] = edges.every if margins.n_all == 3 and plan.n_all > 0 else 0  # (its layout: ``EdgeSearch``)
     ints[_E_N_SWING], ints[_E_N] = edges.n_swing, edges.n_samples
     noise[1] = edges.margins.residual_noise
     steps = np.ascontiguousarray(edges.steps, dtype=np.int64)
@@ -1230,6 +1284,8 @@ def search(
             fam,
             fcnt,
             multiplicity,
+            np.empty((0, 0, 1)),
+            np.empty((0, 0), dtype=np.int64),
         )
     if N == 1 and cnt[0] <= MAX_CAND and fcnt[0] == 0 and (redo is None or not redo[0]):
         # (a single pose: the general bookkeeping costs ~40 us)

@@ -417,11 +417,14 @@ class GeometricReduction(Reduction):
         from .kernels import RESIDUAL_SIG, RESIDUALS_SIG, SWING_SIG, address_of
 
         ck = self._case_kernels
+        L, row = geometric.LAYOUT, self._solving_row
+        every = row[L["pos_branches"]] == 4 and row[L["need"]] == 3  # (pair_every's plans: every branch searched)
         return fastsweep.EdgeSearch(
             margins=_Margins(self, np.empty((0, 0))),
             swing=address_of(geometric.swing, SWING_SIG),
             amplitude=address_of(ck.amplitude, RESIDUAL_SIG),
             amplitudes=address_of(ck.amplitudes, RESIDUALS_SIG),
+            every=address_of(ck.pair_every, RESIDUALS_SIG) if every else 0,
             steps=np.asarray(self._steps[1], dtype=np.int64),
             n_swing=geometric.SWING_PER_POSE,
             n_samples=sweep.N_SAMPLES,

@@ -665,10 +665,12 @@ class CaseKernels(NamedTuple):
     """The compiled kernels of the pair and wrist families for one position case (``position.CASES``): Python calls
     ``wrist_singular(params, thr, out, low, start, stop)``; the others are :class:`~.kernels.LazyKernel` objects with
     the engine's signatures (``pair_margin`` and ``amplitude`` take the step ``k`` where the others take a branch;
-    ``pair_residuals`` and ``pair_margins`` are their all-branch kernels, ``Reduction.kernel_residuals``)."""
+    ``pair_residuals`` and ``pair_margins`` are their all-branch kernels, ``Reduction.kernel_residuals``;
+    ``pair_every`` the residuals and margins at once)."""
 
     pair_residual: Any
     pair_residuals: Any
+    pair_every: Any
     pair_configuration: Any
     pair_margin: Any
     pair_margins: Any
@@ -729,6 +731,23 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
                     out[2 * b1] = _orientation(p, arm[0], arm[2], arm[3])
                     if 2 * b1 + 1 < nb:
                         out[2 * b1 + 1] = _orientation(p, arm[1], arm[2], arm[3])
+
+        def every(p, x, out):
+            """``residuals`` of the four branches and ``margins`` of the three steps at once, into ``out[:4]`` and
+            ``out[4:7]``, bit for bit theirs (the margins' cosines are those the residuals' first four joints come
+            from): the engine's uniform samples (``fastsweep.EdgeSearch.every``) for a plan whose four branches are all
+            searched (``LAYOUT['need']`` 3)."""
+            nb = int(p[_POS_BRANCHES])
+            both = BOTH + 0 * nb  # (a run-time value: see position.place)
+            a0 = _arm(p, x, 0 * nb, both, case, free, rev)
+            a1 = _arm(p, x, 1 + 0 * nb, both, case, free, rev)
+            out[0] = _orientation(p, a0[0], a0[2], a0[3])
+            out[1] = _orientation(p, a0[1], a0[2], a0[3])
+            out[2] = _orientation(p, a1[0], a1[2], a1[3])
+            out[3] = _orientation(p, a1[1], a1[2], a1[3])
+            out[4] = 1.0 - a0[2] * a0[2]
+            out[5] = 1.0 - a0[3] * a0[3]
+            out[6] = 1.0 - a1[3] * a1[3]
 
         def configuration(p, x, branch, out):
             arm = _arm(p, x, branch // 2, branch % 2, case, free, rev)
@@ -850,6 +869,7 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
         ck = _CASE_KERNELS[key] = CaseKernels(
             LazyKernel(residual, RESIDUAL_SIG, cache=True),
             LazyKernel(residuals, RESIDUALS_SIG, cache=True),
+            LazyKernel(every, RESIDUALS_SIG, cache=True),
             LazyKernel(configuration, CONFIGURATION_SIG, cache=True),
             LazyKernel(margin, RESIDUAL_SIG, cache=True),
             LazyKernel(margins, RESIDUALS_SIG, cache=True),
