@@ -368,7 +368,9 @@ if AVAILABLE:
             start = stop
         count[0] = c
 
-    @lazy_njit((int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True)
+    @lazy_njit(
+        (int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True, nogil=True
+    )
     def _dedupe_compiled(pose, q, score, rev, tol, keep):  # pragma: no cover
         _dedupe_rows(pose, q, score, rev, tol, keep)
 

@@ -203,6 +203,31 @@ def _orientation(p, m, c1, c2):
 
 
 @inlined
+def _orientations(p, m, n, c1, c2):
+    """``_orientation`` of two branches of one first step (motions ``m`` and ``n``, the same cosines), bit for bit:
+    the target's joint-6 axis is rotated once for both, and each joint's rotation of joint 5's axis once while the
+    two branches' motions and vectors so far agree (from the last joint: the first step's joint, and theta* when it
+    is joint 4)."""
+    if not (in_domain(c1) and in_domain(c2)):
+        return math.nan, math.nan
+    h4, h5 = _h(p, 4), _h(p, 5)
+    g, k = _mat(p, h5), dot(h4, h5)
+    ms, ns = m, n
+    vm, vn = h4, h4
+    shared = True
+    for i in range(3, -1, -1):
+        if p[_REV + i] > 0.5:
+            hi = _h(p, i)
+            a, b = ms[i], ns[i]
+            vm = rot_cs(hi, a[0], a[1], vm)
+            shared = shared and a[0] == b[0] and a[1] == b[1]
+            vn = vm if shared else rot_cs(hi, b[0], b[1], vn)
+    rm = math.nan if _missing(m[0], m[1], m[2], m[3]) else dot(vm, g) - k
+    rn = math.nan if _missing(n[0], n[1], n[2], n[3]) else dot(vn, g) - k
+    return rm, rn
+
+
+@inlined
 def _back(p, m0, m1, m2, m3, v):
     """``R_04^T v = R_3^T R_2^T R_1^T R_0^T v``: ``v`` seen from frame 4 (joint 0's rotation undone first)."""
     ms = (m0, m1, m2, m3)
@@ -563,7 +588,7 @@ def configure(cfg, params, pose, theta, branch, out):
 _CONTINUUM_SIG = _EVALUATE_SIG + (float64, int64, float64[::1], int64[::1], int64[::1])
 
 
-@lazy_njit(_CONTINUUM_SIG, cache=True)
+@lazy_njit(_CONTINUUM_SIG, cache=True, nogil=True)
 def _continuum_rows(amp, params, pose, theta, branch, err, tol, div, thr, joints, out):
     amp = as_residual(amp)
     flagged = 0
@@ -720,10 +745,9 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
                 # shares their common work (theta*'s motion, the reduced chain) and interleaves the rest (~-4 %)
                 a0 = _arm(p, x, 0 * nb, both, case, free, rev)
                 a1 = _arm(p, x, 1 + 0 * nb, both, case, free, rev)
-                out[0] = _orientation(p, a0[0], a0[2], a0[3])
-                out[1] = _orientation(p, a0[1], a0[2], a0[3])
-                out[2] = _orientation(p, a1[0], a1[2], a1[3])
-                out[3] = _orientation(p, a1[1], a1[2], a1[3])
+                r0, r1 = _orientations(p, a0[0], a0[1], a0[2], a0[3])
+                r2, r3 = _orientations(p, a1[0], a1[1], a1[2], a1[3])
+                out[0], out[1], out[2], out[3] = r0, r1, r2, r3
                 return
             for b1 in range((nb + 1) // 2):
                 if need & (1 << b1):
@@ -741,10 +765,9 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
             both = BOTH + 0 * nb  # (a run-time value: see position.place)
             a0 = _arm(p, x, 0 * nb, both, case, free, rev)
             a1 = _arm(p, x, 1 + 0 * nb, both, case, free, rev)
-            out[0] = _orientation(p, a0[0], a0[2], a0[3])
-            out[1] = _orientation(p, a0[1], a0[2], a0[3])
-            out[2] = _orientation(p, a1[0], a1[2], a1[3])
-            out[3] = _orientation(p, a1[1], a1[2], a1[3])
+            r0, r1 = _orientations(p, a0[0], a0[1], a0[2], a0[3])
+            r2, r3 = _orientations(p, a1[0], a1[1], a1[2], a1[3])
+            out[0], out[1], out[2], out[3] = r0, r1, r2, r3
             out[4] = 1.0 - a0[2] * a0[2]
             out[5] = 1.0 - a0[3] * a0[3]
             out[6] = 1.0 - a1[3] * a1[3]
