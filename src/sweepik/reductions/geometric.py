@@ -785,9 +785,11 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
         def margin(p, x, k):
             """``1 - c^2`` of step k's cosine c: positive inside the branch domains, zero at their edges (found by
             the same sweep, and sampled as hints)."""
-            arm = _arm(p, x, 0 if k == 0 else k - 1, NEITHER + 0 * k, case, free, rev)
-            c = arm[2] if k == 0 else arm[3]
-            return 1.0 - c * c
+            if k == 0:  # (the first step's cosine alone: the compiler drops the second step)
+                arm = _arm(p, x, 0 * k, NEITHER + 0 * k, case, free, rev)
+                return 1.0 - arm[2] * arm[2]
+            arm = _arm(p, x, k - 1, NEITHER + 0 * k, case, free, rev)
+            return 1.0 - arm[3] * arm[3]
 
         def margins(p, x, out):
             """``margin`` of steps 0 and 1 (one first-step branch) and of step 2 (the other) at once, as they are
