@@ -811,8 +811,11 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
                 pb = k - 3
                 arm = _arm(p, x, pb // 2, pb % 2, case, free, rev)
                 return arm[6] if pb % 2 == 0 else arm[7]
-            arm = _arm(p, x, 0 if k == 0 else k - 1, NEITHER + 0 * k, case, free, rev)
-            return arm[4] if k == 0 else arm[5]
+            if k == 0:  # (the first step alone, as ``margin``)
+                arm = _arm(p, x, 0 * k, NEITHER + 0 * k, case, free, rev)
+                return arm[4]
+            arm = _arm(p, x, k - 1, NEITHER + 0 * k, case, free, rev)
+            return arm[5]
 
         def amplitudes(p, x, out):
             """``amplitude`` of the steps wanted (``LAYOUT['need_amplitude']``: bit k for step k) at once."""
