@@ -418,7 +418,7 @@ class GeometricReduction(Reduction):
 
         ck = self._case_kernels
         L, row = geometric.LAYOUT, self._solving_row
-        every = row[L["pos_branches"]] == 4 and row[L["need"]] == 3  # (pair_every's plans: every branch searched)
+        every = row[L["pos_branches"]] == 4 and row[L["need"]] == 3  # (pair_every's plans: both first steps)
         return fastsweep.EdgeSearch(
             margins=_Margins(self, np.empty((0, 0))),
             swing=address_of(geometric.swing, SWING_SIG),

@@ -212,13 +212,12 @@ def _orientations(p, m, n, c1, c2):
         return math.nan, math.nan
     h4, h5 = _h(p, 4), _h(p, 5)
     g, k = _mat(p, h5), dot(h4, h5)
-    ms, ns = m, n
     vm, vn = h4, h4
     shared = True
     for i in range(3, -1, -1):
         if p[_REV + i] > 0.5:
             hi = _h(p, i)
-            a, b = ms[i], ns[i]
+            a, b = m[i], n[i]
             vm = rot_cs(hi, a[0], a[1], vm)
             shared = shared and a[0] == b[0] and a[1] == b[1]
             vn = vm if shared else rot_cs(hi, b[0], b[1], vn)
@@ -742,7 +741,7 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
             both = BOTH + 0 * nb  # (a run-time value: see position.place)
             if nb == 4 and need & 3 == 3:
                 # the usual case written out: both first-step branches in one stretch of code, so that the compiler
-                # shares their common work (theta*'s motion, the reduced chain) and interleaves the rest (~-4 %)
+                # shares their common work (theta*'s motion, the reduced chain) and interleaves the rest
                 a0 = _arm(p, x, 0 * nb, both, case, free, rev)
                 a1 = _arm(p, x, 1 + 0 * nb, both, case, free, rev)
                 r0, r1 = _orientations(p, a0[0], a0[1], a0[2], a0[3])
@@ -759,8 +758,8 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
         def every(p, x, out):
             """``residuals`` of the four branches and ``margins`` of the three steps at once, into ``out[:4]`` and
             ``out[4:7]``, bit for bit theirs (the margins' cosines are those the residuals' first four joints come
-            from): the engine's uniform samples (``fastsweep.EdgeSearch.every``) for a plan whose four branches are all
-            searched (``LAYOUT['need']`` 3)."""
+            from): the engine's uniform samples (``fastsweep.EdgeSearch.every``) for a plan that searches both
+            first-step branches (``LAYOUT['need']`` 3)."""
             nb = int(p[_POS_BRANCHES])
             both = BOTH + 0 * nb  # (a run-time value: see position.place)
             a0 = _arm(p, x, 0 * nb, both, case, free, rev)
