@@ -995,14 +995,15 @@ class EdgeSearch(NamedTuple):
     swing: int  # the address of the swing kernel (``kernels.SWING_SIG``)
     amplitude: int  # ... of the amplitude kernels it takes
     amplitudes: int
-    # ... of a kernel computing the residuals and the margins at once (``kernels.RESIDUALS_SIG``: the reduction's
-    # branches, then 3 margins; 0: none), for the uniform samples that both searches take
-    every: int
     steps: NDArray[np.int64]  # the steps whose amplitudes it examines
     n_swing: int  # the samples it writes per pose, at most
     n_samples: int  # its grid's samples (the sweep's default: ``sweep.N_SAMPLES``)
     hint_range: Any  # ``hint_range(reduction, poses) -> (lo, hi)``: theta*'s range its hints are sought over
     # (a function, not a bound method: the engine keeps its plan while the reduction lives, and no longer)
+    # the address of a kernel computing the residuals and the margins at once (``kernels.RESIDUALS_SIG``: the
+    # reduction's ``n_branches`` residuals, then the margins' 3), for the uniform samples that both searches take
+    # (used where the margins have an all-branch kernel of 3); 0: none, each search evaluates its own
+    every: int = 0
 
 
 def writable(a: ArrayLike) -> Array:

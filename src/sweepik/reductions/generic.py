@@ -424,11 +424,11 @@ class GeometricReduction(Reduction):
             swing=address_of(geometric.swing, SWING_SIG),
             amplitude=address_of(ck.amplitude, RESIDUAL_SIG),
             amplitudes=address_of(ck.amplitudes, RESIDUALS_SIG),
-            every=address_of(ck.pair_every, RESIDUALS_SIG) if every else 0,
             steps=np.asarray(self._steps[1], dtype=np.int64),
             n_swing=geometric.SWING_PER_POSE,
             n_samples=sweep.N_SAMPLES,
             hint_range=GeometricReduction._range,
+            every=address_of(ck.pair_every, RESIDUALS_SIG) if every else 0,
         )
 
     def _range(self, poses: Array) -> tuple[Array, Array]:
