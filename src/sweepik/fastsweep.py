@@ -311,6 +311,12 @@ if AVAILABLE:
         return min(abs(f[e]), abs(f[n1])) <= BEND * abs(dd) * x1 * x1
 
     @inlined
+    def _dd(fa, fb, fc, hl, hr):
+        """The second divided difference of three samples ``hl`` and ``hr`` apart (the scan's curvature, as the
+        reference's ``sweep._Search.scan`` works it out)."""
+        return 2.0 * ((fc - fb) / hr - (fb - fa) / hl) / (hl + hr)
+
+    @inlined
     def _bends_later(f_all, th, later, j):
         """Level 0: some branch of ``later`` bends in interval j, away from a domain edge: the first level's bend test
         (``BEND``, in theta) on the residuals ``f_all`` of every branch (a forecast: the branch's own scan decides)."""
@@ -327,13 +333,13 @@ if AVAILABLE:
                 if math.isnan(fm):
                     continue
                 hl, hr = th[j] - th[j - 1], h
-                curv = abs(2.0 * ((f1 - f0) / hr - (f0 - fm) / hl) / (hl + hr))
+                curv = abs(_dd(fm, f0, f1, hl, hr))
             if j + 2 < M:
                 fp = f_all[j + 2, b]
                 if math.isnan(fp):
                     continue
                 hl, hr = h, th[j + 2] - th[j + 1]
-                curv = max(curv, abs(2.0 * ((fp - f1) / hr - (f1 - f0) / hl) / (hl + hr)))
+                curv = max(curv, abs(_dd(f0, f1, fp, hl, hr)))
             if min(abs(f0), abs(f1)) <= BEND * curv * h * h:
                 return True
         return False
@@ -368,7 +374,7 @@ if AVAILABLE:
             hl, hr = th[j] - tm, tp - th[j]
             if not (hl > 0 and hr > 0):
                 continue
-            ddj = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr)
+            ddj = _dd(fm, fc, fp, hl, hr)
             if abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2:  # (it may touch zero)
                 _extremum(res, p, b, tm, th[j], tp, fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
         for j in range(M):  # samples next to a domain edge (or at the range ends, level 0)
@@ -405,7 +411,7 @@ if AVAILABLE:
                 hl = x[j + 1] - x[j]
                 hr = x[j + 2] - x[j + 1]
                 if hl != 0.0 and hr != 0.0:  # (decreasing where the edge is on the right: same dd)
-                    c2 = 2.0 * ((f[j + 2] - f[j + 1]) / hr - (f[j + 1] - f[j]) / hl) / (hl + hr)
+                    c2 = _dd(f[j], f[j + 1], f[j + 2], hl, hr)
             if not (valid[j] and valid[j + 1] and th[j + 1] > th[j]):
                 continue
             prod = f[j] * f[j + 1]

@@ -194,20 +194,17 @@ def _missing(m0, m1, m2, m3):
 @inlined
 def _orientation(p, m, c1, c2):
     """The pair family's residual for the motions ``m`` of the first four joints and the cosines of the position
-    case's steps: NaN outside the branch's domain."""
-    m0, m1, m2, m3 = m
-    if _missing(m0, m1, m2, m3) or not (in_domain(c1) and in_domain(c2)):
-        return math.nan
-    h4, h5 = _h(p, 4), _h(p, 5)
-    return dot(_fore(p, m0, m1, m2, m3, h4), _mat(p, h5)) - dot(h4, h5)
+    case's steps (``_orientations`` of one branch): NaN outside the branch's domain."""
+    return _orientations(p, m, m, c1, c2)[0]
 
 
 @inlined
 def _orientations(p, m, n, c1, c2):
-    """``_orientation`` of two branches of one first step (motions ``m`` and ``n``, the same cosines), bit for bit:
-    the target's joint-6 axis is rotated once for both, and each joint's rotation of joint 5's axis once while the
-    two branches' motions and vectors so far agree (from the last joint: the first step's joint, and theta* when it
-    is joint 4)."""
+    """The pair family's residuals of two branches of one first step (motions ``m`` and ``n`` of the first four
+    joints, the same cosines): joint 5's axis turned by ``R_04``, dotted with the target's joint-6 axis, less
+    ``h5 . h6``; NaN outside a branch's domain. The target's axis is computed once for both, and each joint's rotation
+    of joint 5's axis once while the two branches' motions and vectors so far agree (from the last joint: the first
+    step's joint, and theta* when it is joint 4)."""
     if not (in_domain(c1) and in_domain(c2)):
         return math.nan, math.nan
     h4, h5 = _h(p, 4), _h(p, 5)
@@ -233,16 +230,6 @@ def _back(p, m0, m1, m2, m3, v):
     for i in range(4):
         if p[_REV + i] > 0.5:
             v = rot_cs(_h(p, i), ms[i][0], -ms[i][1], v)
-    return v
-
-
-@inlined
-def _fore(p, m0, m1, m2, m3, v):
-    """``R_04 v``."""
-    ms = (m0, m1, m2, m3)
-    for i in range(3, -1, -1):
-        if p[_REV + i] > 0.5:
-            v = rot_cs(_h(p, i), ms[i][0], ms[i][1], v)
     return v
 
 
