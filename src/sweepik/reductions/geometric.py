@@ -391,7 +391,13 @@ def _parallel_finish(p, shared, elbow, out):
     # joint 4 = phi - joint 2 - joint 3 (angles as unit complex numbers)
     c12, s12 = c1 * c2 - s1_ * s2_, s1_ * c2 + c1 * s2_
     c3, s3_ = cf * c12 + sf * s12, sf * c12 - cf * s12
-    _write(p, out, m0, (c1, s1_, 0.0), (c2, s2_, 0.0), (c3, s3_, 0.0), math.atan2(m4[1], m4[0]), math.atan2(s5, c5))
+    # the angles above turn about h (joint 2's axis); an axis written the other way round (-h) turns by minus them
+    g2 = 1.0 if dot(_h(p, 2), h) > 0.0 else -1.0
+    g3 = 1.0 if dot(_h(p, 3), h) > 0.0 else -1.0
+    _write(
+        p, out, m0, (c1, s1_, 0.0), (c2, g2 * s2_, 0.0), (c3, g3 * s3_, 0.0), math.atan2(m4[1], m4[0]),
+        math.atan2(s5, c5),
+    )
 
 
 def _parallel_configuration(p, x, branch, out):

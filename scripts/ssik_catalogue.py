@@ -1,0 +1,182 @@
+"""sweepik against ssik's prebuilt catalogue: recall, agreement and wrong answers on vendors' arms (issue 35).
+
+Each prebuilt ssik arm (``ssik.list_arms()``) is rebuilt in sweepik in origin + axis form from the artifact's own
+per-joint constants (``T_left[i] @ Rot(axis_i, q_i) @ T_right[i]``), lengths in metres; its FK is checked against the
+artifact's ``fk``. For every six-joint arm: random configurations (uniform over [-pi, pi)) and configurations on
+singular sets, limits off; ``sweepik.solve_many`` must return the generating configuration (recall), every solution
+must reproduce the pose (wrong), and the set is compared with ssik's ``solve(T, respect_limits=False)``.
+
+    python scripts/ssik_catalogue.py [--n 50] [--singular 0] [--arms ur5_ik ...] [--rewrite] [--seed 0]
+
+``--rewrite`` rewrites each arm at random first (axis reversals, zero offsets, base/tool transforms, millimetres):
+the recall must not change.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+
+import sweepik  # noqa: E402
+from sweepik.robot import Joint, Robot  # noqa: E402
+
+
+def ssik_module(name: str):  # type: ignore[no-untyped-def]
+    import ssik
+
+    entry = next(a for a in ssik.list_arms() if a.name == name)
+    return importlib.import_module(entry.import_path)
+
+
+def _tuple(T: np.ndarray) -> tuple[tuple[float, ...], ...]:
+    return tuple(tuple(float(v) for v in row) for row in T)
+
+
+def robot_from_ssik(name: str) -> Robot:
+    """The ssik artifact ``name`` as a sweepik robot (origin + axis, metres, limits from the artifact)."""
+    m = ssik_module(name)
+    joints = []
+    carry = np.eye(4)
+    for i, (ax, TL, TR, ty, lim) in enumerate(
+        zip(m._JOINT_AXES, m._JOINT_T_LEFTS, m._JOINT_T_RIGHTS, m._JOINT_TYPES, m._JOINT_LIMITS, strict=True)
+    ):
+        typ = "revolute" if ty in ("revolute", "continuous") else "prismatic"
+        joints.append(
+            Joint(
+                typ,
+                origin=_tuple(carry @ np.asarray(TL)),
+                axis=tuple(float(v) for v in ax),
+                lower=-np.pi if lim is None else float(lim[0]),
+                upper=np.pi if lim is None else float(lim[1]),
+                name=str(m._JOINT_NAMES[i]),
+            )
+        )
+        carry = np.asarray(TR, dtype=np.float64)
+    return Robot(name.removesuffix("_ik"), tuple(joints), "none", T_flange_tool=carry, length_unit="m")
+
+
+def check_fk(robot: Robot, name: str, rng: np.random.Generator) -> float:
+    m = ssik_module(name)
+    Q = rng.uniform(-np.pi, np.pi, (20, robot.n_joints))
+    return max(float(np.abs(robot.fk(q) - m.fk(q)).max()) for q in Q)
+
+
+def _rot(axis: np.ndarray, t: float) -> np.ndarray:
+    axis = axis / np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K
+
+
+def random_transform(rng: np.random.Generator, length: float) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = _rot(rng.normal(size=3), rng.uniform(-np.pi, np.pi))
+    T[:3, 3] = rng.uniform(-length, length, 3)
+    return T
+
+
+def rewrite(robot: Robot, rng: np.random.Generator) -> tuple[Robot, np.ndarray, np.ndarray, np.ndarray, float]:
+    """The same arm written otherwise: ``(robot2, sign, offset, A, scale)`` with
+    ``robot2.fk(sign * q - offset) = A @ S(robot.fk(q)) @ B`` for some tool ``B`` and ``S`` scaling lengths
+    by ``scale``; configurations map as ``q2 = sign * q - offset`` (``q = sign * (q2 + offset)``).
+    Axis reversals, zero offsets (revolute joints), base and tool transforms and a unit change (m -> mm)."""
+    from sweepik.origin_axis import origin_axis_form
+
+    r = origin_axis_form(robot)
+    n = r.n_joints
+    scale = 1000.0 if rng.random() < 0.5 else 1.0
+    sign = np.where(rng.random(n) < 0.5, -1.0, 1.0)
+    offset = np.where(r.is_revolute & (rng.random(n) < 0.5), rng.uniform(-np.pi, np.pi, n), 0.0)
+    joints = []
+    for j, s, o in zip(r.joints, sign, offset, strict=True):
+        org = np.array(j.origin)
+        org[:3, 3] *= scale
+        axis = np.array(j.axis)
+        if o != 0.0:
+            # q_old = s * (q_new + o): the joint's frame rotated by s*o about its axis at q_new = 0
+            org[:3, :3] = org[:3, :3] @ _rot(axis, s * o)
+        lo, hi = (j.lower, j.upper) if s > 0 else (-j.upper, -j.lower)
+        if j.is_revolute:
+            lo, hi = lo - o, hi - o
+        else:
+            lo, hi = lo * scale, hi * scale
+        joints.append(Joint(j.type, origin=_tuple(org), axis=tuple(float(v) for v in s * axis), lower=lo, upper=hi,
+                            name=j.name))
+    A = random_transform(rng, 0.5 * scale)
+    B = random_transform(rng, 0.1 * scale)
+    base = np.array(r.T_world_base)
+    base[:3, 3] *= scale
+    tool = np.array(r.T_flange_tool)
+    tool[:3, 3] *= scale
+    unit = "mm" if scale == 1000.0 else r.length_unit
+    r2 = Robot(r.name + "_rewritten", tuple(joints), "none", T_world_base=A @ base, T_flange_tool=tool @ B,
+               length_unit=unit)
+    return r2, sign, offset, A, scale
+
+
+def main() -> None:
+    import ssik
+
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n", type=int, default=50)
+    ap.add_argument("--arms", nargs="*", default=None)
+    ap.add_argument("--rewrite", action="store_true")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--ssik", action="store_true", help="also compare sets with ssik")
+    ap.add_argument("--slow", type=float, default=0.05, help="report solves slower than this (s)")
+    args = ap.parse_args()
+    names = args.arms or [a.name for a in ssik.list_arms() if a.dof == 6]
+    total = total_rec = 0
+    for name in names:
+        rng = np.random.default_rng(args.seed)
+        robot = robot_from_ssik(name)
+        fk_err = check_fk(robot, name, rng)
+        Q = rng.uniform(-np.pi, np.pi, (args.n, robot.n_joints))
+        solver_robot, Qs = robot, Q
+        if args.rewrite:
+            solver_robot, sign, offset, _, _ = rewrite(robot, rng)
+            Qs = sign * Q - offset
+        try:
+            a = sweepik.analyze(solver_robot); c = a["chosen"]; plan = (a["structure"], c and (c["family"], c["free_joint"], c["chain"], c["case"]), a["reason"])
+        except Exception as exc:  # noqa: BLE001
+            plan = f"refused: {exc}"
+        T = solver_robot.fk(Qs)
+        rec = wrong = slow = 0
+        misses = []
+        t0 = time.perf_counter()
+        for i, (t, q) in enumerate(zip(T, Qs, strict=True)):
+            t1 = time.perf_counter()
+            try:
+                s = sweepik.solve(solver_robot, t, limits=False)
+            except sweepik.SweepikError:
+                misses.append(i)
+                continue
+            dt = time.perf_counter() - t1
+            slow += dt > args.slow
+            if not (len(s) or s.families):
+                misses.append(i)
+                continue
+            d = s.nearest(q) - q
+            d = np.where(solver_robot.is_revolute, np.angle(np.exp(1j * d)), d / solver_robot.length_scale)
+            ok = bool(np.max(np.abs(d)) < 1e-6)
+            rec += ok
+            if not ok:
+                misses.append(i)
+            if len(s):
+                wrong += int((s.error_geodesic > 1e-9 * solver_robot.length_scale).sum())
+        dt = time.perf_counter() - t0
+        total += len(Q)
+        total_rec += rec
+        print(f"{name:24s} fk {fk_err:.1e}  recall {rec:3d}/{len(Q)}  wrong {wrong}  slow {slow}  "
+              f"{dt / len(Q) * 1e3:6.2f} ms/pose  {str(plan)[:70]}  misses {misses[:6]}", flush=True)
+    print(f"total recall {total_rec}/{total} ({100 * total_rec / max(total, 1):.2f} %)")
+
+
+if __name__ == "__main__":
+    main()
