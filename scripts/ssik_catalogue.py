@@ -24,6 +24,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
+from rewrites import rewrite  # noqa: E402
+
 import sweepik  # noqa: E402
 from sweepik.robot import Joint, Robot  # noqa: E402
 
@@ -68,56 +70,33 @@ def check_fk(robot: Robot, name: str, rng: np.random.Generator) -> float:
     return max(float(np.abs(robot.fk(q) - m.fk(q)).max()) for q in Q)
 
 
-def _rot(axis: np.ndarray, t: float) -> np.ndarray:
-    axis = axis / np.linalg.norm(axis)
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    return np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K
+def singular_configurations(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
+    """``(m, n_joints)`` configurations on the arm's singular set (det J = 0, found along one joint from a random
+    configuration by a sign change and bisection) and 1e-9 ... 1e-3 off it along that joint."""
+    from scipy.optimize import brentq
 
+    out: list[np.ndarray] = []
+    grid = np.linspace(-np.pi, np.pi, 721)
+    while len(out) < n:
+        q = rng.uniform(-np.pi, np.pi, robot.n_joints)
+        k = int(rng.integers(robot.n_joints))
 
-def random_transform(rng: np.random.Generator, length: float) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = _rot(rng.normal(size=3), rng.uniform(-np.pi, np.pi))
-    T[:3, 3] = rng.uniform(-length, length, 3)
-    return T
+        def det(x: float, q: np.ndarray = q, k: int = k) -> float:
+            qq = q.copy()
+            qq[k] = x
+            return float(np.linalg.det(robot.jacobian(qq)))
 
-
-def rewrite(robot: Robot, rng: np.random.Generator) -> tuple[Robot, np.ndarray, np.ndarray, np.ndarray, float]:
-    """The same arm written otherwise: ``(robot2, sign, offset, A, scale)`` with
-    ``robot2.fk(sign * q - offset) = A @ S(robot.fk(q)) @ B`` for some tool ``B`` and ``S`` scaling lengths
-    by ``scale``; configurations map as ``q2 = sign * q - offset`` (``q = sign * (q2 + offset)``).
-    Axis reversals, zero offsets (revolute joints), base and tool transforms and a unit change (m -> mm)."""
-    from sweepik.origin_axis import origin_axis_form
-
-    r = origin_axis_form(robot)
-    n = r.n_joints
-    scale = 1000.0 if rng.random() < 0.5 else 1.0
-    sign = np.where(rng.random(n) < 0.5, -1.0, 1.0)
-    offset = np.where(r.is_revolute & (rng.random(n) < 0.5), rng.uniform(-np.pi, np.pi, n), 0.0)
-    joints = []
-    for j, s, o in zip(r.joints, sign, offset, strict=True):
-        org = np.array(j.origin)
-        org[:3, 3] *= scale
-        axis = np.array(j.axis)
-        if o != 0.0:
-            # q_old = s * (q_new + o): the joint's frame rotated by s*o about its axis at q_new = 0
-            org[:3, :3] = org[:3, :3] @ _rot(axis, s * o)
-        lo, hi = (j.lower, j.upper) if s > 0 else (-j.upper, -j.lower)
-        if j.is_revolute:
-            lo, hi = lo - o, hi - o
-        else:
-            lo, hi = lo * scale, hi * scale
-        joints.append(Joint(j.type, origin=_tuple(org), axis=tuple(float(v) for v in s * axis), lower=lo, upper=hi,
-                            name=j.name))
-    A = random_transform(rng, 0.5 * scale)
-    B = random_transform(rng, 0.1 * scale)
-    base = np.array(r.T_world_base)
-    base[:3, 3] *= scale
-    tool = np.array(r.T_flange_tool)
-    tool[:3, 3] *= scale
-    unit = "mm" if scale == 1000.0 else r.length_unit
-    r2 = Robot(r.name + "_rewritten", tuple(joints), "none", T_world_base=A @ base, T_flange_tool=tool @ B,
-               length_unit=unit)
-    return r2, sign, offset, A, scale
+        vals = np.array([det(x) for x in grid])
+        idx = np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)
+        if idx.size == 0:
+            continue
+        i = int(rng.choice(idx))
+        x = brentq(det, grid[i], grid[i + 1], xtol=1e-15)
+        delta = float(rng.choice([0.0, 0.0, 1e-9, 1e-7, 1e-5, 1e-4, 1e-3])) * float(rng.choice([-1.0, 1.0]))
+        qs = q.copy()
+        qs[k] = x + delta
+        out.append(qs)
+    return np.array(out[:n])
 
 
 def main() -> None:
@@ -128,6 +107,7 @@ def main() -> None:
     ap.add_argument("--arms", nargs="*", default=None)
     ap.add_argument("--rewrite", action="store_true")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--singular", type=int, default=0, help="configurations on (and near) the singular set per arm")
     ap.add_argument("--ssik", action="store_true", help="also compare sets with ssik")
     ap.add_argument("--slow", type=float, default=0.05, help="report solves slower than this (s)")
     args = ap.parse_args()
@@ -138,12 +118,16 @@ def main() -> None:
         robot = robot_from_ssik(name)
         fk_err = check_fk(robot, name, rng)
         Q = rng.uniform(-np.pi, np.pi, (args.n, robot.n_joints))
+        if args.singular:
+            Q = np.concatenate([Q, singular_configurations(robot, args.singular, rng)])
         solver_robot, Qs = robot, Q
         if args.rewrite:
-            solver_robot, sign, offset, _, _ = rewrite(robot, rng)
-            Qs = sign * Q - offset
+            rw = rewrite(robot, rng)
+            solver_robot, Qs = rw.robot, rw.forward(Q)
         try:
-            a = sweepik.analyze(solver_robot); c = a["chosen"]; plan = (a["structure"], c and (c["family"], c["free_joint"], c["chain"], c["case"]), a["reason"])
+            a = sweepik.analyze(solver_robot)
+            c = a["chosen"]
+            plan = (a["structure"], c and (c["family"], c["free_joint"], c["chain"], c["case"]), a["reason"])
         except Exception as exc:  # noqa: BLE001
             plan = f"refused: {exc}"
         T = solver_robot.fk(Qs)
@@ -173,8 +157,11 @@ def main() -> None:
         dt = time.perf_counter() - t0
         total += len(Q)
         total_rec += rec
-        print(f"{name:24s} fk {fk_err:.1e}  recall {rec:3d}/{len(Q)}  wrong {wrong}  slow {slow}  "
-              f"{dt / len(Q) * 1e3:6.2f} ms/pose  {str(plan)[:70]}  misses {misses[:6]}", flush=True)
+        print(
+            f"{name:24s} fk {fk_err:.1e}  recall {rec:3d}/{len(Q)}  wrong {wrong}  slow {slow}  "
+            f"{dt / len(Q) * 1e3:6.2f} ms/pose  {str(plan)[:70]}  misses {misses[:6]}",
+            flush=True,
+        )
     print(f"total recall {total_rec}/{total} ({100 * total_rec / max(total, 1):.2f} %)")
 
 

@@ -26,10 +26,22 @@ import sweepik
 from sweepik import NoReductionError
 from sweepik.reductions.decompose import plans
 from sweepik.robot_file import bundled_robots, robot_from_dict
+from sweepik.structure import near_structure
 
 # the six-joint bundled arms (the seven-joint ones are solved with a joint locked: tests/test_locked.py)
 BUNDLED = [n for n in bundled_robots() if sweepik.load_robot(n).n_joints == 6]
-CLOSED = {"puma560", "puma560_std", "kuka_kr6_r900", "abb_irb140", "stanford", "carm_swapped", "ur3", "ur5", "ur10"}
+CLOSED = {
+    "puma560",
+    "puma560_std",
+    "kuka_kr6_r900",
+    "abb_irb140",
+    "stanford",
+    "carm_swapped",
+    "ur3",
+    "ur5",
+    "ur10",
+    "standardbots_spark",
+}
 CERT_REL = 1e-9
 # the bundled 6R arms sweepik sweeps (no closed form): those ssik's Raghavan-Roth elimination is compared on
 SWEPT_6R = [
@@ -85,7 +97,11 @@ def test_other_decompositions_agree(name):
     # prismatic joints lie beyond them
     ref = sweepik.solve_many(robot, T, **_kw(robot))
     for k in frees:
-        other = sweepik.solve_many(robot, T, free_joint=k)
+        try:
+            other = sweepik.solve_many(robot, T, free_joint=k)
+        except sweepik.NoReductionError:  # (a sweep that its check on the arm found lossy: a near-structure)
+            assert near_structure(robot.chain, robot.length_scale), (name, k)
+            continue
         same = [
             same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale) for a, b in zip(ref, other, strict=True)
         ]
@@ -114,8 +130,11 @@ def _ssik_difference(robot, k, q, T, ours, ref):
     singular value of the Jacobian there (near 0: a multiple root or a continuum, known only to ~sqrt(rounding))
     and whether a many-start numerical search (a third opinion) finds it."""
     rev, L = robot.is_revolute, robot.length_scale
-    missing = [x for x in ref if not recovers(robot, ours, x)]
-    extra = [x for x in ours.q if not contains(ref, x, rev, L)]
+    # an oracle's solution next to a singular configuration is only as exact as its FK error over the Jacobian's
+    # smallest singular value (ssik's near a nearly spherical wrist: FK errors 1e-9 ... 4e-7, joints 1e-3 off)
+    tol = [max(1e-6, 10.0 * max(pose_errors(robot.fk(x), T, L)) / _sigma_min(robot, x)) for x in ref]
+    missing = [x for x, t in zip(ref, tol, strict=True) if not recovers(robot, ours, x, t)]
+    extra = [x for x in ours.q if not any(contains(y[None], x, rev, L, t) for y, t in zip(ref, tol, strict=True))]
     if not missing and not extra:
         return None
     num = numerical_solutions(robot, T, n_starts=600, full_circle=True)
@@ -132,6 +151,13 @@ def _ssik_difference(robot, k, q, T, ours, ref):
                 f"numerical search finds it: {contains(num, x, rev, L, 1e-5)}"
             )
     return "\n".join(lines)
+
+
+def _sigma_min(robot, q):
+    """The smallest singular value of the Jacobian at ``q``, lengths over the arm's length scale."""
+    J = robot.jacobian(q)
+    J[:3] /= robot.length_scale
+    return max(float(np.linalg.svd(J, compute_uv=False)[-1]), 1e-300)
 
 
 def test_swept_6r_arms_are_found():

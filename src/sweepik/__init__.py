@@ -10,6 +10,7 @@ docs/conventions.md for units and conventions.
 
 from typing import TYPE_CHECKING, Any
 
+from . import plan_check as _plan_check  # noqa: F401 (registers the automatic decomposition's check)
 from .analysis import analyze
 from .batch import SolutionBatch
 from .errors import (

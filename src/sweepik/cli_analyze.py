@@ -76,13 +76,20 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     if "locks" in info:
         _print_locks(robot, info["locks"])
         return 0
+    if info.get("near_structure"):
+        print(f"near-structure (holds nearly, not exactly: a general arm there): {', '.join(info['near_structure'])}")
     chosen = info["chosen"]
     if chosen is None:
         print(f"no decomposition: {info['reason']}")
         return 0
     print(f"chosen: {plan_line(chosen)}")
+    print(f"  why: {info['why']}")
     for step in chosen["steps"]:
         print(f"  - {step}")
+    if info.get("checks"):
+        print("checked on the arm (configurations given back, solutions found):")
+        for c in info["checks"]:
+            print(f"  {plan_line(c)} ({c['case']}): {c['recovered']}/{c['checked']}, {c['solutions']}")
     rows = [
         [
             str(i + 1),

@@ -26,7 +26,7 @@ from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
 from .polish import geodesic_errors, polish
 from .pose import pose_error_geodesic, pose_error_paper
-from .reductions import Reduction, get_reduction, is_default
+from .reductions import Reduction, automatic_for_held, get_reduction, is_default
 from .reductions.decompose import not_sweepable
 from .reductions.kernels import owned_kernel
 from .robot import Robot
@@ -855,7 +855,10 @@ def _prepare(
         )
     fj = _free_joint_index(robot, free_joint, reduction)
     try:
-        red = get_reduction(robot, reduction, fj)
+        if held is not None and fj is None and is_default(robot, reduction) and robot.default_reduction is None:
+            red = automatic_for_held(held.robot, tuple(k for k, _ in held.held), robot)
+        else:
+            red = get_reduction(robot, reduction, fj)
     except NoReductionError:
         if held is None or fj is None:
             raise

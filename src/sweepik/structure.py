@@ -27,13 +27,28 @@ from .chain import Chain
 
 Array = NDArray[np.float64]
 
-__all__ = ["Structure", "structure_of", "line_relation", "PARALLEL_TOL", "INTERSECT_TOL_REL"]
+__all__ = [
+    "Structure",
+    "structure_of",
+    "near_structure",
+    "line_relation",
+    "PARALLEL_TOL",
+    "INTERSECT_TOL_REL",
+    "NEAR_TOL",
+]
 
 #: Two axes are parallel when the sine of the angle between them is below this (radians). Published arm
 #: parameters are exact (90 degrees, 0 mm); rounding a right angle to 7 digits (1.570796) is 3e-7 off.
 PARALLEL_TOL = 1e-9
 #: Two axis lines intersect when their distance is below this times the robot's length scale.
 INTERSECT_TOL_REL = 1e-9
+#: A relation that holds to within this (the sine of an angle, or a distance over the length scale) but not to the
+#: tolerances above is a **near-structure**: vendors' descriptions rounded (axes parallel to 1e-6 rad, axes that miss
+#: by a micrometre, a wrist centre 25 um off an axis). Such an arm is general (treating a 1e-6 rad angle as parallel
+#: moves the pose by ~1e-6 of the arm's size, a thousand times what the certification accepts), but a decomposition
+#: that sweeps across the near-structure can be ill-conditioned: the automatic choice then checks every plan
+#: (:mod:`sweepik.plan_check`). The real offsets of arms (a 10 mm wrist offset on a 1 m arm) are above it.
+NEAR_TOL = 1e-3
 
 
 def line_relation(h1: Array, o1: Array, h2: Array, o2: Array, dist_tol: float) -> tuple[str, Array | None]:
@@ -160,3 +175,42 @@ def structure_of(chain: Chain, length_scale: float, tol_rel: float = INTERSECT_T
         spherical.append(tuple(run))
         i = k if len(run) > 2 else i + 1
     return Structure(tuple(bool(r) for r in rev), tuple(pairs), points, frozenset(parallel), tuple(spherical), tol)
+
+
+def near_structure(chain: Chain, length_scale: float) -> tuple[str, ...]:
+    """The relations that nearly hold (within ``NEAR_TOL``) but not exactly, as text (joints numbered from 1):
+    ``"2≈∥3 (7.3e-06 rad)"`` axes nearly parallel (consecutive, or with only slides and nearly parallel axes
+    between), ``"1≈∩2 (1.3e-06)"`` consecutive revolute axes that nearly meet (their distance over the length
+    scale), ``"4≈∩5∩6 (2.5e-05)"`` three consecutive revolute axes that nearly share one point."""
+    n = chain.n_joints
+    H, pts, rev = chain.H, chain.points, chain.revolute
+    scale = max(length_scale, 1e-300)
+    out: list[str] = []
+
+    def sin(i: int, j: int) -> float:
+        return float(np.linalg.norm(np.cross(H[i], H[j])))
+
+    for i in range(n):
+        for j in range(i + 1, n):
+            s_ij = sin(i, j)
+            if not PARALLEL_TOL <= s_ij < NEAR_TOL:
+                continue
+            if all((not rev[k]) or sin(i, k) < NEAR_TOL for k in range(i + 1, j)):
+                out.append(f"{i + 1}≈∥{j + 1} ({s_ij:.1e} rad)")
+    meets: dict[int, Array] = {}
+    for i in range(n - 1):
+        if not (rev[i] and rev[i + 1]) or sin(i, i + 1) < NEAR_TOL:
+            continue
+        rel, pt = line_relation(H[i], pts[i], H[i + 1], pts[i + 1], NEAR_TOL * scale)
+        if rel != "intersecting":
+            continue
+        meets[i] = pt  # type: ignore[assignment]
+        d = abs(float(np.dot(pts[i + 1] - pts[i], np.cross(H[i], H[i + 1])))) / sin(i, i + 1)
+        if d >= INTERSECT_TOL_REL * scale:
+            out.append(f"{i + 1}≈∩{i + 2} ({d / scale:.1e})")
+    for i in range(n - 2):
+        if i in meets and i + 1 in meets:
+            d = float(np.linalg.norm(meets[i] - meets[i + 1]))
+            if INTERSECT_TOL_REL * scale <= d < NEAR_TOL * scale:
+                out.append(f"{i + 1}≈∩{i + 2}∩{i + 3} ({d / scale:.1e})")
+    return tuple(out)

@@ -7,6 +7,7 @@ from functools import lru_cache
 
 from ..errors import UnknownOptionError
 from ..robot import Robot
+from . import decompose
 from .base import Reduction
 from .carm import CArmD1, CArmTheta2
 from .decompose import choose
@@ -22,6 +23,8 @@ __all__ = [
     "get_reduction",
     "is_default",
     "AUTO",
+    "set_plan_check",
+    "automatic_for_held",
 ]
 
 #: Name of the reduction derived from the arm's geometry (``reductions.decompose``).
@@ -73,3 +76,40 @@ def _cached(robot: Robot, name: str) -> Reduction:
 @lru_cache(maxsize=64)
 def _automatic(robot: Robot, free_joint: int | None) -> Reduction:
     return GeometricReduction(robot, choose(robot, free_joint))
+
+
+def set_plan_check(check: Callable[..., object] | None) -> None:
+    """Register the check that the automatic decomposition runs on the plans it chooses among
+    (``decompose.set_plan_check``); cached choices are dropped."""
+    decompose.set_plan_check(check)  # type: ignore[arg-type]
+    _automatic.cache_clear()
+
+
+#: The plan chosen for an arm with joints held, by (full arm, held joints): a new lock value reuses it (see
+#: ``automatic_for_held``).
+_HELD_PLANS: dict[tuple[Robot, tuple[int, ...]], tuple[str, bool, int, str]] = {}
+
+
+def _signature(plan: Plan) -> tuple[str, bool, int, str]:
+    return plan.family, plan.reversed, plan.free, plan.case
+
+
+def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduction:
+    """The automatic reduction of ``arm``, ``full`` with the joints ``held`` locked at some values: as
+    ``get_reduction(arm, "auto")`` (on an arm with a near-structure every plan is checked on the arm, ``plan_check``),
+    but the plan chosen for other values of the same joints (the same family, theta*, case and chain) is taken
+    when a shorter check at these values finds it sound: a new lock value every pose (a redundant arm's self-motion
+    swept, a path with a changing elbow angle) would otherwise check every plan again."""
+    key = (full, held)
+    sig = _HELD_PLANS.get(key)
+    hint = next((p for p in decompose.plans(arm) if _signature(p) == sig), None) if sig is not None else None
+    red = _held_reduction(arm, decompose.choice(arm, None, hint)[0])
+    if len(_HELD_PLANS) > 256:  # (bounded, as the caches around it)
+        _HELD_PLANS.clear()
+    _HELD_PLANS[key] = _signature(red.plan)
+    return red
+
+
+@lru_cache(maxsize=64)
+def _held_reduction(arm: Robot, plan: Plan) -> GeometricReduction:
+    return GeometricReduction(arm, plan)

@@ -13,7 +13,7 @@ one with; fewer branches (less work per sample); the forward chain before the re
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import lru_cache
 from typing import Any
 
@@ -22,13 +22,13 @@ import numpy as np
 from ..chain import Chain, rotation_about
 from ..errors import NoReductionError
 from ..robot import Robot
-from ..structure import INTERSECT_TOL_REL, PARALLEL_TOL, Structure, line_relation, structure_of
+from ..structure import INTERSECT_TOL_REL, PARALLEL_TOL, Structure, line_relation, near_structure, structure_of
 from .generic import Plan
 from .position import BRANCHES, CASES, motion, reduce_chain
 
 _reduce_chain: Any = reduce_chain
 
-__all__ = ["plans", "choose", "explain"]
+__all__ = ["plans", "choose", "choice", "explain", "set_plan_check"]
 
 #: theta* values at which a case's condition is checked (revolute theta*; a prismatic one uses fractions of its
 #: range): generic angles, so that a relation holding at all of them holds for every angle.
@@ -317,37 +317,89 @@ def not_sweepable(robot: Robot, free_joint: int, full: Robot | None = None, join
     )
 
 
+#: The check of a choice (``plan_check.checked_choice``: plans solved on sample configurations of the arm), registered
+#: by the solver's layer, which can solve; None: the ranking alone chooses.
+_plan_check: Callable[[Robot, tuple[Plan, ...], Plan | None], tuple[Plan, tuple[Any, ...]]] | None = None
+
+
+def set_plan_check(
+    check: Callable[[Robot, tuple[Plan, ...], Plan | None], tuple[Plan, tuple[Any, ...]]] | None,
+) -> None:
+    """Register the check that :func:`choose` runs on the plans it chooses among (None: none)."""
+    global _plan_check
+    _plan_check = check
+    choice.cache_clear()
+
+
 def choose(robot: Robot, free_joint: int | None = None) -> Plan:
     """The best plan for ``robot`` (with theta* = ``free_joint`` if given); NoReductionError if there is none."""
+    return choice(robot, free_joint)[0]
+
+
+@lru_cache(maxsize=64)
+def choice(robot: Robot, free_joint: int | None = None, hint: Plan | None = None) -> tuple[Plan, tuple[Any, ...]]:
+    """:func:`choose`'s plan and the checks that chose it (``plan_check.PlanCheck``, in the order made; empty when
+    there was nothing to choose from). The candidates: the plans sweeping ``free_joint`` if given, else those
+    without a blind spot (all plans when every one has one), best ranked first. The first is chosen, unless the arm
+    has a near-structure (``structure.near_structure``): then every candidate is checked on the arm and the one that
+    recovers most of the check's configurations is chosen (:mod:`sweepik.plan_check`). A ``free_joint`` whose best
+    plan loses any of them raises NoReductionError (a sweep of that joint would miss solutions on this arm). ``hint``
+    (one of the candidates, e.g. the plan chosen for the same arm at other lock values) is taken when a shorter check
+    on the arm finds it sound (``plan_check.checked_choice``)."""
     options = plans(robot)
     if free_joint is not None:
         options = tuple(p for p in options if not p.closed_form and p.free_joint == free_joint)
         if not options:
             raise NoReductionError(not_sweepable(robot, free_joint))
-        return options[0]
-    usable = [p for p in options if not p.conditional]
-    if not usable:
-        if options:
-            return options[0]
+    elif not options:
         raise NoReductionError(_missing(robot))
-    return usable[0]
+    else:
+        options = tuple(p for p in options if not p.conditional) or options
+    near = near_structure(robot.chain, robot.length_scale)
+    if _plan_check is None or not near or (len(options) == 1 and free_joint is None):
+        return options[0], ()
+    plan, checks = _plan_check(robot, options, hint if hint in options else None)
+    best = next(c for c in checks if c.plan == plan)
+    if free_joint is not None and best.recovered < best.checked:
+        raise NoReductionError(
+            f"robot {robot.name!r}: sweeping {robot.joint_names[free_joint]} (index {free_joint}) would miss "
+            f"solutions: the arm has a near-structure ({', '.join(near)}), and checked on {best.checked} of its "
+            f"configurations that sweep gave back {best.recovered}; leave free_joint unset (the automatic choice) or "
+            "see sweepik.analyze(robot)['checks']"
+        )
+    return plan, checks
 
 
 def explain(robot: Robot) -> dict[str, Any]:
     """Plain values for ``sweepik analyze``: structure, every plan, the chosen one (or why none)."""
     st = robot.structure()
     found = plans(robot)
+    near = near_structure(robot.chain, robot.length_scale)
     info: dict[str, Any] = {
         "robot": robot.name,
         "structure": st.describe(),
+        "near_structure": list(near),
         "plans": [_plan_dict(robot, p) for p in found],
+        "checks": [],
     }
     try:
-        info["chosen"] = _plan_dict(robot, choose(robot))
-        info["reason"] = None
+        plan, checks = choice(robot)
     except NoReductionError as e:
-        info["chosen"] = None
-        info["reason"] = str(e)
+        info.update(chosen=None, reason=str(e), why=None)
+        return info
+    info.update(chosen=_plan_dict(robot, plan), reason=None)
+    info["checks"] = [
+        {**_plan_dict(robot, c.plan), "recovered": c.recovered, "checked": c.checked, "solutions": c.solutions}
+        for c in checks
+    ]
+    if checks:
+        best = next(c for c in checks if c.plan == plan)
+        info["why"] = (
+            f"near-structure ({', '.join(near)}): every plan checked on {best.checked} configurations of the arm; "
+            f"this one gave {best.recovered} of them back and {best.solutions} solutions in all, the most"
+        )
+    else:
+        info["why"] = "the best ranked plan (a closed form before a sweep, no blind spot, fewer branches)"
     return info
 
 

@@ -395,7 +395,13 @@ def _parallel_finish(p, shared, elbow, out):
     g2 = 1.0 if dot(_h(p, 2), h) > 0.0 else -1.0
     g3 = 1.0 if dot(_h(p, 3), h) > 0.0 else -1.0
     _write(
-        p, out, m0, (c1, s1_, 0.0), (c2, g2 * s2_, 0.0), (c3, g3 * s3_, 0.0), math.atan2(m4[1], m4[0]),
+        p,
+        out,
+        m0,
+        (c1, s1_, 0.0),
+        (c2, g2 * s2_, 0.0),
+        (c3, g3 * s3_, 0.0),
+        math.atan2(m4[1], m4[0]),
         math.atan2(s5, c5),
     )
 

@@ -1,0 +1,98 @@
+"""The choice of a decomposition on arms with a near-structure (issue 35): rounded vendor descriptions.
+
+An arm whose axes are parallel to 1e-6 rad, or miss each other by a micrometre, is a general arm there: a plan that
+takes the structure as exact would move the solutions by ~1e-6 of the arm's size, and a plan that is exact but sweeps
+across the near-structure can lose solutions (its branch domains shrink to ~1e-4 rad, its roots come in close pairs).
+The tolerance (``structure.PARALLEL_TOL``, ``INTERSECT_TOL_REL``: 1e-9) separates the two sides; between it and
+``NEAR_TOL`` (1e-3) every plan is checked on the arm and the best one chosen (``plan_check``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from oracles import recovers
+from rewrites import rotation
+
+import sweepik
+from sweepik import load_robot, solve
+from sweepik.origin_axis import origin_axis_form
+from sweepik.plan_check import N_CHECK, check_plan
+from sweepik.reductions import decompose
+from sweepik.robot_file import bundled_robots
+from sweepik.structure import NEAR_TOL, PARALLEL_TOL, near_structure
+
+
+def _tilted(name: str, joint: int, angle: float) -> sweepik.Robot:
+    """Bundled arm ``name`` with ``joint``'s axis tilted by ``angle`` (rad) about a direction across it, through the
+    same point (the rest of the arm as it was)."""
+    robot = origin_axis_form(load_robot(name))
+    js = list(robot.joints)
+    a = np.array(js[joint].axis)
+    across = np.cross(a, [0.3, 0.5, 0.8])
+    js[joint] = replace(js[joint], axis=tuple(float(v) for v in rotation(across, angle) @ a))
+    return replace(robot, joints=tuple(js), name=f"{name}_tilted")
+
+
+def _recall(robot: sweepik.Robot, n: int, seed: int) -> int:
+    rng = np.random.default_rng(seed)
+    Q = rng.uniform(-np.pi, np.pi, (n, 6))
+    found = 0
+    for q in Q:
+        s = solve(robot, robot.fk(q), limits=False)
+        assert (s.error_geodesic <= 1e-9 * robot.length_scale).all()
+        found += recovers(robot, s, q)
+    return found
+
+
+@pytest.mark.parametrize("angle", [1e-12, 1e-10])
+def test_below_the_tolerance_a_structure_is_exact(angle: float) -> None:
+    """UR5 with joint 3's axis 1e-12 / 1e-10 rad off parallel: the parallel closed form, every configuration back."""
+    robot = _tilted("ur5", 2, angle)
+    assert angle < PARALLEL_TOL and not near_structure(robot.chain, robot.length_scale)
+    assert sweepik.analyze(robot)["chosen"]["family"] == "parallel"
+    assert _recall(robot, 8, 1) == 8
+
+
+@pytest.mark.parametrize("angle", [1e-8, 1e-6, 1e-4])
+def test_above_the_tolerance_a_near_structure_is_a_general_arm(angle: float) -> None:
+    """The same arm 1e-8 ... 1e-4 rad off: not parallel (a sweep, exact for the arm), the near-structure named, every
+    configuration back."""
+    robot = _tilted("ur5", 2, angle)
+    info = sweepik.analyze(robot)
+    assert info["chosen"]["family"] == "pair"
+    assert any(t.startswith("2≈∥3") for t in info["near_structure"]) and angle < NEAR_TOL
+    assert _recall(robot, 8, 2) == 8
+
+
+def test_far_from_a_structure_nothing_is_near() -> None:
+    robot = _tilted("ur5", 2, 0.05)
+    assert not any("∥" in t for t in near_structure(robot.chain, robot.length_scale))
+    assert _recall(robot, 4, 3) == 4
+
+
+@pytest.mark.parametrize("name", [n for n in bundled_robots() if load_robot(n).n_joints == 6])
+def test_an_arm_without_near_structure_takes_the_best_ranked_plan_unchecked(name: str) -> None:
+    robot = load_robot(name)
+    if near_structure(robot.chain, robot.length_scale):
+        pytest.skip(f"{name} is written with a near-structure (a vendor's rounded description)")
+    plan, checks = decompose.choice(robot)
+    assert checks == ()
+    options = [p for p in decompose.plans(robot) if not p.conditional] or list(decompose.plans(robot))
+    assert plan == options[0]
+
+
+def test_a_near_structure_plan_is_chosen_by_its_check() -> None:
+    """The UR5 1e-6 rad off: every candidate checked; the chosen one has the best score, and it gives back every one of
+    the check's configurations."""
+    robot = _tilted("ur5", 2, 1e-6)
+    plan, checks = decompose.choice(robot)
+    assert len(checks) >= 2
+    best = next(c for c in checks if c.plan == plan)
+    assert best.score == max(c.score for c in checks)
+    assert best.recovered == best.checked == N_CHECK
+    assert check_plan(robot, plan) == best  # (cached, the same)
+    info = sweepik.analyze(robot)
+    assert "near-structure" in info["why"] and len(info["checks"]) == len(checks)
