@@ -96,3 +96,30 @@ def test_a_near_structure_plan_is_chosen_by_its_check() -> None:
     assert check_plan(robot, plan) == best  # (cached, the same)
     info = sweepik.analyze(robot)
     assert "near-structure" in info["why"] and len(info["checks"]) == len(checks)
+
+
+def test_an_arm_whose_every_pose_is_a_continuum_is_refused_saying_why() -> None:
+    """The iiwa with its elbow (A4) held: a spherical shoulder and a spherical wrist at a fixed distance, so every pose
+    leaves a turn about the line through their centres free (held straight, A3 and A5 also turn about one line)."""
+    iiwa = load_robot("kuka_iiwa14")
+    for value in (0.3, 0.0):
+        info = sweepik.analyze(iiwa, locked={"A4": value})
+        assert info["chosen"] is None and "every pose is a continuum" in info["reason"]
+        with pytest.raises(sweepik.NoReductionError, match="every pose is a continuum"):
+            solve(iiwa, iiwa.fk(np.array([0.1, 0.5, -0.3, value, 0.2, -0.4, 0.6])), locked={"A4": value})
+
+
+def test_nearly_coaxial_axes_are_a_near_structure() -> None:
+    """The UR5 with joint 3's axis moved onto joint 2's line, 1e-7 of the arm's size off it: two consecutive axes
+    nearly on one line are named ``2≈≡3``, and the arm is refused (every pose nearly a continuum)."""
+    robot = origin_axis_form(load_robot("ur5"))
+    js = list(robot.joints)
+    # joint 3's frame moved onto joint 2's axis line, 1e-7 of the length scale off it
+    T = np.array(js[2].origin)
+    h = np.array(js[2].axis)
+    T[:3, 3] = T[:3, 3] - (T[:3, 3] - np.dot(T[:3, 3], h) * h) + 1e-7 * robot.length_scale * np.cross(h, [1.0, 0, 0])
+    js[2] = replace(js[2], origin=tuple(tuple(float(v) for v in row) for row in T))
+    arm = replace(robot, joints=tuple(js), name="ur5_coaxial")
+    assert any("2≈≡3" in t for t in near_structure(arm.chain, arm.length_scale))
+    with pytest.raises(sweepik.NoReductionError, match="continuum"):
+        solve(arm, arm.fk(np.zeros(6)))

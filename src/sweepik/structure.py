@@ -181,7 +181,8 @@ def near_structure(chain: Chain, length_scale: float) -> tuple[str, ...]:
     """The relations that nearly hold (within ``NEAR_TOL``) but not exactly, as text (joints numbered from 1):
     ``"2≈∥3 (7.3e-06 rad)"`` axes nearly parallel (consecutive, or with only slides and nearly parallel axes
     between), ``"1≈∩2 (1.3e-06)"`` consecutive revolute axes that nearly meet (their distance over the length
-    scale), ``"4≈∩5∩6 (2.5e-05)"`` three consecutive revolute axes that nearly share one point."""
+    scale), ``"4≈∩5∩6 (2.5e-05)"`` three consecutive revolute axes that nearly share one point, ``"3≈≡4 (7.7e-07)"``
+    two consecutive revolute axes nearly on one line (their distance over the length scale)."""
     n = chain.n_joints
     H, pts, rev = chain.H, chain.points, chain.revolute
     scale = max(length_scale, 1e-300)
@@ -197,6 +198,12 @@ def near_structure(chain: Chain, length_scale: float) -> tuple[str, ...]:
                 continue
             if all((not rev[k]) or sin(i, k) < NEAR_TOL for k in range(i + 1, j)):
                 out.append(f"{i + 1}≈∥{j + 1} ({s_ij:.1e} rad)")
+    for i in range(n - 1):  # consecutive revolute axes on nearly one line
+        if rev[i] and rev[i + 1] and sin(i, i + 1) < NEAR_TOL:
+            d = pts[i + 1] - pts[i]
+            off = float(np.linalg.norm(d - np.dot(d, H[i]) * H[i]))
+            if INTERSECT_TOL_REL * scale <= off < NEAR_TOL * scale:
+                out.append(f"{i + 1}≈≡{i + 2} ({off / scale:.1e})")
     meets: dict[int, Array] = {}
     for i in range(n - 1):
         if not (rev[i] and rev[i + 1]) or sin(i, i + 1) < NEAR_TOL:

@@ -281,6 +281,36 @@ def _continuum_covered(plan: Plan, found: list[Plan], robot: Robot) -> bool:
     return any(p.family == "pair" and not p.conditional and p.free_joint in moving for p in found)
 
 
+def continuum_everywhere(robot: Robot) -> str | None:
+    """Why every pose of ``robot`` is a continuum (or nearly: an arm no decomposition can solve to certification),
+    or None. Two consecutive revolute axes on one line (exactly, or to ``structure.NEAR_TOL``: a 7-joint arm whose
+    elbow is locked straight, e.g. the Realman RM75 with joint 4 at 0) turn the rest of the arm by the sum of their
+    angles alone; a spherical shoulder and a spherical wrist (exactly or nearly: an SRS arm with its elbow locked, the
+    KUKA iiwa or the RM75 with joint 4 held) leave a turn about the line through their centres free."""
+    st = robot.structure()
+    near = near_structure(robot.chain, robot.length_scale)
+    coaxial = [f"{i + 1}≡{i + 2}" for i, rel in enumerate(st.pairs) if rel == "coincident"]
+    coaxial += [t for t in near if "≈≡" in t]
+    ends = [
+        st.common_point(run) or any(t.startswith(label + " ") for t in near)
+        for run, label in (((0, 1, 2), "1≈∩2∩3"), ((3, 4, 5), "4≈∩5∩6"))
+    ]
+    if all(robot.is_revolute) and all(ends):
+        return (
+            f"robot {robot.name!r}: every pose is a continuum (or nearly one): joints 1-3 meet at one point and joints "
+            "4-6 at another (exactly or to 1e-3), so the two points keep their distance and a pose fixes the arm only "
+            "up to a turn about the line through both (a 7-joint arm with its elbow locked: its self-motion); with "
+            "joints locked, lock another joint"
+        )
+    if not coaxial:
+        return None
+    return (
+        f"robot {robot.name!r}: every pose is a continuum (or nearly one): joints {', '.join(coaxial)} turn about one "
+        "line (joints numbered from 1 in this arm), so only the sum of their angles is fixed by a pose; with joints "
+        "locked, lock another joint or another value"
+    )
+
+
 def _missing(robot: Robot) -> str:
     if robot.n_joints != 6:
         return f"robot {robot.name!r} has {robot.n_joints} joints: the decompositions solve 6-joint arms"
@@ -293,11 +323,23 @@ def _missing(robot: Robot) -> str:
             "offset): at joint 5 = 0 the solutions form a continuum that only a sweep can report, and no sweep fits "
             "this arm (it needs two axes meeting at the tool or at the base)"
         )
-    return head + (
-        "a decomposition needs the last two axes (or the first two) revolute and meeting at a point, with the "
-        "other joints placing that point by a chain of subproblems (two revolute axes among them parallel or "
-        "meeting, two parallel revolute axes around a slide, a revolute joint before or after two slides, or three "
-        "slides), or axes 2-4 parallel (the UR family)"
+    near = near_structure(robot.chain, robot.length_scale)
+    nearly = (
+        f" Its description has relations that hold only nearly ({', '.join(near)}: rounded, not exact), and a "
+        "decomposition built on them would be off by about that much times the arm's size; with them exact, a "
+        "decomposition may exist"
+        if near
+        else ""
+    )
+    return (
+        head
+        + (
+            "a decomposition needs the last two axes (or the first two) revolute and meeting at a point, with the "
+            "other joints placing that point by a chain of subproblems (two revolute axes among them parallel or "
+            "meeting, two parallel revolute axes around a slide, a revolute joint before or after two slides, or "
+            "three slides), or axes 2-4 parallel (the UR family)."
+        )
+        + nearly
     )
 
 
@@ -346,6 +388,9 @@ def choice(robot: Robot, free_joint: int | None = None, hint: Plan | None = None
     plan loses any of them raises NoReductionError (a sweep of that joint would miss solutions on this arm). ``hint``
     (one of the candidates, e.g. the plan chosen for the same arm at other lock values) is taken when a shorter check
     on the arm finds it sound (``plan_check.checked_choice``)."""
+    everywhere = continuum_everywhere(robot)
+    if everywhere:
+        raise NoReductionError(everywhere)
     options = plans(robot)
     if free_joint is not None:
         options = tuple(p for p in options if not p.closed_form and p.free_joint == free_joint)
