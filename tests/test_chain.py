@@ -78,7 +78,8 @@ def _origin_axis_copy(robot: Robot, rng: np.random.Generator) -> Robot:
         F[:3, :3] = _random_rotation(rng)
         child = J @ F
         origin = np.linalg.inv(parent) @ child
-        axis = F[:3, :3].T @ np.array([0.0, 0.0, 1.0])
+        # (DH joints move about z of their frame; origin + axis joints about their own axis, not always z)
+        axis = F[:3, :3].T @ (np.array(j.axis) if robot.dh_convention == "none" else np.array([0.0, 0.0, 1.0]))
         joints.append(
             Joint(j.type, lower=j.lower, upper=j.upper, name=j.name, origin=tuple(map(tuple, origin)), axis=tuple(axis))  # type: ignore[arg-type]
         )

@@ -521,38 +521,99 @@ if AVAILABLE:
         for k in range(start, stop):
             Tk = _poe_fk(H, P, rev, R_end, q[k])
             _put_pose(Tk, T[k])
-            # each joint's axis (world) and a point on it, from the rotations of the joints before it
-            r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
-            px, py, pz = P[0, 0], P[0, 1], P[0, 2]
-            for i in range(n):
-                kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
-                z[i, 0] = r00 * kx + r01 * ky + r02 * kz
-                z[i, 1] = r10 * kx + r11 * ky + r12 * kz
-                z[i, 2] = r20 * kx + r21 * ky + r22 * kz
-                o[i, 0], o[i, 1], o[i, 2] = px, py, pz
-                if rev[i]:
-                    r00, r01, r02, r10, r11, r12, r20, r21, r22 = _turn(
-                        r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, q[k, i]
-                    )
-                else:
-                    d = q[k, i]
-                    px += z[i, 0] * d
-                    py += z[i, 1] * d
-                    pz += z[i, 2] * d
-                ax, ay, az = P[i + 1, 0], P[i + 1, 1], P[i + 1, 2]
-                px += r00 * ax + r01 * ay + r02 * az
-                py += r10 * ax + r11 * ay + r12 * az
-                pz += r20 * ax + r21 * ay + r22 * az
-            tx, ty, tz = Tk[9], Tk[10], Tk[11]
-            for i in range(n):
-                zx, zy, zz = z[i, 0], z[i, 1], z[i, 2]
-                if rev[i]:
-                    dx, dy, dz = tx - o[i, 0], ty - o[i, 1], tz - o[i, 2]
-                    J[k, 0, i], J[k, 1, i], J[k, 2, i] = zy * dz - zz * dy, zz * dx - zx * dz, zx * dy - zy * dx
-                    J[k, 3, i], J[k, 4, i], J[k, 5, i] = zx, zy, zz
-                else:
-                    J[k, 0, i], J[k, 1, i], J[k, 2, i] = zx, zy, zz
-                    J[k, 3, i], J[k, 4, i], J[k, 5, i] = 0.0, 0.0, 0.0
+            _jacobian(H, P, rev, q[k], Tk, J[k], z, o)
+
+    @inlined
+    def _jacobian(H, P, rev, qk, Tk, J, z, o):
+        """The geometric Jacobian ``J (6, n)`` at the tool point of configuration ``qk`` (tool pose ``Tk``, 12
+        scalars as ``_poe_fk``); ``z``, ``o`` ``(n, 3)`` scratch: each joint's axis (world) and a point on it."""
+        n = H.shape[0]
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+        px, py, pz = P[0, 0], P[0, 1], P[0, 2]
+        for i in range(n):
+            kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
+            z[i, 0] = r00 * kx + r01 * ky + r02 * kz
+            z[i, 1] = r10 * kx + r11 * ky + r12 * kz
+            z[i, 2] = r20 * kx + r21 * ky + r22 * kz
+            o[i, 0], o[i, 1], o[i, 2] = px, py, pz
+            if rev[i]:
+                r00, r01, r02, r10, r11, r12, r20, r21, r22 = _turn(
+                    r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, qk[i]
+                )
+            else:
+                d = qk[i]
+                px += z[i, 0] * d
+                py += z[i, 1] * d
+                pz += z[i, 2] * d
+            ax, ay, az = P[i + 1, 0], P[i + 1, 1], P[i + 1, 2]
+            px += r00 * ax + r01 * ay + r02 * az
+            py += r10 * ax + r11 * ay + r12 * az
+            pz += r20 * ax + r21 * ay + r22 * az
+        tx, ty, tz = Tk[9], Tk[10], Tk[11]
+        for i in range(n):
+            zx, zy, zz = z[i, 0], z[i, 1], z[i, 2]
+            if rev[i]:
+                dx, dy, dz = tx - o[i, 0], ty - o[i, 1], tz - o[i, 2]
+                J[0, i], J[1, i], J[2, i] = zy * dz - zz * dy, zz * dx - zx * dz, zx * dy - zy * dx
+                J[3, i], J[4, i], J[5, i] = zx, zy, zz
+            else:
+                J[0, i], J[1, i], J[2, i] = zx, zy, zz
+                J[3, i], J[4, i], J[5, i] = 0.0, 0.0, 0.0
+
+    @lazy_njit(
+        (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64[:, ::1], float64[:, :, ::1])
+        + (float64, types.boolean[:, ::1], int64, int64, float64, float64, float64[::1], int64, int64),
+        cache=True,
+        nogil=True,
+    )
+    def _polish_rows(H, P, rev, R_end, q, target, weight, fixed, iterations, backtrack, rcond, floor, err, start, stop):
+        """``polish.polish`` compiled, rows ``start .. stop - 1`` of ``q`` in place (``err``: their geodesic errors
+        after): damped Newton steps on the full pose (pseudo-inverse of the Jacobian, singular values below ``rcond``
+        of the largest dropped; ``fixed`` joints held), a step kept only if it lowers the error, else halved up to
+        ``backtrack`` times; a row stops when no step improves it or (after one step) its error is at most
+        ``floor``."""
+        n = H.shape[0]
+        z = np.empty((n, 3))
+        o = np.empty((n, 3))
+        J = np.empty((6, n))
+        e = np.empty(6)
+        trial = np.empty(n)
+        for k in range(start, stop):
+            Td = target[k]
+            cur = _geodesic(_poe_fk(H, P, rev, R_end, q[k]), Td, weight)[0]
+            for _ in range(iterations):
+                Tk = _poe_fk(H, P, rev, R_end, q[k])
+                _jacobian(H, P, rev, q[k], Tk, J, z, o)
+                r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = Tk
+                e[0], e[1], e[2] = Td[0, 3] - px, Td[1, 3] - py, Td[2, 3] - pz
+                # dR = Rd R^T; its skew part, halved, scaled by the orientation weight
+                d21 = Td[2, 0] * r10 + Td[2, 1] * r11 + Td[2, 2] * r12
+                d12 = Td[1, 0] * r20 + Td[1, 1] * r21 + Td[1, 2] * r22
+                d02 = Td[0, 0] * r20 + Td[0, 1] * r21 + Td[0, 2] * r22
+                d20 = Td[2, 0] * r00 + Td[2, 1] * r01 + Td[2, 2] * r02
+                d10 = Td[1, 0] * r00 + Td[1, 1] * r01 + Td[1, 2] * r02
+                d01 = Td[0, 0] * r10 + Td[0, 1] * r11 + Td[0, 2] * r12
+                e[3], e[4], e[5] = 0.5 * weight * (d21 - d12), 0.5 * weight * (d02 - d20), 0.5 * weight * (d10 - d01)
+                for i in range(n):
+                    for r in range(6):
+                        J[r, i] = 0.0 if fixed[k, i] else (J[r, i] * weight if r >= 3 else J[r, i])
+                step = np.linalg.pinv(J, rcond) @ e
+                improved = False
+                for _ in range(backtrack + 1):
+                    for i in range(n):
+                        trial[i] = q[k, i] + step[i]
+                    new = _geodesic(_poe_fk(H, P, rev, R_end, trial), Td, weight)[0]
+                    if new < cur:  # (False for NaN)
+                        for i in range(n):
+                            q[k, i] = trial[i]
+                        cur = new
+                        improved = True
+                        break
+                    for i in range(n):
+                        step[i] *= 0.5
+                if not improved or cur <= floor:
+                    break
+            err[k] = cur
 
 
 @lru_cache(maxsize=64)
@@ -570,6 +631,38 @@ def pose_and_jacobian(robot, q: Array) -> tuple[Array, Array]:
     T, J = np.empty((K, 4, 4)), np.empty((K, 6, n))
     parallel.run(_pose_jacobian, K, 16 * PARALLEL_MIN, *chain_args(robot), writable(q), T, J)
     return T, J
+
+
+def polish_rows(
+    robot,
+    q: Array,
+    target: Array,
+    weight: float,
+    fixed: NDArray[np.bool_],
+    iterations: int,
+    backtrack: int,
+    rcond: float,
+    floor: float,
+) -> tuple[Array, Array]:
+    """``polish.polish`` compiled: ``(q (K, n) polished, geodesic errors (K,))``."""
+    K = q.shape[0]
+    out, err = np.array(q, dtype=np.float64), np.empty(K)
+    parallel.run(
+        _polish_rows,
+        K,
+        PARALLEL_MIN,
+        *chain_args(robot),
+        out,
+        writable(target),
+        float(weight),
+        np.ascontiguousarray(fixed, dtype=np.bool_),
+        int(iterations),
+        int(backtrack),
+        float(rcond),
+        float(floor),
+        err,
+    )
+    return out, err
 
 
 def tool_poses(robot, q: Array, target: Array | None = None, weight: float = 1.0) -> tuple[Array, Array]:

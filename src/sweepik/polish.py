@@ -4,6 +4,10 @@ A reduction can be badly conditioned where theta* barely moves the pose (e.g. th
 while theta2 swings through pi within |Pz - d1| ~ |Px|): there a root in theta* at full precision still
 leaves ~1e-10 mm of pose error. One or two Newton steps on all six joints remove it. Next to a singular
 configuration (an elbow almost straight) the step is damped: halved until it lowers the error.
+
+With Numba the same steps run compiled (``fastcertify.polish_rows``): the continuation of a traced family corrects a
+few hundred configurations one by one, ~1.5 ms each in NumPy (a shoulder-singular pose of a spherical-wrist arm, four
+families along joint 1: 250-450 ms, now ~55 ms). This NumPy loop is what runs without Numba.
 """
 
 from __future__ import annotations
@@ -62,6 +66,12 @@ def polish(
     once its error is at most ``floor`` (after one step at least). ``fixed (K, n)``: joints held where True."""
     if q.shape[0] == 0:
         return q
+    from .fastcertify import AVAILABLE, polish_rows
+
+    if AVAILABLE:  # (the same steps, compiled: a single configuration's polish took ~1.5 ms in NumPy, continuation
+        # corrects hundreds along a traced family)
+        held = np.zeros(q.shape, dtype=np.bool_) if fixed is None else fixed
+        return polish_rows(robot, q, target, weight, held, iterations, BACKTRACK, PINV_RCOND, floor)[0]
     q = q.copy()
     err = geodesic_errors(robot, q, target, weight)
     scale = np.array([1.0, 1.0, 1.0, weight, weight, weight])
