@@ -598,6 +598,9 @@ if AVAILABLE:
                     for r in range(6):
                         J[r, i] = 0.0 if fixed[k, i] else (J[r, i] * weight if r >= 3 else J[r, i])
                 step = np.linalg.pinv(J, rcond) @ e
+                for i in range(n):  # (a held joint's zero column gives a step of rounding size: none at all)
+                    if fixed[k, i]:
+                        step[i] = 0.0
                 improved = False
                 for _ in range(backtrack + 1):
                     for i in range(n):

@@ -88,6 +88,8 @@ def polish(
             Js = np.where(fixed[active][:, None, :], 0.0, Js)
         # pseudo-inverse per candidate: singular Jacobians (rank-deficient arms poses) stay bounded
         step = np.einsum("kij,kj->ki", np.linalg.pinv(Js, rcond=PINV_RCOND), e)
+        if fixed is not None:  # (a held joint's zero column gives a step of rounding size: none at all)
+            step = np.where(fixed[active], 0.0, step)
         improved = np.zeros(active.size, dtype=bool)
         todo = np.arange(active.size)
         for _ in range(BACKTRACK + 1):
