@@ -25,6 +25,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 from rewrites import rewrite  # noqa: E402
+from singular import recovered, singular_configurations  # noqa: E402
 
 import sweepik  # noqa: E402
 from sweepik.robot import Joint, Robot  # noqa: E402
@@ -68,35 +69,6 @@ def check_fk(robot: Robot, name: str, rng: np.random.Generator) -> float:
     m = ssik_module(name)
     Q = rng.uniform(-np.pi, np.pi, (20, robot.n_joints))
     return max(float(np.abs(robot.fk(q) - m.fk(q)).max()) for q in Q)
-
-
-def singular_configurations(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
-    """``(m, n_joints)`` configurations on the arm's singular set (det J = 0, found along one joint from a random
-    configuration by a sign change and bisection) and 1e-9 ... 1e-3 off it along that joint."""
-    from scipy.optimize import brentq
-
-    out: list[np.ndarray] = []
-    grid = np.linspace(-np.pi, np.pi, 721)
-    while len(out) < n:
-        q = rng.uniform(-np.pi, np.pi, robot.n_joints)
-        k = int(rng.integers(robot.n_joints))
-
-        def det(x: float, q: np.ndarray = q, k: int = k) -> float:
-            qq = q.copy()
-            qq[k] = x
-            return float(np.linalg.det(robot.jacobian(qq)))
-
-        vals = np.array([det(x) for x in grid])
-        idx = np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)
-        if idx.size == 0:
-            continue
-        i = int(rng.choice(idx))
-        x = brentq(det, grid[i], grid[i + 1], xtol=1e-15)
-        delta = float(rng.choice([0.0, 0.0, 1e-9, 1e-7, 1e-5, 1e-4, 1e-3])) * float(rng.choice([-1.0, 1.0]))
-        qs = q.copy()
-        qs[k] = x + delta
-        out.append(qs)
-    return np.array(out[:n])
 
 
 def main() -> None:
@@ -143,12 +115,7 @@ def main() -> None:
                 continue
             dt = time.perf_counter() - t1
             slow += dt > args.slow
-            if not (len(s) or s.families):
-                misses.append(i)
-                continue
-            d = s.nearest(q) - q
-            d = np.where(solver_robot.is_revolute, np.angle(np.exp(1j * d)), d / solver_robot.length_scale)
-            ok = bool(np.max(np.abs(d)) < 1e-6)
+            ok = recovered(solver_robot, s, q)
             rec += ok
             if not ok:
                 misses.append(i)

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .kinematics import geometric_jacobian
-from .polish import geodesic_errors, polish
+from .polish import polished
 from .reductions.base import Reduction
 from .robot import Robot
 from .solutions import Family, weighted_joint_distance
@@ -85,8 +85,7 @@ def _correct(robot: Robot, q: Array, world: Array, joint: int, tol: float) -> tu
     weight = orientation_weight(robot.length_unit)
     fixed = np.zeros(q.shape, dtype=bool)
     fixed[:, joint] = True
-    q = polish(robot, q, world, weight, iterations=TRACE_NEWTON, fixed=fixed, floor=1e-3 * tol)
-    return q, geodesic_errors(robot, q, world, weight)
+    return polished(robot, q, world, weight, iterations=TRACE_NEWTON, fixed=fixed, floor=1e-3 * tol)
 
 
 def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) -> tuple[Array, Array, bool] | None:

@@ -60,18 +60,32 @@ def polish(
     fixed: NDArray[np.bool_] | None = None,
     floor: float = 0.0,
 ) -> Array:
+    """:func:`polished`'s configurations alone."""
+    return polished(robot, q, target, weight, iterations, fixed, floor)[0]
+
+
+def polished(
+    robot: Robot,
+    q: Array,
+    target: Array,
+    weight: float,
+    iterations: int = ITERATIONS,
+    fixed: NDArray[np.bool_] | None = None,
+    floor: float = 0.0,
+) -> tuple[Array, Array]:
     """Improve configurations ``q (K, n)`` towards poses ``target (K, 4, 4)`` by damped Newton steps on the full
     pose; a step is kept only if the geodesic error (position + ``weight`` x angle) decreases, else it is halved
     (up to ``BACKTRACK`` times), and a configuration no step improves is left as it is. A configuration stops
-    once its error is at most ``floor`` (after one step at least). ``fixed (K, n)``: joints held where True."""
+    once its error is at most ``floor`` (after one step at least). ``fixed (K, n)``: joints held where True.
+    Returns ``(q, geodesic errors (K,))``."""
     if q.shape[0] == 0:
-        return q
+        return q, np.zeros(0)
     from .fastcertify import AVAILABLE, polish_rows
 
     if AVAILABLE:  # (the same steps, compiled: a single configuration's polish took ~1.5 ms in NumPy, continuation
         # corrects hundreds along a traced family)
         held = np.zeros(q.shape, dtype=np.bool_) if fixed is None else fixed
-        return polish_rows(robot, q, target, weight, held, iterations, BACKTRACK, PINV_RCOND, floor)[0]
+        return polish_rows(robot, q, target, weight, held, iterations, BACKTRACK, PINV_RCOND, floor)
     q = q.copy()
     err = geodesic_errors(robot, q, target, weight)
     scale = np.array([1.0, 1.0, 1.0, weight, weight, weight])
@@ -106,7 +120,7 @@ def polish(
         active = active[improved & (err[active] > floor)]
         if active.size == 0:
             break
-    return q
+    return q, err
 
 
 def _pose(robot: Robot, q: Array) -> Array:

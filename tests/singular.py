@@ -1,0 +1,86 @@
+"""Configurations on and next to an arm's singular set, and what "recovered" means there (tests and scripts).
+
+``singular_configurations``: from a random configuration, one joint is moved to where det J changes sign (the singular
+set, found by a sign change on a grid and bisection), then left there or moved 1e-9 ... 1e-3 off it. Random arms meet
+their singular set in its generic part and, by the joint chosen, in every component det J has.
+
+``recovered``: a configuration is recovered by a solve when a solution (or a family member) lies within ``tol`` of it,
+or when the straight segment between them solves the pose (its midpoint and quarter points within the certification
+tolerance): the two are then the same root to the precision the pose fixes it (a double root is fixed only to about
+the square root of the rounding, and near a continuum less).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy.optimize import brentq
+
+#: Offsets from the singular set along the moved joint (radians, or times the length scale for a slide).
+OFFSETS = (0.0, 0.0, 1e-9, 1e-7, 1e-5, 1e-4, 1e-3)
+#: The certification's tolerance on the geodesic pose error, relative to the length scale (``solver.ACCEPT_TOL_REL``
+#: with the margin the solver's polish leaves).
+SAME_ROOT_REL = 1e-12
+
+
+def _range(robot: Any) -> tuple[np.ndarray, np.ndarray]:
+    lo = np.where(np.isfinite(robot.lower), robot.lower, -robot.length_scale)
+    hi = np.where(np.isfinite(robot.upper), robot.upper, robot.length_scale)
+    lo = np.where(robot.is_revolute, -np.pi, lo)
+    hi = np.where(robot.is_revolute, np.pi, hi)
+    return lo, hi
+
+
+def singular_configurations(robot: Any, n: int, rng: np.random.Generator, grid: int = 721) -> np.ndarray:
+    """``(n, n_joints)`` configurations on the singular set of ``robot`` (6 joints) and next to it."""
+    lo, hi = _range(robot)
+    out: list[np.ndarray] = []
+    tries = 0
+    while len(out) < n and tries < 50 * n:
+        tries += 1
+        q = rng.uniform(lo, hi)
+        k = int(rng.integers(robot.n_joints))
+        xs = np.linspace(lo[k], hi[k], grid)
+        Q = np.repeat(q[None], grid, axis=0)
+        Q[:, k] = xs
+        vals = np.linalg.det(robot.jacobian(Q))
+        idx = np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)
+        if idx.size == 0:
+            continue
+        i = int(rng.choice(idx))
+
+        def det(x: float, q: np.ndarray = q, k: int = k) -> float:
+            qq = q.copy()
+            qq[k] = x
+            return float(np.linalg.det(robot.jacobian(qq)))
+
+        x = brentq(det, xs[i], xs[i + 1], xtol=1e-15)
+        step = float(rng.choice(OFFSETS)) * float(rng.choice([-1.0, 1.0]))
+        qs = q.copy()
+        qs[k] = x + (step if robot.is_revolute[k] else step * robot.length_scale)
+        out.append(qs)
+    return np.array(out)
+
+
+def recovered(robot: Any, sols: Any, q: np.ndarray, tol: float = 1e-6) -> bool:
+    """``q`` is among ``sols`` (a ``sweepik.Solutions``) as the module docstring says."""
+    if not (len(sols) or sols.families):
+        return False
+    s = sols.nearest(q)
+    d = s - q
+    d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
+    if np.max(np.abs(d)) < tol:
+        return True
+    T = robot.fk(q)
+    s = q + np.where(robot.is_revolute, np.angle(np.exp(1j * (s - q))), s - q)  # (the same winding as q)
+    between = q[None] + np.array([0.25, 0.5, 0.75])[:, None] * (s - q)[None]
+    return bool(np.all(_geodesic(robot, between, T) <= SAME_ROOT_REL * robot.length_scale))
+
+
+def _geodesic(robot: Any, Q: np.ndarray, T: np.ndarray) -> np.ndarray:
+    from sweepik.pose import pose_error_geodesic
+    from sweepik.units import orientation_weight
+
+    F = robot.fk(Q)
+    return pose_error_geodesic(F, np.broadcast_to(T, F.shape), orientation_weight(robot.length_unit))
