@@ -34,7 +34,8 @@ __all__ = ["N_CHECK", "N_QUICK", "RECOVER_TOL", "PlanCheck", "check_plan", "chec
 #: Configurations each plan is checked on. A near-structure loses solutions on many poses (Doosan M1013 swept on joint
 #: 1: 96 of 200 with one plan, 40 of 200 with another, 1 of 200 with a third, 0 with a fourth).
 N_CHECK = 64
-#: Configurations a suggested plan (``checked_choice``'s ``hint``: the plan chosen at other lock values) is checked on.
+#: Configurations a suggested plan (``checked_choice``'s ``hints``: the plans chosen at other lock values) is
+#: checked on.
 N_QUICK = 16
 #: A configuration is recovered when a solution (or a family member) lies this close to it: radians for revolute
 #: joints, times the arm's length scale for prismatic ones (the certified solutions are ~1e-12 off).
@@ -94,15 +95,16 @@ def check_plan(robot: Robot, plan: Plan, n: int = N_CHECK) -> PlanCheck:
 
 
 def checked_choice(
-    robot: Robot, options: tuple[Plan, ...], hint: Plan | None = None
+    robot: Robot, options: tuple[Plan, ...], hints: tuple[Plan, ...] = ()
 ) -> tuple[Plan, tuple[PlanCheck, ...]]:
     """The plan of ``options`` (best ranked first) with the best ``PlanCheck.score`` (ties: the better ranked), with
-    every plan's check (in the order of ``options``). ``hint`` (one of ``options``) is taken, with its check alone,
-    when it gives back all of ``N_QUICK`` configurations."""
-    if hint is not None:
-        quick = check_plan(robot, hint, N_QUICK)
-        if quick.passed:
-            return hint, (quick,)
+    every plan's check (in the order of ``options``). The first of ``hints`` (plans of ``options``) that gives back
+    all of ``N_QUICK`` configurations is taken instead, with the quick checks made."""
+    quick: list[PlanCheck] = []
+    for hint in hints:
+        quick.append(check_plan(robot, hint, N_QUICK))
+        if quick[-1].passed:
+            return hint, tuple(quick)
     checks = tuple(check_plan(robot, plan) for plan in options)
     best = max(checks, key=lambda c: c.score)  # (max keeps the first of equals: the better ranked)
     return best.plan, checks

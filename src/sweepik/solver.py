@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import fastcertify, fastsolve, fastsweep, parallel
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch, no_solution_reason
+from .companion import joined
 from .continuation import continuum_families
 from .dedupe import finish, merged_multiplicity, near_pairs, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
@@ -208,7 +209,26 @@ def _solve_chunk(
     one_call: bool = True,
 ) -> Block:
     """The solutions of the chunk ``poses``; ``one_call``: a single pose may take the one compiled call (False: the
-    caller found that it cannot)."""
+    caller found that it cannot). A reduction with a ``companion`` (an arm with a near-structure): both solve, and
+    the companion's solutions that the first lacks are joined (:mod:`.companion`)."""
+    block = _solve_chunk_by(robot, red, poses, strategy, limits, n_samples, use_fallback, one_call)
+    comp = getattr(red, "companion", None)
+    if comp is None or strategy != "precise":
+        return block
+    return joined(block, _solve_chunk_by(robot, comp, poses, strategy, limits, n_samples, use_fallback, False))
+
+
+def _solve_chunk_by(
+    robot: Robot,
+    red: Reduction,
+    poses: Array,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    use_fallback: bool = True,
+    one_call: bool = True,
+) -> Block:
+    """:func:`_solve_chunk` with ``red`` alone."""
     chain = _chain_poses(robot, poses)  # (one array: the reduction keeps its parameters for it)
     if len(poses) == 1 and strategy == "precise" and use_fallback and one_call and red.uses_kernel:
         block = _settled_single(robot, red, poses, chain, limits, n_samples)
@@ -457,7 +477,9 @@ def _settled(
 ) -> fastsolve.Settled | None:
     """One pose's solutions from the one compiled call (``fastsolve``); None where the pose needs one of its rarer
     steps (a polish, families, special solutions, a continuum along another joint, the fallback, branches of a
-    closed form that meet)."""
+    closed form that meet) or a second reduction's solutions (a ``companion``)."""
+    if getattr(red, "companion", None) is not None:
+        return None
     params = red.kernel_params(chain)
     bounds, reach = _settle_bounds(robot), _snap_reach(robot)
     if red.closed_form:  # (branches that meet, ``MEET``: merged into one of higher multiplicity, the general way)

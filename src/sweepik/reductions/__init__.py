@@ -75,7 +75,11 @@ def _cached(robot: Robot, name: str) -> Reduction:
 
 @lru_cache(maxsize=64)
 def _automatic(robot: Robot, free_joint: int | None) -> Reduction:
-    return GeometricReduction(robot, choose(robot, free_joint))
+    red = GeometricReduction(robot, choose(robot, free_joint))
+    if free_joint is None:  # (an arm with a near-structure: a second plan's solutions joined, sweepik.companion)
+        comp = decompose.companion_plan(robot)
+        red.companion = None if comp is None else GeometricReduction(robot, comp)
+    return red
 
 
 def set_plan_check(check: Callable[..., object] | None) -> None:
@@ -85,12 +89,13 @@ def set_plan_check(check: Callable[..., object] | None) -> None:
     _automatic.cache_clear()
 
 
+_Sig = tuple[str, bool, int, str]
 #: The plan chosen for an arm with joints held, by (full arm, held joints): a new lock value reuses it (see
 #: ``automatic_for_held``).
-_HELD_PLANS: dict[tuple[Robot, tuple[int, ...]], tuple[str, bool, int, str]] = {}
+_HELD_PLANS: dict[tuple[Robot, tuple[int, ...]], tuple[_Sig | None, ...]] = {}
 
 
-def _signature(plan: Plan) -> tuple[str, bool, int, str]:
+def _signature(plan: Plan) -> _Sig:
     return plan.family, plan.reversed, plan.free, plan.case
 
 
@@ -98,15 +103,24 @@ def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduct
     """The automatic reduction of ``arm``, ``full`` with the joints ``held`` locked at some values: as
     ``get_reduction(arm, "auto")`` (on an arm with a near-structure every plan is checked on the arm, ``plan_check``),
     but the plan chosen for other values of the same joints (the same family, theta*, case and chain) is taken
-    when a shorter check at these values finds it sound: a new lock value every pose (a redundant arm's self-motion
-    swept, a path with a changing elbow angle) would otherwise check every plan again."""
+    when a shorter check at these values finds it (or else its companion, :mod:`sweepik.companion`) sound, the other
+    of the two as the companion:
+    a new lock value every pose (a redundant arm's self-motion swept, a path with a changing elbow angle) would
+    otherwise check every plan again."""
     key = (full, held)
-    sig = _HELD_PLANS.get(key)
-    hint = next((p for p in decompose.plans(arm) if _signature(p) == sig), None) if sig is not None else None
-    red = _held_reduction(arm, decompose.choice(arm, None, hint)[0])
+    sigs = _HELD_PLANS.get(key, ())
+    options = decompose.plans(arm)
+    hints = tuple(p for sig in sigs for p in options if sig is not None and _signature(p) == sig)
+    plan, _ = decompose.choice(arm, None, hints)
+    if plan in hints:  # (the other plan chosen with it, unchecked: a companion only adds solutions)
+        comp = next((p for p in hints if p != plan), None)
+    else:
+        comp = decompose.companion_plan(arm)
+    red = _held_reduction(arm, plan)
+    red.companion = None if comp is None else GeometricReduction(arm, comp)
     if len(_HELD_PLANS) > 256:  # (bounded, as the caches around it)
         _HELD_PLANS.clear()
-    _HELD_PLANS[key] = _signature(red.plan)
+    _HELD_PLANS[key] = (_signature(plan), None if comp is None else _signature(comp))
     return red
 
 

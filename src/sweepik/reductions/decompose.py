@@ -28,7 +28,7 @@ from .position import BRANCHES, CASES, motion, reduce_chain
 
 _reduce_chain: Any = reduce_chain
 
-__all__ = ["plans", "choose", "choice", "explain", "set_plan_check"]
+__all__ = ["plans", "choose", "choice", "companion_plan", "explain", "set_plan_check"]
 
 #: theta* values at which a case's condition is checked (revolute theta*; a prismatic one uses fractions of its
 #: range): generic angles, so that a relation holding at all of them holds for every angle.
@@ -239,6 +239,12 @@ def _rank(p: Plan) -> tuple[int, int, int, int, int]:
     return (0 if p.closed_form else 1, int(p.conditional), p.branches, int(p.reversed), p.free)
 
 
+@lru_cache(maxsize=64)
+def _near(robot: Robot) -> tuple[str, ...]:
+    """``structure.near_structure`` of the robot's chain, kept per robot (by value)."""
+    return near_structure(robot.chain, robot.length_scale)
+
+
 def _structures(robot: Robot) -> list[tuple[bool, Chain, Structure]]:
     out = []
     for rev_chain in (False, True):
@@ -288,7 +294,7 @@ def continuum_everywhere(robot: Robot) -> str | None:
     angles alone; a spherical shoulder and a spherical wrist (exactly or nearly: an SRS arm with its elbow locked, the
     KUKA iiwa or the RM75 with joint 4 held) leave a turn about the line through their centres free."""
     st = robot.structure()
-    near = near_structure(robot.chain, robot.length_scale)
+    near = _near(robot)
     coaxial = [f"{i + 1}≡{i + 2}" for i, rel in enumerate(st.pairs) if rel == "coincident"]
     coaxial += [t for t in near if "≈≡" in t]
     ends = [
@@ -323,7 +329,7 @@ def _missing(robot: Robot) -> str:
             "offset): at joint 5 = 0 the solutions form a continuum that only a sweep can report, and no sweep fits "
             "this arm (it needs two axes meeting at the tool or at the base)"
         )
-    near = near_structure(robot.chain, robot.length_scale)
+    near = _near(robot)
     nearly = (
         f" Its description has relations that hold only nearly ({', '.join(near)}: rounded, not exact), and a "
         "decomposition built on them would be off by about that much times the arm's size; with them exact, a "
@@ -379,15 +385,15 @@ def choose(robot: Robot, free_joint: int | None = None) -> Plan:
 
 
 @lru_cache(maxsize=64)
-def choice(robot: Robot, free_joint: int | None = None, hint: Plan | None = None) -> tuple[Plan, tuple[Any, ...]]:
+def choice(robot: Robot, free_joint: int | None = None, hints: tuple[Plan, ...] = ()) -> tuple[Plan, tuple[Any, ...]]:
     """:func:`choose`'s plan and the checks that chose it (``plan_check.PlanCheck``, in the order made; empty when
     there was nothing to choose from). The candidates: the plans sweeping ``free_joint`` if given, else those
     without a blind spot (all plans when every one has one), best ranked first. The first is chosen, unless the arm
     has a near-structure (``structure.near_structure``): then every candidate is checked on the arm and the one that
     recovers most of the check's configurations is chosen (:mod:`sweepik.plan_check`). A ``free_joint`` whose best
-    plan loses any of them raises NoReductionError (a sweep of that joint would miss solutions on this arm). ``hint``
-    (one of the candidates, e.g. the plan chosen for the same arm at other lock values) is taken when a shorter check
-    on the arm finds it sound (``plan_check.checked_choice``)."""
+    plan loses any of them raises NoReductionError (a sweep of that joint would miss solutions on this arm). ``hints``
+    (candidates, e.g. the plans chosen for the same arm at other lock values): the first that a shorter check on the
+    arm finds sound is taken (``plan_check.checked_choice``)."""
     everywhere = continuum_everywhere(robot)
     if everywhere:
         raise NoReductionError(everywhere)
@@ -400,10 +406,10 @@ def choice(robot: Robot, free_joint: int | None = None, hint: Plan | None = None
         raise NoReductionError(_missing(robot))
     else:
         options = tuple(p for p in options if not p.conditional) or options
-    near = near_structure(robot.chain, robot.length_scale)
+    near = _near(robot)
     if _plan_check is None or not near or (len(options) == 1 and free_joint is None):
         return options[0], ()
-    plan, checks = _plan_check(robot, options, hint if hint in options else None)
+    plan, checks = _plan_check(robot, options, tuple(h for h in hints if h in options))
     best = next(c for c in checks if c.plan == plan)
     if free_joint is not None and best.recovered < best.checked:
         raise NoReductionError(
@@ -415,11 +421,24 @@ def choice(robot: Robot, free_joint: int | None = None, hint: Plan | None = None
     return plan, checks
 
 
+def companion_plan(robot: Robot) -> Plan | None:
+    """The plan solved beside the automatic choice on an arm with a near-structure (:mod:`sweepik.companion`): of the
+    other checked plans that gave back every configuration of the check, the best scored one sweeping another joint
+    or the other chain; None without a near-structure or such a plan."""
+    try:
+        plan, checks = choice(robot)
+    except NoReductionError:
+        return None
+    mine = (plan.reversed, plan.free)
+    others = [c for c in checks if c.passed and (c.plan.reversed, c.plan.free) != mine and c.plan != plan]
+    return max(others, key=lambda c: c.score).plan if others else None
+
+
 def explain(robot: Robot) -> dict[str, Any]:
     """Plain values for ``sweepik analyze``: structure, every plan, the chosen one (or why none)."""
     st = robot.structure()
     found = plans(robot)
-    near = near_structure(robot.chain, robot.length_scale)
+    near = _near(robot)
     info: dict[str, Any] = {
         "robot": robot.name,
         "structure": st.describe(),
@@ -430,13 +449,15 @@ def explain(robot: Robot) -> dict[str, Any]:
     try:
         plan, checks = choice(robot)
     except NoReductionError as e:
-        info.update(chosen=None, reason=str(e), why=None)
+        info.update(chosen=None, reason=str(e), why=None, companion=None)
         return info
     info.update(chosen=_plan_dict(robot, plan), reason=None)
     info["checks"] = [
         {**_plan_dict(robot, c.plan), "recovered": c.recovered, "checked": c.checked, "solutions": c.solutions}
         for c in checks
     ]
+    comp = companion_plan(robot)
+    info["companion"] = None if comp is None else _plan_dict(robot, comp)
     if checks:
         best = next(c for c in checks if c.plan == plan)
         info["why"] = (

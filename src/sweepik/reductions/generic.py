@@ -117,6 +117,10 @@ def _chain_rows(chain: Chain) -> Array:
 class GeometricReduction(Reduction):
     """A reduction from a :class:`Plan`: the family's compiled kernels over the generic parameter row."""
 
+    #: A second reduction whose solutions the solver joins to this one's (:mod:`sweepik.companion`): set by the
+    #: automatic decomposition on an arm with a near-structure, None otherwise.
+    companion: Reduction | None = None
+
     #: Set per instance (the family's pair, its all-branch residual or configurations); declared here so that
     #: ``uses_kernel`` and the engine see this class as their owner.
     kernel: tuple[Any, Any] | None = None

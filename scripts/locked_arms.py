@@ -1,0 +1,72 @@
+"""Seven-joint arms with each lock that ``sweepik.analyze`` offers (issue 35): recall and refusals.
+
+    python scripts/locked_arms.py [--n 20] [--arms kinova_gen3 franka_panda kuka_iiwa14 ...] [--ssik]
+
+For every joint and every lock value ``analyze(robot)["locks"]`` lists, ``--n`` random configurations with that joint
+at that value (the others uniform within their limits, or over one turn) are solved with the joint locked, limits
+off; the configuration must come back (``tests/singular.recovered``). A lock ``analyze`` says nothing solves must be
+refused by ``solve`` with NoReductionError (never answered wrongly). ``--ssik``: the 7-joint arms of ssik 8.2's
+prebuilt catalogue too (built as ``scripts/ssik_catalogue.py`` does).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from singular import recovered  # noqa: E402
+
+import sweepik  # noqa: E402
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n", type=int, default=20)
+    ap.add_argument("--arms", nargs="*", default=None)
+    ap.add_argument("--ssik", action="store_true")
+    args = ap.parse_args()
+    robots = [sweepik.load_robot(n) for n in (args.arms or sweepik.bundled_robots())]
+    if args.ssik:
+        import ssik
+        from ssik_catalogue import robot_from_ssik
+
+        robots += [robot_from_ssik(a.name) for a in ssik.list_arms() if a.dof == 7]
+    rng = np.random.default_rng(0)
+    for robot in robots:
+        if robot.n_joints != 7:
+            continue
+        lo, hi = np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi)
+        for lock in sweepik.analyze(robot)["locks"]:
+            k, name = lock["joint"], lock["joint_name"]
+            for entry in lock["values"]:
+                v = float(entry["value"])
+                Q = rng.uniform(lo, hi, (args.n, 7))
+                Q[:, k] = v
+                rec = refused = 0
+                slow = 0.0
+                for q in Q:
+                    t0 = time.perf_counter()
+                    try:
+                        s = sweepik.solve(robot, robot.fk(q), locked={name: v}, limits=False)
+                    except sweepik.NoReductionError:
+                        refused += 1
+                        continue
+                    slow = max(slow, time.perf_counter() - t0)
+                    rec += recovered(robot, s, q)
+                said = "refused" if entry["chosen"] is None else "solved"
+                print(
+                    f"{robot.name:18s} lock {name:14s} = {v:+.4f}  analyze: {said:7s}  recall {rec}/{args.n - refused}"
+                    f"  refused {refused}  slowest {slow * 1e3:.0f} ms",
+                    flush=True,
+                )
+
+
+if __name__ == "__main__":
+    main()
