@@ -367,11 +367,11 @@ def not_sweepable(robot: Robot, free_joint: int, full: Robot | None = None, join
 
 #: The check of a choice (``plan_check.checked_choice``: plans solved on sample configurations of the arm), registered
 #: by the solver's layer, which can solve; None: the ranking alone chooses.
-_plan_check: Callable[[Robot, tuple[Plan, ...], Plan | None], tuple[Plan, tuple[Any, ...]]] | None = None
+_plan_check: Callable[[Robot, tuple[Plan, ...], tuple[Plan, ...]], tuple[Plan, tuple[Any, ...]]] | None = None
 
 
 def set_plan_check(
-    check: Callable[[Robot, tuple[Plan, ...], Plan | None], tuple[Plan, tuple[Any, ...]]] | None,
+    check: Callable[[Robot, tuple[Plan, ...], tuple[Plan, ...]], tuple[Plan, tuple[Any, ...]]] | None,
 ) -> None:
     """Register the check that :func:`choose` runs on the plans it chooses among (None: none)."""
     global _plan_check
