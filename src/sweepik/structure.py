@@ -177,8 +177,9 @@ def structure_of(chain: Chain, length_scale: float, tol_rel: float = INTERSECT_T
     return Structure(tuple(bool(r) for r in rev), tuple(pairs), points, frozenset(parallel), tuple(spherical), tol)
 
 
-def near_structure(chain: Chain, length_scale: float) -> tuple[str, ...]:
-    """The relations that nearly hold (within ``NEAR_TOL``) but not exactly, as text (joints numbered from 1):
+def near_structure(chain: Chain, length_scale: float, tol: float = NEAR_TOL) -> tuple[str, ...]:
+    """The relations that nearly hold (within ``tol``, default ``NEAR_TOL``) but not exactly, as text (joints numbered
+    from 1):
     ``"2≈∥3 (7.3e-06 rad)"`` axes nearly parallel (consecutive, or with only slides and nearly parallel axes
     between), ``"1≈∩2 (1.3e-06)"`` consecutive revolute axes that nearly meet (their distance over the length
     scale), ``"4≈∩5∩6 (2.5e-05)"`` three consecutive revolute axes that nearly share one point, ``"3≈≡4 (7.7e-07)"``
@@ -194,21 +195,21 @@ def near_structure(chain: Chain, length_scale: float) -> tuple[str, ...]:
     for i in range(n):
         for j in range(i + 1, n):
             s_ij = sin(i, j)
-            if not PARALLEL_TOL <= s_ij < NEAR_TOL:
+            if not PARALLEL_TOL <= s_ij < tol:
                 continue
-            if all((not rev[k]) or sin(i, k) < NEAR_TOL for k in range(i + 1, j)):
+            if all((not rev[k]) or sin(i, k) < tol for k in range(i + 1, j)):
                 out.append(f"{i + 1}≈∥{j + 1} ({s_ij:.1e} rad)")
     for i in range(n - 1):  # consecutive revolute axes on nearly one line
-        if rev[i] and rev[i + 1] and sin(i, i + 1) < NEAR_TOL:
+        if rev[i] and rev[i + 1] and sin(i, i + 1) < tol:
             d = pts[i + 1] - pts[i]
             off = float(np.linalg.norm(d - np.dot(d, H[i]) * H[i]))
-            if INTERSECT_TOL_REL * scale <= off < NEAR_TOL * scale:
+            if INTERSECT_TOL_REL * scale <= off < tol * scale:
                 out.append(f"{i + 1}≈≡{i + 2} ({off / scale:.1e})")
     meets: dict[int, Array] = {}
     for i in range(n - 1):
-        if not (rev[i] and rev[i + 1]) or sin(i, i + 1) < NEAR_TOL:
+        if not (rev[i] and rev[i + 1]) or sin(i, i + 1) < tol:
             continue
-        rel, pt = line_relation(H[i], pts[i], H[i + 1], pts[i + 1], NEAR_TOL * scale)
+        rel, pt = line_relation(H[i], pts[i], H[i + 1], pts[i + 1], tol * scale)
         if rel != "intersecting":
             continue
         meets[i] = pt  # type: ignore[assignment]
@@ -218,6 +219,6 @@ def near_structure(chain: Chain, length_scale: float) -> tuple[str, ...]:
     for i in range(n - 2):
         if i in meets and i + 1 in meets:
             d = float(np.linalg.norm(meets[i] - meets[i + 1]))
-            if INTERSECT_TOL_REL * scale <= d < NEAR_TOL * scale:
+            if INTERSECT_TOL_REL * scale <= d < tol * scale:
                 out.append(f"{i + 1}≈∩{i + 2}∩{i + 3} ({d / scale:.1e})")
     return tuple(out)

@@ -34,6 +34,11 @@ __all__ = ["plans", "choose", "choice", "companion_plan", "explain", "set_plan_c
 #: range): generic angles, so that a relation holding at all of them holds for every angle.
 _ANGLES = (0.0, 0.9, 2.1, -1.3, -2.8)
 _FRACTIONS = (0.5, 0.1, 0.9, 0.3, 0.7)
+#: A relation holding to this (a sine, or a distance over the length scale) but not exactly still makes every pose
+#: nearly a continuum where the exact relation would make it one (``continuum_everywhere``): the Realman RM75 with
+#: joint 4 held has axes 3 and 4 on one line to 7.7e-7, its shoulder and wrist axes meeting to 1.1e-6 and 6.2e-7, and
+#: its solutions then turn on the rounding of the pose. Real offsets (a millimetre on a metre) are well above it.
+DEGENERATE_TOL = 1e-5
 #: A dot product entering a division must exceed this (it is a cosine between unit vectors) ...
 MIN_DOT = 1e-6
 #: ... and is theta*-dependent (the plan has a blind spot) when it varies across the samples by more than this.
@@ -289,12 +294,12 @@ def _continuum_covered(plan: Plan, found: list[Plan], robot: Robot) -> bool:
 
 def continuum_everywhere(robot: Robot) -> str | None:
     """Why every pose of ``robot`` is a continuum (or nearly: an arm no decomposition can solve to certification),
-    or None. Two consecutive revolute axes on one line (exactly, or to ``structure.NEAR_TOL``: a 7-joint arm whose
+    or None. Two consecutive revolute axes on one line (exactly, or to ``DEGENERATE_TOL``: a 7-joint arm whose
     elbow is locked straight, e.g. the Realman RM75 with joint 4 at 0) turn the rest of the arm by the sum of their
     angles alone; a spherical shoulder and a spherical wrist (exactly or nearly: an SRS arm with its elbow locked, the
     KUKA iiwa or the RM75 with joint 4 held) leave a turn about the line through their centres free."""
     st = robot.structure()
-    near = _near(robot)
+    near = near_structure(robot.chain, robot.length_scale, DEGENERATE_TOL)
     coaxial = [f"{i + 1}≡{i + 2}" for i, rel in enumerate(st.pairs) if rel == "coincident"]
     coaxial += [t for t in near if "≈≡" in t]
     ends = [
@@ -304,7 +309,7 @@ def continuum_everywhere(robot: Robot) -> str | None:
     if all(robot.is_revolute) and all(ends):
         return (
             f"robot {robot.name!r}: every pose is a continuum (or nearly one): joints 1-3 meet at one point and joints "
-            "4-6 at another (exactly or to 1e-3), so the two points keep their distance and a pose fixes the arm only "
+            "4-6 at another (exactly or to 1e-5), so the two points keep their distance and a pose fixes the arm only "
             "up to a turn about the line through both (a 7-joint arm with its elbow locked: its self-motion); with "
             "joints locked, lock another joint"
         )
