@@ -97,7 +97,8 @@ def analyze(robot: Robot | str, locked: Mapping[Any, float] | None = None) -> di
 def _numbered_in_full_arm(info: dict[str, Any], held: HeldJoints) -> dict[str, Any]:
     """``explain`` of the smaller arm with each plan's ``free_joint`` (and number) those of the full arm, as
     ``solve(..., locked=..., free_joint=...)`` takes them; ``held`` and ``arm_joints`` keys added."""
-    for plan in [*info["plans"], *info["checks"], *([info["chosen"]] if info["chosen"] else [])]:
+    others = [p for p in (info["chosen"], info.get("companion")) if p]
+    for plan in [*info["plans"], *info["checks"], *others]:
         if plan["free_joint"] is not None:
             plan["free_joint"] = held.free[plan["free_joint"]]
             plan["free_joint_number"] = plan["free_joint"] + 1

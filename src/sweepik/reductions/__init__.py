@@ -116,8 +116,7 @@ def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduct
         comp = next((p for p in hints if p != plan), None)
     else:
         comp = decompose.companion_plan(arm)
-    red = _held_reduction(arm, plan)
-    red.companion = None if comp is None else GeometricReduction(arm, comp)
+    red = _held_reduction(arm, plan, comp)
     if len(_HELD_PLANS) > 256:  # (bounded, as the caches around it)
         _HELD_PLANS.clear()
     _HELD_PLANS[key] = (_signature(plan), None if comp is None else _signature(comp))
@@ -125,5 +124,7 @@ def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduct
 
 
 @lru_cache(maxsize=64)
-def _held_reduction(arm: Robot, plan: Plan) -> GeometricReduction:
-    return GeometricReduction(arm, plan)
+def _held_reduction(arm: Robot, plan: Plan, companion: Plan | None) -> GeometricReduction:
+    red = GeometricReduction(arm, plan)
+    red.companion = None if companion is None else GeometricReduction(arm, companion)
+    return red
