@@ -54,6 +54,31 @@ def test_compiled_finish_equals_reference(name: str, per_pose: int, monkeypatch:
         assert same.sum() == len(k), "two kept candidates are equal"
 
 
+@pytest.mark.parametrize("joint", [0, 3, 5])
+def test_a_continuum_across_the_seam_deduplicates_as_the_reference(joint: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Thousands of candidates of one pose along an arc of one joint that crosses +-pi (a numerical continuum's, the
+    other joints constant or drifting by less than the tolerance), with near copies: the compiled pass (by buckets
+    along the joint that spreads most) keeps exactly what the all-pairs reference keeps, seam pairs included."""
+    robot = sweepik.load_robot("ur5")
+    rng = np.random.default_rng(joint)
+    K = 3000
+    q = np.tile(rng.uniform(-np.pi, np.pi, 6), (K, 1))
+    q[:, joint] = np.pi + rng.uniform(-0.2, 0.2, K)  # (wrapped: both sides of the seam)
+    copies = rng.random(K) < 0.4
+    q[copies] = q[rng.integers(0, K, int(copies.sum()))] + rng.normal(scale=3e-7, size=(int(copies.sum()), 6))
+    q[:, (joint + 1) % 6] += rng.normal(scale=2e-7, size=K)
+    q[:20, joint] = np.pi - rng.uniform(0, 4e-7, 20)  # just below pi, and copies of them just above -pi
+    q[20:40] = q[:20]
+    q[20:40, joint] += rng.uniform(4e-7, 6e-7, 20) - 2 * np.pi
+    err = rng.choice([1e-12, 2e-12], K)
+    pose = np.zeros(K, dtype=np.intp)
+    w_c, _, keep_c = dedupe.finish(robot, pose, q, err)
+    monkeypatch.setattr(dedupe, "AVAILABLE", False)
+    _, _, keep_r = dedupe.finish(robot, pose, q, err)
+    np.testing.assert_array_equal(keep_c, keep_r)
+    assert 0 < keep_c.sum() < K
+
+
 def test_a_continuum_of_tens_of_thousands_of_points_collapses_in_bounded_memory() -> None:
     """40,000 certified points along one arc of a pose (a numerical continuum) and 5 isolated ones: the arc is
     reported by one medoid (before, the all-pairs comparison asked for (K, K, 6) floats: 77 GB)."""

@@ -44,6 +44,8 @@ __all__ = [
 DEDUPE_ANGLE = 1e-6
 #: ... and every prismatic joint within this times the arm's length scale.
 DEDUPE_LENGTH_REL = 1e-8
+#: A pose with more candidates than this (a numerical continuum) is deduplicated by buckets, not pair by pair.
+_LARGE_GROUP = 64
 #: ``settle`` runs on several threads from this many candidates on (fewer: a thread hand-off costs more).
 _PARALLEL_ROWS = 4096
 
@@ -400,6 +402,10 @@ if AVAILABLE:
         start = 0
         while start < K:
             stop = _group_stop(pose, order, start)
+            if stop - start > _LARGE_GROUP:
+                _dedupe_bucketed(q, score, rev, tol, order[start:stop], keep)
+                start = stop
+                continue
             for a in range(start, stop):
                 i = order[a]
                 for b in range(start, stop):
@@ -410,6 +416,76 @@ if AVAILABLE:
                         keep[i] = False
                         break
             start = stop
+
+    @inlined
+    def _drop_worse(q, score, rev, tol, a, b, keep):  # pragma: no cover
+        """Of rows ``a`` and ``b`` when equal (``_rows_within``), the worse one dropped (a tie: the later row)."""
+        if _rows_within(q, a, b, rev, tol):
+            if score[b] < score[a] or (score[b] == score[a] and b < a):
+                keep[a] = False
+            else:
+                keep[b] = False
+
+    @internal
+    def _bucket_rows(q, rev, tol, rows, j, key, bucket):  # pragma: no cover
+        """Rows ``rows`` of ``q`` in ``rows.shape[0]`` buckets along joint ``j`` (its value modulo 2 pi for a revolute
+        one, into ``key``), each at least the joint's tolerance wide (into ``bucket``); returns the number of pairs
+        the buckets leave to compare (same or neighbouring bucket, the first and last for a revolute joint)."""
+        m = rows.shape[0]
+        lo, hi = math.inf, -math.inf
+        for x in range(m):
+            key[x] = wrap_pi(q[rows[x], j]) if rev[j] else q[rows[x], j]
+            lo, hi = min(lo, key[x]), max(hi, key[x])
+        width = max(tol[j] * (1.0 + 1e-9), (hi - lo) / m)
+        count = np.zeros(m, dtype=np.int64)
+        for x in range(m):
+            bucket[x] = min(int((key[x] - lo) / width), m - 1)
+            count[bucket[x]] += 1
+        pairs = 0
+        for b in range(m):
+            pairs += count[b] * count[b] + (count[b] * count[b + 1] if b + 1 < m else 0)
+        if rev[j]:
+            pairs += count[0] * (count[m - 1] + count[m - 2])
+        return pairs
+
+    @internal
+    def _dedupe_bucketed(q, score, rev, tol, rows, keep):  # pragma: no cover
+        """Step 3 for one pose's many candidates ``rows`` (a numerical continuum's: thousands), in about linear time:
+        the rows put in as many buckets along the joint whose buckets leave fewest pairs (``_bucket_rows``), so that
+        equal rows share a bucket or lie in neighbouring ones (the first and last ones too for a revolute joint);
+        only those pairs compared."""
+        m = rows.shape[0]
+        key = np.empty(m)
+        bucket = np.empty(m, dtype=np.int64)
+        best, fewest = 0, -1
+        for j in range(q.shape[1]):
+            pairs = _bucket_rows(q, rev, tol, rows, j, key, bucket)
+            if fewest < 0 or pairs < fewest:
+                best, fewest = j, pairs
+        _bucket_rows(q, rev, tol, rows, best, key, bucket)
+        first = np.zeros(m + 1, dtype=np.int64)
+        for x in range(m):
+            first[bucket[x] + 1] += 1
+        for b in range(m):
+            first[b + 1] += first[b]
+        fill = first[:m].copy()
+        sorted_rows = np.empty(m, dtype=np.int64)
+        for x in range(m):
+            sorted_rows[fill[bucket[x]]] = rows[x]
+            fill[bucket[x]] += 1
+        last = bucket.max()
+        for b in range(last + 1):
+            for x in range(first[b], first[b + 1]):
+                a = sorted_rows[x]
+                for y in range(x + 1, first[b + 1]):
+                    _drop_worse(q, score, rev, tol, a, sorted_rows[y], keep)
+                if b < last:
+                    for y in range(first[b + 1], first[b + 2]):
+                        _drop_worse(q, score, rev, tol, a, sorted_rows[y], keep)
+        if rev[best] and last > 1:  # (a row just below pi may lie one bucket short of the last)
+            for x in range(first[0], first[1]):
+                for y in range(first[last - 1], first[last + 1]):
+                    _drop_worse(q, score, rev, tol, sorted_rows[x], sorted_rows[y], keep)
 
     #: ``_settle``'s arguments (``fastsolve`` calls it by its address too).
     _SETTLE_SIG = (
