@@ -64,14 +64,21 @@ PROBE_STEP = 2.0**-8
 PROBE_ERROR = 1e-2
 
 
-def _singular_along(robot: Robot, q: Array, joint: int) -> NDArray[np.bool_]:
-    """``(K,)``: the configurations ``q (K, n)`` are singular with a null direction that moves ``joint``
-    (``TRACE_SINGULAR``, ``TRACE_SHARE``): the only places a continuum along it can pass (elsewhere the arm's
-    solutions are isolated)."""
+def scaled_singular(robot: Robot, q: Array) -> tuple[Array, Array]:
+    """Singular values ``(K, 6)`` (decreasing) and right singular vectors ``(K, n, n)`` (rows) of the Jacobian at
+    configurations ``q (K, n)``, lengths over the arm's length scale (a slide's column: per length scale)."""
     J = geometric_jacobian(robot, q)
     J[:, :3, :] /= robot.length_scale
     J[:, :, ~robot.is_revolute] *= robot.length_scale
     _, s, vt = np.linalg.svd(J)
+    return s, vt
+
+
+def _singular_along(robot: Robot, q: Array, joint: int) -> NDArray[np.bool_]:
+    """``(K,)``: the configurations ``q (K, n)`` are singular with a null direction that moves ``joint``
+    (``TRACE_SINGULAR``, ``TRACE_SHARE``): the only places a continuum along it can pass (elsewhere the arm's
+    solutions are isolated)."""
+    s, vt = scaled_singular(robot, q)
     return np.asarray((s[:, -1] <= TRACE_SINGULAR * s[:, 0]) & (np.abs(vt[:, -1, joint]) >= TRACE_SHARE))
 
 
@@ -80,12 +87,22 @@ def _world(robot: Robot, chain: Array) -> Array:
     return robot.T_world_base @ chain @ robot.T_flange_tool
 
 
-def _correct(robot: Robot, q: Array, world: Array, joint: int, tol: float) -> tuple[Array, Array]:
-    """Newton steps on configurations ``q (K, n)`` towards ``world (K, 4, 4)`` with ``joint`` held: ``(q, errors)``."""
+def correct(robot: Robot, q: Array, world: Array, joint: int | IntArray, tol: float) -> tuple[Array, Array]:
+    """Newton steps on configurations ``q (K, n)`` towards ``world (K, 4, 4)`` with ``joint`` held (one for all, or
+    one per configuration ``(K,)``): ``(q, errors)``."""
     weight = orientation_weight(robot.length_unit)
     fixed = np.zeros(q.shape, dtype=bool)
-    fixed[:, joint] = True
+    fixed[np.arange(q.shape[0]), joint] = True
     return polished(robot, q, world, weight, iterations=TRACE_NEWTON, fixed=fixed, floor=1e-3 * tol)
+
+
+def _bridged(robot: Robot, world: Array, a: Array, b: Array, joint: int, tol: float) -> bool:
+    """The member halfway between members ``a`` and ``b`` (the joint's midpoint, the others interpolated and corrected
+    as :class:`Traced` does) solves the pose: a step of the trace may not leap over a gap in the solution set (a
+    KR 6 pose whose wrist centre sits on axis 1 at full stretch holds stretches of a continuum along joint 1 with
+    gaps between them, where the interpolated members missed the pose by 6e-5 of the arm's size)."""
+    mid, err = correct(robot, (0.5 * (a + b))[None], world[None], joint, tol)
+    return bool(err[0] <= tol)
 
 
 def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) -> tuple[Array, Array, bool] | None:
@@ -117,10 +134,12 @@ def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) ->
                 xp, qp = nodes[-2]
                 pred = q + (q - qp) * (step / abs(x - xp))
             pred[joint] = x + sign * step
-            corr, err = _correct(robot, pred[None], world[None], joint, tol)
+            corr, err = correct(robot, pred[None], world[None], joint, tol)
             if len(nodes) == 1 and not err[0] <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
                 break
-            if err[0] <= tol and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP:
+            if err[0] <= tol and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP and _bridged(
+                robot, world, q, corr[0], joint, tol
+            ):
                 nodes.append((x + sign * step, corr[0]))
                 done += step
                 h = min(2.0 * h, h0)
@@ -188,7 +207,7 @@ class Traced(Reduction):
             q[rows] = np.stack([np.interp(xu, th, Q[:, i]) for i in range(n)], axis=-1)
             q[rows, j] = x[rows]
         ok = np.all(np.isfinite(q), axis=1) & np.isfinite(x)
-        q[ok] = _correct(self.robot, q[ok], world[ok], j, self.tol)[0]
+        q[ok] = correct(self.robot, q[ok], world[ok], j, self.tol)[0]
         return q.reshape(*theta.shape, n)
 
 
@@ -236,7 +255,7 @@ def continuum_families(
                 # onto the solution set first, a few at a time (a candidate where the closed form leaves j free is
                 # rough; a pose on a continuum can have thousands, most of them on the first family traced)
                 head = left[:SEED_BATCH]
-                head, err = _correct(robot, head, np.repeat(world[i][None], head.shape[0], axis=0), j, tol)
+                head, err = correct(robot, head, np.repeat(world[i][None], head.shape[0], axis=0), j, tol)
                 good = np.nonzero(err <= tol)[0]
                 good = good[_singular_along(robot, head[good], j)]
                 if good.size == 0:

@@ -19,7 +19,8 @@ from . import fastcertify, fastsolve, fastsweep, parallel
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch, no_solution_reason
 from .companion import joined
-from .continuation import continuum_families
+from .continuation import continuum_families, correct
+from .crossings import crossing_seeds
 from .dedupe import finish, merged_multiplicity, near_pairs, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from .families import MAX_ISOLATED_SOLUTIONS, collapse_continua, families_of, off_families, unique_families
@@ -367,6 +368,8 @@ def _solve_chunk_by(
     # poses with families (few): their isolated solutions lying on a family are reported by the family; the
     # reduction's blind spot: the fallback reduction's families are added, and its isolated solutions when this
     # reduction has none (a closed form: always)
+    if strategy == "precise" and use_fallback and (fams or fallback):
+        _add_crossing_families(robot, chain, poses, limits, fams, fallback)
     families: dict[int, tuple[Family, ...]] = {}
     if fams or fallback:
         families, pose_idx, q, err_paper, err_geo, inside, mult = _with_families(
@@ -577,6 +580,45 @@ def _trace_cut_continua(
             off = off_families(robot, [(m, tuple(found)) for m in ends])
             kept = tuple(f for f, o in zip(sol.families, off, strict=True) if o.any())
             fallback[i] = dataclasses.replace(sol, families=kept)
+
+
+def _add_crossing_families(
+    robot: Robot,
+    chain: Array,
+    poses: Array,
+    limits: bool,
+    fams: dict[int, list[Family]],
+    fallback: dict[int, Solutions],
+) -> None:
+    """The continua that cross the families found (``fams`` and the fallback's, per pose), traced from where they
+    cross (:mod:`.crossings`) and added to ``fams`` when not on a family found already."""
+    tol = ACCEPT_TOL_REL * robot.length_scale
+    known: dict[int, tuple[Family, ...]] = {}
+    seed_p, seed_q, seed_j = [], [], []
+    for i in sorted(set(fams) | set(fallback)):
+        known[i] = tuple(fams.get(i, ())) + (fallback[i].families if i in fallback else ())
+        q, j = crossing_seeds(robot, known[i])
+        if j.size:
+            seed_p.append(np.full(j.size, i, dtype=np.intp))
+            seed_q.append(q)
+            seed_j.append(j)
+    if not seed_p:
+        return
+    p, q, j = np.concatenate(seed_p), np.concatenate(seed_q), np.concatenate(seed_j)
+    # onto the solution set; those that fall back onto a family found already are not traced (most crossings of a
+    # family with another singular set branch into no other continuum)
+    q, err = correct(robot, q, poses[p], j, tol)
+    new = err <= tol
+    for i in np.unique(p[new]).tolist():
+        rows = np.nonzero(new & (p == i))[0]
+        new[rows] = off_families(robot, [(q[rows], known[i])])[0]
+    if not new.any():
+        return
+    traced, _, _ = continuum_families(robot, chain, poses, p[new], q[new], j[new], limits, tol)
+    for i, found in traced.items():
+        members = [f.at(np.linspace(f.interval[0], f.interval[1], 3)) for f in found]
+        off = off_families(robot, [(m, known[i]) for m in members])
+        fams.setdefault(i, []).extend(f for f, o in zip(found, off, strict=True) if o.any())
 
 
 def _with_families(

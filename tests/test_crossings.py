@@ -1,0 +1,91 @@
+"""Two continua that cross (issue 35, point 5): a spherical-wrist arm with its wrist centre on axis 1 (a continuum along
+joint 1) and its wrist straight (A5 = 0: the wrist's own circle, A4 and A6 turning against each other) holds both, and
+they meet in one configuration. Configurations on the wrist circle away from the meeting point must come back as
+solutions or family members, and every member of every family must solve the pose."""
+
+from __future__ import annotations
+
+import zlib
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+from singular import recovered
+
+import sweepik
+from sweepik.pose import pose_error_geodesic
+from sweepik.units import orientation_weight
+
+
+def _shoulder_singular(robot: sweepik.Robot, rng: np.random.Generator) -> np.ndarray:
+    """A configuration with det J = 0 along joint 2 (with A5 away from 0 the only factor that joint 2 moves: the
+    shoulder's, where the wrist centre lies on axis 1), then A5 = 0."""
+    while True:
+        q = rng.uniform(-np.pi, np.pi, 6)
+        q[4] = rng.choice([-1.0, 1.0]) * rng.uniform(0.3, 2.8)
+        xs = np.linspace(-np.pi, np.pi, 721)
+        Q = np.repeat(q[None], xs.size, axis=0)
+        Q[:, 1] = xs
+        det = np.linalg.det(robot.jacobian(Q))
+        idx = np.flatnonzero(np.sign(det[:-1]) * np.sign(det[1:]) < 0)
+        if idx.size:
+            break
+    i = int(rng.choice(idx))
+
+    def f(x: float) -> float:
+        qq = q.copy()
+        qq[1] = x
+        return float(np.linalg.det(robot.jacobian(qq)))
+
+    q[1] = brentq(f, xs[i], xs[i + 1], xtol=1e-15)
+    q[4] = 0.0
+    return q
+
+
+def _on_wrist_circle(robot: sweepik.Robot, q: np.ndarray, t: float) -> np.ndarray:
+    """``q`` with A4 moved by ``t`` and A6 by -t or +t, whichever keeps the pose (axes 4 and 6 aligned at A5 = 0)."""
+    T = robot.fk(q)
+    best = None
+    for sign in (-1.0, 1.0):
+        c = q.copy()
+        c[3] += t
+        c[5] += sign * t
+        e = float(np.max(np.abs(robot.fk(c) - T)))
+        if best is None or e < best[0]:
+            best = (e, c)
+    assert best is not None and best[0] < 1e-9 * robot.length_scale, "not a wrist circle"
+    return best[1]
+
+
+@pytest.mark.parametrize("name", ["kuka_kr6_r900", "abb_irb140"])
+def test_the_wrist_circle_crossing_a_joint_1_continuum_comes_back(name: str) -> None:
+    robot = sweepik.load_robot(name)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    w = orientation_weight(robot.length_unit)
+    for _ in range(3):
+        q = _shoulder_singular(robot, rng)
+        T = robot.fk(q)
+        s = sweepik.solve(robot, T, limits=False)
+        assert s.families, "no continuum reported"
+        for t in (0.4, -1.1, 2.0):
+            assert recovered(robot, s, _on_wrist_circle(robot, q, t)), (name, q.tolist(), t)
+        for f in s.families:
+            m = f.at(np.linspace(f.interval[0], f.interval[1], 7))
+            err = pose_error_geodesic(robot.fk(m), np.broadcast_to(T, (len(m), 4, 4)), w)
+            assert np.all(err <= 1e-9 * robot.length_scale), (name, q.tolist(), f)
+
+
+def test_the_issue_reproducers_wrist_circle() -> None:
+    """The KR 6 and IRB 140 configurations of issue 35 (wrist centre on axis 1, A5 = 0): 0 solutions and the joint-1
+    families only, the wrist circle through them missing."""
+    cases = {
+        "kuka_kr6_r900": [-0.449947703404042, -0.6365112470698561, -2.038806599570209, -1.6754080220239238, 0.0,
+                          -2.6548778051440474],
+        "abb_irb140": [-2.633936123427877, -1.1638693734790628, 0.3487714784042786, -2.47670646646433, 0.0,
+                       -3.027679808844194],
+    }  # fmt: skip
+    for name, q in cases.items():
+        robot = sweepik.load_robot(name)
+        q = np.array(q)
+        s = sweepik.solve(robot, robot.fk(q), limits=False)
+        assert recovered(robot, s, q), name
