@@ -253,3 +253,56 @@ def test_traced_family_passes_where_another_singular_set_crosses() -> None:
         m = f.at(-np.pi / 2)
         err = pose_error_geodesic(robot.fk(m[None]), T[None], orientation_weight(robot.length_unit))
         assert err[0] <= 4.0 * ACCEPT_TOL_REL * robot.length_scale
+
+
+@pytest.mark.parametrize("limits", [False, True])
+def test_wrist_continuum_traced_from_a_member_at_a_second_singularity(limits: bool) -> None:
+    """PUMA 560 with A4 = 0 and A5 = 0 (issue 35): axes 2, 3 and 5 parallel as well as the wrist straight. With the
+    limits on, the one seed left is a member whose A5 is 9e-7 (the root of the rounding), where the wrist continuum's
+    direction is the second smallest singular one: it came back as that one isolated solution. Now the continuum is
+    reported, cut to joint 4's limits, every member a solution."""
+    arm = load_robot("puma560")
+    q = np.array([2.3568597051599407, 0.6302471995232901, 1.6177742441429797, 2.3660966733039746, 0.0,
+                  -0.6885664195971763])  # fmt: skip
+    T = arm.fk(q)
+    s = solve(arm, T, limits=limits)
+    fam = [f for f in s.families if f.free_joint == 3]
+    assert fam, s
+    f = fam[0]
+    if limits:
+        np.testing.assert_allclose(f.interval, (arm.lower[3], arm.upper[3]), atol=1e-9)
+    m = f.at(np.linspace(f.interval[0], f.interval[1], 9))
+    err = pose_error_geodesic(arm.fk(m), np.broadcast_to(T, (9, 4, 4)), orientation_weight(arm.length_unit))
+    assert np.all(err <= ACCEPT_TOL_REL * arm.length_scale)
+    assert np.any(np.max(np.abs(joint_distance(arm, f.at(q[3:4]), q)), axis=-1) < 1e-6)
+
+
+@pytest.mark.parametrize(
+    "q",
+    [
+        [399.0308879364266, 2.7778786000458915, 3.1415925535886777, -2.478746263017324, 0.8112104407914167,
+         2.683891211730887],
+        [1305.229152673277, -1.4209480208846816, -3.141592753589775, 2.788486605067879, -2.3447772999628302,
+         2.2919696260401583],
+        [1642.2061767892776, 3.0274166388510366, 1.0000032334890302e-07, -0.4768530155683983, 3.013973045327825,
+         2.9781318484005785],
+    ],
+)  # fmt: skip
+def test_numerical_continuum_next_to_a_self_motion(q: list[float]) -> None:
+    """carm_swapped with its elbow 1e-7 rad off its theta2 self-motion (issue 35): the solutions around the configuration
+    form stretches of numerical continuum along theta2 (every member solves the pose to the certification), which the
+    closed form's candidates flag only with ``CONTINUUM_AMPLITUDE`` above their 1e-7: before, 8 isolated solutions
+    came back, none of them this configuration (0.002 to 0.1 rad away)."""
+    from singular import recovered
+
+    arm = load_robot("carm_swapped")
+    q_ = np.array(q)
+    T = arm.fk(q_)
+    s = solve(arm, T, limits=False)
+    assert recovered(arm, s, q_)
+    w = orientation_weight(arm.length_unit)
+    for f in s.families:
+        m = f.at(np.linspace(f.interval[0], f.interval[1], 9))
+        err = pose_error_geodesic(arm.fk(m), np.broadcast_to(T, (9, 4, 4)), w)
+        # (an end sits where members stop being certified: another FK's rounding can put it a hair over)
+        assert np.all(err <= 1.01 * ACCEPT_TOL_REL * arm.length_scale), (err / (ACCEPT_TOL_REL * arm.length_scale), f)

@@ -43,10 +43,11 @@ TRACE_JUMP = 0.25
 TRACE_NEWTON = 20
 #: A seed is followed only where a continuum can pass along the joint: the arm's Jacobian (lengths over the arm's
 #: length scale) has its smallest singular value below this fraction of its largest (members of a continuum: ~1e-17,
-#: and ~1e-9 where two singular directions meet and the member is pinned down only to the root of the rounding;
-#: regular solutions: above ~1e-3) ...
-TRACE_SINGULAR = 1e-7
-#: ... and the joint's share of that singular value's direction (the continuum's tangent) is above this.
+#: ~1e-9 where two singular directions meet, and up to ~1e-7 where the member is pinned down only to the root of the
+#: rounding: a PUMA 560 member with A5 = 9e-7, A4 = 0, its wrist continuum's direction the second smallest at
+#: 9.4e-8; regular solutions: above ~1e-3) ...
+TRACE_SINGULAR = 1e-5
+#: ... and the joint's share of the nearly null directions (the continuum's tangent among them) is above this.
 TRACE_SHARE = 1e-3
 #: Seeds corrected at once (``continuum_families``).
 SEED_BATCH = 8
@@ -75,11 +76,13 @@ def scaled_singular(robot: Robot, q: Array) -> tuple[Array, Array]:
 
 
 def _singular_along(robot: Robot, q: Array, joint: int) -> NDArray[np.bool_]:
-    """``(K,)``: the configurations ``q (K, n)`` are singular with a null direction that moves ``joint``
+    """``(K,)``: the configurations ``q (K, n)`` are singular with nearly null directions that move ``joint``
     (``TRACE_SINGULAR``, ``TRACE_SHARE``): the only places a continuum along it can pass (elsewhere the arm's
     solutions are isolated)."""
     s, vt = scaled_singular(robot, q)
-    return np.asarray((s[:, -1] <= TRACE_SINGULAR * s[:, 0]) & (np.abs(vt[:, -1, joint]) >= TRACE_SHARE))
+    null = s <= TRACE_SINGULAR * s[:, :1]  # (K, 6): the nearly null directions (two where singular sets meet)
+    share = np.sqrt(np.sum(np.where(null, vt[:, :6, joint] ** 2, 0.0), axis=1))
+    return np.asarray(null[:, -1] & (share >= TRACE_SHARE))
 
 
 def _world(robot: Robot, chain: Array) -> Array:
@@ -137,8 +140,10 @@ def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) ->
             corr, err = correct(robot, pred[None], world[None], joint, tol)
             if len(nodes) == 1 and not err[0] <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
                 break
-            if err[0] <= tol and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP and _bridged(
-                robot, world, q, corr[0], joint, tol
+            if (
+                err[0] <= tol
+                and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP
+                and _bridged(robot, world, q, corr[0], joint, tol)
             ):
                 nodes.append((x + sign * step, corr[0]))
                 done += step

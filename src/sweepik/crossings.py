@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .continuation import TRACE_SINGULAR, scaled_singular
+from .continuation import scaled_singular
 from .families import _golden_least
 from .robot import Robot
 from .solutions import Family
@@ -29,9 +29,11 @@ IntArray = NDArray[np.intp]
 #: Members sampled along a family (its interval, ends included) ...
 CROSS_SAMPLES = 65
 #: ... and golden-section steps at most around a least second singular value between them, until it is below
-#: ``continuation.TRACE_SINGULAR`` (a crossing, located to about that over its slope: far closer than the seeds'
+#: ``CROSS_SINGULAR`` (a crossing, located to about that over its slope: far closer than the seeds'
 #: step) or cannot get there any more (its slope bounded by twice the rise to the samples beside it).
 CROSS_STEPS = 40
+#: The second singular value (over the largest) at a crossing: members of a continuum have their smallest at ~1e-17.
+CROSS_SINGULAR = 1e-7
 #: A family whose second singular value stays below this over half its members is not searched: the arm
 #: loses a second rank all along it (the KR 6's wrist centre on axis 1 with the elbow straight), where no other
 #: continuum branches off at one point.
@@ -85,11 +87,11 @@ def crossing_seeds(robot: Robot, families: tuple[Family, ...]) -> tuple[Array, I
             continue
 
         def excess(t: Array, f: Family = f) -> Array:
-            return _second_singular(robot, f, t) - TRACE_SINGULAR
+            return _second_singular(robot, f, t) - CROSS_SINGULAR
 
         a, b = grid[np.maximum(dips - 1, 0)], grid[np.minimum(dips + 1, grid.size - 1)]
         slope = 2.0 * rise[dips] / (grid[1] - grid[0])  # (a bound on the V's slope)
-        x, e = _golden_least(excess, a, b, grid[dips], s2[dips] - TRACE_SINGULAR, steps=CROSS_STEPS, slope=slope)
+        x, e = _golden_least(excess, a, b, grid[dips], s2[dips] - CROSS_SINGULAR, steps=CROSS_STEPS, slope=slope)
         x = x[e <= 0.0]
         if x.size == 0:
             continue

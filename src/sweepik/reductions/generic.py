@@ -22,9 +22,13 @@ from .base import Array, IntArray, Reduction
 from .position import CASES, FINAL_JOINTS, STEP_JOINTS
 
 #: A candidate where a step's amplitude (``amplitude`` of ``geometric.case_kernels``) is below this fraction of the
-#: step's typical amplitude leaves that step's joint free (``continuum_joints``). On the C-Arm's theta2 self-motion
-#: the first step's amplitude is 1e-12 to 1e-8 mm at the candidates, against 30 to 700 mm at random poses.
-CONTINUUM_AMPLITUDE = 1e-7
+#: step's typical amplitude leaves that step's joint free (``continuum_joints``): the tracer follows it where it can
+#: (a numerical continuum) and gives nothing where it cannot. On the C-Arm's theta2 self-motion the first step's
+#: amplitude is 1e-12 to 1e-8 mm at the candidates, against 30 to 700 mm at random poses; carm_swapped with its elbow
+#: folded 1e-7 rad short of its self-motion holds stretches of numerical continuum along theta2 whose candidates'
+#: amplitudes lie above 1e-7 (with that threshold, 3 of 40 such configurations came back as none of 8 isolated
+#: solutions, each 0.002 to 0.1 rad away).
+CONTINUUM_AMPLITUDE = 1e-5
 
 #: Twin branches: residuals compared at this many random poses and theta* values, equal to this (absolute; the
 #: residual is a difference of cosines).
