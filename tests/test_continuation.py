@@ -289,10 +289,10 @@ def test_wrist_continuum_traced_from_a_member_at_a_second_singularity(limits: bo
     ],
 )  # fmt: skip
 def test_numerical_continuum_next_to_a_self_motion(q: list[float]) -> None:
-    """carm_swapped with its elbow 1e-7 rad off its theta2 self-motion (issue 35): the solutions around the configuration
-    form stretches of numerical continuum along theta2 (every member solves the pose to the certification), which the
-    closed form's candidates flag only with ``CONTINUUM_AMPLITUDE`` above their 1e-7: before, 8 isolated solutions
-    came back, none of them this configuration (0.002 to 0.1 rad away)."""
+    """carm_swapped with its elbow 1e-7 rad off its theta2 self-motion (issue 35): the solutions around the
+    configuration form stretches of numerical continuum along theta2 (every member solves the pose to the
+    certification), which the closed form's candidates flag only with ``CONTINUUM_AMPLITUDE`` above their 1e-7:
+    before, 8 isolated solutions came back, none of them this configuration (0.002 to 0.1 rad away)."""
     from singular import recovered
 
     arm = load_robot("carm_swapped")

@@ -265,3 +265,40 @@ def test_near_pairs_compiled_is_the_reference(rng: np.random.Generator) -> None:
     want = dedupe._near_pairs(robot, pose, w, keep, reach)
     assert want.shape[0] > 40
     np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize("name", ["ur3", "ur5", "ur10"])
+@pytest.mark.parametrize("a5", [3e-5, -6e-5, 2e-4])
+def test_shoulder_double_root_with_the_wrist_nearly_straight(name: str, a5: float) -> None:
+    """A UR arm at its shoulder singularity (det J = 0 along joint 2) with A5 3e-5 ... 2e-4 from 0 (issue 35, the UR16e
+    of ssik's catalogue): joint 1's two roots meet, the closed form splits them by the rounding of joint 1 (~1e-8),
+    which the wrist magnifies by 1 / sin A5 into two certified solutions up to ~3e-4 either side of the root. They are
+    one solution at the root (IK(FK(q)) holds q to 1e-6, multiplicity 2), not two 1e-4 off it."""
+    from scipy.optimize import brentq
+
+    robot = load_robot(name)
+    rng = np.random.default_rng(int(1e6 * abs(a5)) + len(name))
+    found = 0
+    while found < 3:
+        q = rng.uniform(-2.5, 2.5, 6)
+        q[4] = a5
+        xs = np.linspace(-np.pi, np.pi, 361)
+        Q = np.repeat(q[None], xs.size, axis=0)
+        Q[:, 1] = xs
+        det = np.linalg.det(robot.jacobian(Q))
+        idx = np.flatnonzero(np.sign(det[:-1]) * np.sign(det[1:]) < 0)
+        if idx.size == 0:
+            continue
+
+        def f(x: float, q: np.ndarray = q) -> float:
+            qq = q.copy()
+            qq[1] = x
+            return float(np.linalg.det(robot.jacobian(qq)))
+
+        q[1] = brentq(f, xs[idx[0]], xs[idx[0] + 1], xtol=1e-15)
+        found += 1
+        sols = solve(robot, robot.fk(q), limits=False)
+        d = joint_distance(robot, sols.q, q).max(axis=-1)
+        k = int(np.argmin(d))
+        assert d[k] < 1e-6, (name, q.tolist(), d[k])
+        assert sols.multiplicity[k] >= 2

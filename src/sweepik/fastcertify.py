@@ -20,6 +20,7 @@ from ._jit import alive, inlined, unowned
 from ._wrap import wrap_pi
 from .dedupe import limit_args
 from .fastsweep import AVAILABLE, PARALLEL_MIN, writable
+from .polish import PINV_WIDEN
 from .pose import GIMBAL_TOL
 from .reductions.kernels import address_of, lazy_njit, owned_kernel
 from .units import orientation_weight
@@ -597,23 +598,26 @@ if AVAILABLE:
                 for i in range(n):
                     for r in range(6):
                         J[r, i] = 0.0 if fixed[k, i] else (J[r, i] * weight if r >= 3 else J[r, i])
-                step = np.linalg.pinv(J, rcond) @ e
-                for i in range(n):  # (a held joint's zero column gives a step of rounding size: none at all)
-                    if fixed[k, i]:
-                        step[i] = 0.0
                 improved = False
-                for _ in range(backtrack + 1):
-                    for i in range(n):
-                        trial[i] = q[k, i] + step[i]
-                    new = _geodesic(_poe_fk(H, P, rev, R_end, trial), Td, weight)[0]
-                    if new < cur:  # (False for NaN)
+                for widen in range(len(PINV_WIDEN)):  # (the step with more small directions dropped, if need be)
+                    step = np.linalg.pinv(J, rcond * PINV_WIDEN[widen]) @ e
+                    for i in range(n):  # (a held joint's zero column gives a step of rounding size: none at all)
+                        if fixed[k, i]:
+                            step[i] = 0.0
+                    for _ in range(backtrack + 1):
                         for i in range(n):
-                            q[k, i] = trial[i]
-                        cur = new
-                        improved = True
+                            trial[i] = q[k, i] + step[i]
+                        new = _geodesic(_poe_fk(H, P, rev, R_end, trial), Td, weight)[0]
+                        if new < cur:  # (False for NaN)
+                            for i in range(n):
+                                q[k, i] = trial[i]
+                            cur = new
+                            improved = True
+                            break
+                        for i in range(n):
+                            step[i] *= 0.5
+                    if improved:
                         break
-                    for i in range(n):
-                        step[i] *= 0.5
                 if not improved or cur <= floor:
                     break
             err[k] = cur

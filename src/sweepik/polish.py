@@ -24,6 +24,11 @@ Array = NDArray[np.float64]
 #: Singular values below this fraction of the largest are dropped from the Newton step (pseudo-inverse):
 #: keeps the step bounded at singular configurations, without effect at regular ones.
 PINV_RCOND = 1e-10
+#: A step that no halving makes lower the error is tried again with the singular values below ``PINV_RCOND`` times
+#: these dropped: where the arm loses two ranks (a KR 6 with its wrist centre on axis 1 and its elbow straight, a
+#: member of its joint-1 continuum corrected with joint 1 held) the step along the nearly null directions is all
+#: overshoot, and without them the error went from 2e-4 of the arm's size to 5e-12 (1e-6) and rounding.
+PINV_WIDEN = (1.0, 1e4, 1e7)
 
 
 def _pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:
@@ -77,7 +82,8 @@ def polished(
 ) -> tuple[Array, Array]:
     """Improve configurations ``q (K, n)`` towards poses ``target (K, 4, 4)`` by damped Newton steps on the full
     pose; a step is kept only if the geodesic error (position + ``weight`` x angle) decreases, else it is halved
-    (up to ``BACKTRACK`` times), and a configuration no step improves is left as it is. A configuration stops
+    (up to ``BACKTRACK`` times), then tried with more small singular directions dropped (``PINV_WIDEN``), and a
+    configuration no step improves is left as it is. A configuration stops
     once its error is at most ``floor`` (after one step at least). ``fixed (K, n)``: joints held where True.
     Returns ``(q, geodesic errors (K,))``."""
     if q.shape[0] == 0:
@@ -102,23 +108,26 @@ def polished(
         Js = J * scale[:, None]
         if fixed is not None:
             Js = np.where(fixed[active][:, None, :], 0.0, Js)
-        # pseudo-inverse per candidate: singular Jacobians (rank-deficient arms poses) stay bounded
-        step = np.einsum("kij,kj->ki", np.linalg.pinv(Js, rcond=PINV_RCOND), e)
-        if fixed is not None:  # (a held joint's zero column gives a step of rounding size: none at all)
-            step = np.where(fixed[active], 0.0, step)
         improved = np.zeros(active.size, dtype=bool)
         todo = np.arange(active.size)
-        for _ in range(BACKTRACK + 1):
-            q_new = qa[todo] + step[todo]
-            err_new = geodesic_errors(robot, q_new, ta[todo], weight)
-            better = np.isfinite(err_new) & (err_new < err[active[todo]])
-            rows = active[todo[better]]
-            q[rows], err[rows] = q_new[better], err_new[better]
-            improved[todo[better]] = True
-            todo = todo[~better]
+        for widen in PINV_WIDEN:
+            # pseudo-inverse per candidate: singular Jacobians (rank-deficient arms poses) stay bounded
+            step = np.einsum("kij,kj->ki", np.linalg.pinv(Js, rcond=PINV_RCOND * widen), e)
+            if fixed is not None:  # (a held joint's zero column gives a step of rounding size: none at all)
+                step = np.where(fixed[active], 0.0, step)
+            for _ in range(BACKTRACK + 1):
+                q_new = qa[todo] + step[todo]
+                err_new = geodesic_errors(robot, q_new, ta[todo], weight)
+                better = np.isfinite(err_new) & (err_new < err[active[todo]])
+                rows = active[todo[better]]
+                q[rows], err[rows] = q_new[better], err_new[better]
+                improved[todo[better]] = True
+                todo = todo[~better]
+                if todo.size == 0:
+                    break
+                step[todo] *= 0.5
             if todo.size == 0:
                 break
-            step[todo] *= 0.5
         active = active[improved & (err[active] > floor)]
         if active.size == 0:
             break

@@ -409,7 +409,12 @@ def _solve_chunk_by(
 #: slide) may be one double root that the closed form's rounding split in two: where two branches meet, a step's
 #: cosine sits at +-1 up to rounding magnified by the arm's geometry (1e-12 gives two roots 1.6e-6 rad apart, each
 #: certified, as the pose error grows only quadratically along them). Their midpoint is the root.
-MEET_REL = 1e-4
+MEET_REL = 1e-3
+#: ... but not when the polish of their midpoint moves it by more than this fraction of their distance: it went over
+#: to one of them, and they are two roots (next to a singular set two roots 1e-5 ... 1e-3 apart each solve the pose,
+#: and the polish from between them converges to one). With the wrist nearly singular (UR16e, A5 = 1.7e-4 at a
+#: shoulder double root) the closed form's split pair lies 2.7e-4 apart: the rounding of joint 1 (1e-8) over A5.
+MEET_STAY = 0.1
 
 
 def _meeting_pairs(robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_]) -> NDArray[np.intp]:
@@ -442,11 +447,17 @@ def _merge_meeting(
         d = np.where(robot.is_revolute, np.mod(d + np.pi, 2.0 * np.pi) - np.pi, d)
         target = poses[pose_idx[a]][None]
         # (polished: the pair's other joints carry rounding of their own, which moves the pose linearly)
-        mid, mid_inside = wrap_inside(robot, polish(robot, (w[a] + 0.5 * d)[None], target, weight, SNAP_ITERATIONS))
+        half = (w[a] + 0.5 * d)[None]
+        moved = polish(robot, half, target, weight, SNAP_ITERATIONS)
+        # (the polish may not carry the midpoint over to one of the pair: two distinct roots are not one)
+        step = np.where(robot.is_revolute, np.mod(moved - half + np.pi, 2.0 * np.pi) - np.pi, moved - half)
+        unit = _per_joint(robot, 1.0)
+        stays = np.max(np.abs(step[0]) / unit) <= MEET_STAY * np.max(np.abs(d) / unit)
+        mid, mid_inside = wrap_inside(robot, moved)
         eg, ep = _errors(robot, mid, target, weight)
         # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``)
         best = max(min(err_geo[a], err_geo[b]), POLISH_ABOVE_REL * robot.length_scale)
-        if eg[0] <= best and (mid_inside[0] or not (inside[a] or inside[b])):
+        if stays and eg[0] <= best and (mid_inside[0] or not (inside[a] or inside[b])):
             w[a], err_geo[a], err_paper[a], inside[a] = mid[0], eg[0], ep[0], mid_inside[0]
             mult[a] += mult[b]
             keep[b] = False
