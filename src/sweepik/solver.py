@@ -415,6 +415,13 @@ MEET_REL = 1e-3
 #: and the polish from between them converges to one). With the wrist nearly singular (UR16e, A5 = 1.7e-4 at a
 #: shoulder double root) the closed form's split pair lies 2.7e-4 apart: the rounding of joint 1 (1e-8) over A5.
 MEET_STAY = 0.1
+#: Beyond this (the former ``MEET_REL``), the midpoint must solve the pose no worse than twice the worse of the pair,
+#: not merely below ``POLISH_ABOVE_REL``: a PUMA 560 1e-7 rad off its elbow fold has two roots 3e-4 apart whose polished
+#: midpoint misses the pose by 6e-15 of the arm's size, 60 times more than they do (the UR16e's split root: 1.3e-16).
+MEET_NEAR = 1e-4
+#: ... or than this (relative to the length scale: a few roundings of the forward kinematics; a UR18's split root
+#: 6e-4 apart, each 1e-16, midpoint 2.2e-16).
+MEET_ROUNDING_REL = 1e-15
 
 
 def _meeting_pairs(robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_]) -> NDArray[np.intp]:
@@ -455,8 +462,11 @@ def _merge_meeting(
         stays = np.max(np.abs(step[0]) / unit) <= MEET_STAY * np.max(np.abs(d) / unit)
         mid, mid_inside = wrap_inside(robot, moved)
         eg, ep = _errors(robot, mid, target, weight)
-        # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``)
+        # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``; a pair farther apart than
+        # ``MEET_NEAR``: no worse than twice the worse of them, or than ``MEET_ROUNDING_REL``)
         best = max(min(err_geo[a], err_geo[b]), POLISH_ABOVE_REL * robot.length_scale)
+        if np.max(np.abs(d) / unit) > MEET_NEAR:
+            best = max(2.0 * max(err_geo[a], err_geo[b]), MEET_ROUNDING_REL * robot.length_scale)
         if stays and eg[0] <= best and (mid_inside[0] or not (inside[a] or inside[b])):
             w[a], err_geo[a], err_paper[a], inside[a] = mid[0], eg[0], ep[0], mid_inside[0]
             mult[a] += mult[b]
