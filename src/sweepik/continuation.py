@@ -104,7 +104,7 @@ def _bridged(robot: Robot, world: Array, a: Array, b: Array, joint: int, tol: fl
     as :class:`Traced` does) solves the pose: a step of the trace may not leap over a gap in the solution set (a
     KR 6 pose whose wrist centre sits on axis 1 at full stretch holds stretches of a continuum along joint 1 with
     gaps between them, where the interpolated members missed the pose by 6e-5 of the arm's size)."""
-    mid, err = correct(robot, (0.5 * (a + b))[None], world[None], joint, tol)
+    _, err = correct(robot, (0.5 * (a + b))[None], world[None], joint, tol)
     return bool(err[0] <= tol)
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .continuation import scaled_singular
-from .families import _golden_least
+from .families import golden_least
 from .robot import Robot
 from .solutions import Family
 
@@ -91,7 +91,7 @@ def crossing_seeds(robot: Robot, families: tuple[Family, ...]) -> tuple[Array, I
 
         a, b = grid[np.maximum(dips - 1, 0)], grid[np.minimum(dips + 1, grid.size - 1)]
         slope = 2.0 * rise[dips] / (grid[1] - grid[0])  # (a bound on the V's slope)
-        x, e = _golden_least(excess, a, b, grid[dips], s2[dips] - CROSS_SINGULAR, steps=CROSS_STEPS, slope=slope)
+        x, e = golden_least(excess, a, b, grid[dips], s2[dips] - CROSS_SINGULAR, steps=CROSS_STEPS, slope=slope)
         x = x[e <= 0.0]
         if x.size == 0:
             continue

@@ -278,10 +278,10 @@ def _golden_dips(
     best_e: Array,
 ) -> tuple[Array, Array]:
     """The golden-section steps of ``_limit_dips`` (the NumPy reference; ``fastcertify.dip_search``)."""
-    return _golden_least(lambda x: _limit_excess(robot, red, chain, pose, branch, x), a, b, best_x, best_e)
+    return golden_least(lambda x: _limit_excess(robot, red, chain, pose, branch, x), a, b, best_x, best_e)
 
 
-def _golden_least(
+def golden_least(
     excess: Callable[[Array], Array],
     a: Array,
     b: Array,
@@ -358,7 +358,7 @@ def _limit_peaks(
 
     # the excess changes at most ~PEAK_REACH x its rise per sample step (the brackets are two steps wide)
     slope = PEAK_REACH * rise[k, i, j] / np.maximum(0.5 * (b - a), np.finfo(float).tiny)
-    best_x, best_e = _golden_least(negated, a, b, grid[k, i], -big[k, i, j], _PEAK_STEPS, slope)
+    best_x, best_e = golden_least(negated, a, b, grid[k, i], -big[k, i, j], _PEAK_STEPS, slope)
     found = best_e < 0.0
     rows = k[found]
     width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0

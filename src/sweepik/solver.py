@@ -459,13 +459,14 @@ def _merge_meeting(
         # (the polish may not carry the midpoint over to one of the pair: two distinct roots are not one)
         step = np.where(robot.is_revolute, np.mod(moved - half + np.pi, 2.0 * np.pi) - np.pi, moved - half)
         unit = _per_joint(robot, 1.0)
-        stays = np.max(np.abs(step[0]) / unit) <= MEET_STAY * np.max(np.abs(d) / unit)
+        apart = float(np.max(np.abs(d) / unit))
+        stays = np.max(np.abs(step[0]) / unit) <= MEET_STAY * apart
         mid, mid_inside = wrap_inside(robot, moved)
         eg, ep = _errors(robot, mid, target, weight)
         # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``; a pair farther apart than
         # ``MEET_NEAR``: no worse than twice the worse of them, or than ``MEET_ROUNDING_REL``)
         best = max(min(err_geo[a], err_geo[b]), POLISH_ABOVE_REL * robot.length_scale)
-        if np.max(np.abs(d) / unit) > MEET_NEAR:
+        if apart > MEET_NEAR:
             best = max(2.0 * max(err_geo[a], err_geo[b]), MEET_ROUNDING_REL * robot.length_scale)
         if stays and eg[0] <= best and (mid_inside[0] or not (inside[a] or inside[b])):
             w[a], err_geo[a], err_paper[a], inside[a] = mid[0], eg[0], ep[0], mid_inside[0]
