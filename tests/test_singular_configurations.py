@@ -18,7 +18,7 @@ import sweepik
 from sweepik.pose import pose_error_geodesic
 from sweepik.units import orientation_weight
 
-KNOWN_MISSES = {"i2rt_yam", "fanuc_crx10ia"}
+KNOWN_MISSES = {"i2rt_yam"}
 ARMS = [
     pytest.param(n, marks=pytest.mark.xfail(reason="known misses on its singular set (issue 35)", strict=False))
     if n in KNOWN_MISSES

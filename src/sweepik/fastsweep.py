@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import os
 import weakref
+from collections.abc import Callable
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -602,6 +603,8 @@ if AVAILABLE:
                     else:
                         res_all(p, th[j], f_all[j])
             for bi in range(branches.shape[0]):
+                if c[0] > out_t.shape[1] or fcnt[i] > fam.shape[1]:  # (overflowed: redone by the NumPy engine)
+                    break
                 b = branches[bi]
                 for j in range(M):
                     f[j] = f_all[j, b] if n_all > 0 else res(p, th[j], b)
@@ -642,7 +645,7 @@ if AVAILABLE:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
                           c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, res_all, n_all, edge_f, edge_ok,
                           fm, f_all, branches[bi + 1 :])  # fmt: skip
-                    if top[0] == 0:
+                    if top[0] == 0 or c[0] > out_t.shape[1]:
                         break
                     top[0] -= 1
                     k0 = top[0]
@@ -654,6 +657,8 @@ if AVAILABLE:
                     seq_t, seq_f, ctx, xe = buf_t, buf_f, buf_c, stk_c[k0, 4]
                     level, el, er = stk_i[k0, 0], stk_i[k0, 1] == 1, stk_i[k0, 2] == 1
             cnt[i] = c[0]
+            if c[0] > out_t.shape[1] or fcnt[i] > fam.shape[1]:
+                continue
             n0 = min(c[0], out_t.shape[1])
             w0 = 0
             for k in range(n0):  # (probes[w0]: candidate w0's probes, written whether or not it is kept)
@@ -1216,9 +1221,11 @@ def search(
     params: Array | None = None,
     multiplicity: bool = True,
     one_pass: bool = True,
+    before_redo: Callable[[NDArray[np.intp]], _ref.Spans] | None = None,
 ):
     """Candidates and family spans, as :func:`sweepik.sweep.find_candidates`, computed by the kernel.
-    Poses whose candidate or family buffers overflow are redone by the NumPy engine. ``multiplicity`` False: the
+    Poses whose candidate or family buffers overflow are redone by the NumPy engine; ``before_redo(idx)`` gives the
+    stretches of those poses (``idx``) it leaves out (``find_candidates``' ``masked``). ``multiplicity`` False: the
     candidates' multiplicities are not wanted (each is given as 1; ~4 residuals a candidate less). The candidates
     and spans of the first branch of each class of ``reduction.twins`` are given to the others too
     (``sweep.twin_copies``). A reduction with a hints kernel or an ``EdgeSearch`` finds each pose's samples and
@@ -1319,7 +1326,8 @@ def search(
     redone = bool(over.any())
     if redone:
         idx = np.nonzero(over)[0]
-        c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples)
+        masked = None if before_redo is None else before_redo(idx)
+        c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples, masked)
         if one is not None:  # (the one-pass kernels copied the others' candidates to their twins)
             c2 = _ref.twin_candidates(reduction, c2)
         cand_p.append(idx[c2.pose])

@@ -19,19 +19,28 @@ from . import fastcertify, fastsolve, fastsweep, parallel
 from ._validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
 from .batch import Block, SolutionBatch, no_solution_reason
 from .companion import joined
-from .continuation import continuum_families, correct
+from .continuation import Traced, continuum_families, correct
 from .crossings import crossing_seeds
 from .dedupe import finish, merged_multiplicity, near_pairs, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
-from .families import MAX_ISOLATED_SOLUTIONS, collapse_continua, families_of, off_families, unique_families
+from .families import (
+    MAX_ISOLATED_SOLUTIONS,
+    collapse_continua,
+    families_of,
+    inner_off,
+    off_families,
+    unique_families,
+)
 from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
+from .partners import close_partners
 from .polish import geodesic_errors, polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, automatic_for_held, get_reduction, is_default
 from .reductions.decompose import not_sweepable
 from .reductions.kernels import owned_kernel
 from .robot import Robot
+from .rough_continua import RoughRedo
 from .solutions import Family, Solutions
 from .sweep import N_SAMPLES, Candidates, Spans, find_candidates, twin_copies
 from .units import mm_per_unit, orientation_weight
@@ -243,6 +252,7 @@ def _solve_chunk_by(
     fams: dict[int, list[Family]] = {}  # (poses with self-motion families: few)
     compiled = red.uses_kernel and fastsweep.AVAILABLE
     err_geo = err_paper = None
+    redo: RoughRedo | None = None
     if strategy == "precise" or closed:
         if closed:  # no sweep: every branch of the closed form is a candidate
             params = red.kernel_params(chain) if compiled else None
@@ -258,7 +268,22 @@ def _solve_chunk_by(
                 q = q[:, 0]
         elif compiled:
             params = red.kernel_params(chain)
-            cand, spans = fastsweep.search(red, chain, lo, hi, n_samples, params)  # (twins' copies included)
+            if strategy == "precise":
+                scale = robot.length_scale
+                redo = RoughRedo(
+                    robot,
+                    red,
+                    chain,
+                    poses,
+                    lo,
+                    hi,
+                    n_samples,
+                    limits,
+                    POLISH_BELOW_REL * scale,
+                    ACCEPT_TOL_REL * scale,
+                )
+            # (twins' copies included)
+            cand, spans = fastsweep.search(red, chain, lo, hi, n_samples, params, before_redo=redo)
             cand = _limit_copies(robot, red, cand, hi - lo)
             q, err_geo, err_paper = fastcertify.certify(
                 robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
@@ -297,6 +322,10 @@ def _solve_chunk_by(
             n, seed_tol = cand.pose.size, SEED_TOL_REL * robot.length_scale
             e = None if err_geo is None else err_geo[:n]
             free = red.continuum_joints(chain, cand.pose, cand.theta, cand.branch, e, seed_tol)
+        if redo is not None and redo.families:
+            for i, f in redo.families.items():
+                fams.setdefault(i, []).extend(f)
+            members.append((redo.pose, redo.q))
         if free is not None:
             seeds = np.nonzero(free >= 0)[0]
             seed_p, seed_q, free = cand.pose[seeds], q[seeds], free[seeds]
@@ -579,29 +608,61 @@ def _trace_cut_continua(
     continuum comes out as short pieces and isolated members. From those (each isolated solution, the middle of each
     piece) it is traced along the sweep's joint (:mod:`.continuation`: exact members, and only from a configuration
     where the arm is singular); the continua found go to ``fams``, and the fallback's families they cover are
-    dropped from ``fallback``."""
+    dropped from ``fallback``. The fallback's families traced already (:mod:`.rough_continua`) are whole: the
+    isolated solutions on them are no seeds, and a continuum traced again along one of them is not added."""
     pose = [idx[np.repeat(np.arange(idx.size), np.diff(alt.bounds))]]
     seeds = [alt.q]
+    whole: dict[int, tuple[Family, ...]] = {}  # (the fallback's traced families, per pose of the chunk)
     for k, pieces in alt.families.items():  # (few poses)
-        cut = [f for f in pieces if _cut_short(robot, f, poses[idx[k]], limits)]
+        whole[int(idx[k])] = tuple(f for f in pieces if isinstance(f.reduction, Traced))
+        cut = [f for f in pieces if not isinstance(f.reduction, Traced) and _cut_short(robot, f, poses[idx[k]], limits)]
         if cut:
             pose.append(np.full(len(cut), idx[k], dtype=np.intp))
             seeds.append(np.array([f.at(0.5 * (f.interval[0] + f.interval[1])) for f in cut]))
     p, q = np.concatenate(pose), np.concatenate(seeds)
-    if p.size == 0:
-        return
-    joint = np.full(p.size, get_reduction(robot, red.fallback).free_joint, dtype=np.intp)
-    tol = ACCEPT_TOL_REL * robot.length_scale
-    # (the continua's pieces that shrink to a point at a limit are left out: the fallback has them as solutions)
-    traced, _, _ = continuum_families(robot, chain, poses, p, q, joint, limits, tol)
-    for i, found in traced.items():
-        fams.setdefault(i, []).extend(found)
+    if whole and p.size:
+        off = np.ones(p.size, dtype=bool)
+        for i, known in whole.items():
+            rows = np.nonzero(p == i)[0]
+            off[rows] = off_families(robot, [(q[rows], known)])[0]
+        p, q = p[off], q[off]
+    traced: dict[int, list[Family]] = {}
+    if p.size:
+        joint = np.full(p.size, get_reduction(robot, red.fallback).free_joint, dtype=np.intp)
+        tol = ACCEPT_TOL_REL * robot.length_scale
+        # (the continua's pieces that shrink to a point at a limit are left out: the fallback has them as solutions)
+        traced, _, _ = continuum_families(robot, chain, poses, p, q, joint, limits, tol)
+    for i in sorted(set(traced) | set(whole)):
+        found, known = traced.get(i, []), whole.get(i, ())
         sol = fallback[i]
-        if sol.families:  # the pieces: covered when their ends and middle are members of a traced continuum
-            ends = [f.at(np.linspace(f.interval[0], f.interval[1], 3)) for f in sol.families]
-            off = off_families(robot, [(m, tuple(found)) for m in ends])
-            kept = tuple(f for f, o in zip(sol.families, off, strict=True) if o.any())
-            fallback[i] = dataclasses.replace(sol, families=kept)
+        if found and known:  # a traced family's continuum again (from an isolated solution on it): not added ...
+            new = inner_off(robot, found, known)
+            again = tuple(f for f, o in zip(found, new, strict=True) if not o)
+            found = [f for f, o in zip(found, new, strict=True) if o]
+            if again and len(sol):  # ... and its seeds are members of it (at a fold, or where it meets itself)
+                sol = _rows(sol, off_families(robot, [(sol.q, again)])[0])
+        if found:
+            fams.setdefault(i, []).extend(found)
+        swept = [f for f in sol.families if not isinstance(f.reduction, Traced)]
+        if swept and (found or known):  # the pieces: covered when their ends and middle are members of a continuum
+            ends = [f.at(np.linspace(f.interval[0], f.interval[1], 3)) for f in swept]
+            uncovered = off_families(robot, [(m, tuple(found) + known) for m in ends])
+            sol = dataclasses.replace(
+                sol, families=known + tuple(f for f, o in zip(swept, uncovered, strict=True) if o.any())
+            )
+        fallback[i] = sol
+
+
+def _rows(sol: Solutions, keep: NDArray[np.bool_]) -> Solutions:
+    """``sol`` with the solutions ``keep`` only."""
+    return dataclasses.replace(
+        sol,
+        q=sol.q[keep],
+        error=sol.error[keep],
+        error_geodesic=sol.error_geodesic[keep],
+        within_limits=sol.within_limits[keep],
+        multiplicity=sol.multiplicity[keep],
+    )
 
 
 def _add_crossing_families(
@@ -638,9 +699,7 @@ def _add_crossing_families(
         return
     traced, _, _ = continuum_families(robot, chain, poses, p[new], q[new], j[new], limits, tol)
     for i, found in traced.items():
-        members = [f.at(np.linspace(f.interval[0], f.interval[1], 3)) for f in found]
-        off = off_families(robot, [(m, known[i]) for m in members])
-        fams.setdefault(i, []).extend(f for f, o in zip(found, off, strict=True) if o.any())
+        fams.setdefault(i, []).extend(f for f, o in zip(found, inner_off(robot, found, known[i]), strict=True) if o)
 
 
 def _with_families(
@@ -735,6 +794,18 @@ def _settle_stepwise(
             drift = (err_geo[near] <= accept) & robot.within_limits(q[near]) & ~robot.within_limits(polished)
             take = np.nonzero(~drift)[0]
             q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
+            # a polished solution next to a fold: its partner on the far side (:mod:`.partners`)
+            polished_ok = near[take][eg[take] <= accept]
+            row, q_p, _ = close_partners(robot, q[polished_ok], poses[pose_idx[polished_ok]], accept)
+            if row.size:  # (each after the solution it was found from: a pose's rows stay together)
+                src = polished_ok[row]
+                eg_p, ep_p = _errors(robot, q_p, poses[pose_idx[src]], weight)
+                order = np.argsort(np.concatenate([np.arange(pose_idx.size), src]), kind="stable")
+                pose_idx = np.concatenate([pose_idx, pose_idx[src]])[order]
+                q = np.concatenate([q, q_p])[order]
+                mult = np.concatenate([mult, np.ones(src.size, dtype=mult.dtype)])[order]
+                err_geo = np.concatenate([err_geo, eg_p])[order]
+                err_paper = np.concatenate([err_paper, ep_p])[order]
     if strategy == "precise":
         certified = err_geo <= accept
     else:

@@ -712,8 +712,11 @@ def find_candidates(
     lo: Array,
     hi: Array,
     n_samples: int = N_SAMPLES,
+    masked: Spans | None = None,
 ) -> tuple[Candidates, Spans]:
-    """Candidates for all N chain poses ``(N, 4, 4)`` with theta* ranges ``lo, hi (N,)``."""
+    """Candidates for all N chain poses ``(N, 4, 4)`` with theta* ranges ``lo, hi (N,)``. ``masked``: stretches of
+    theta* (pose, branch, ends) whose samples are left out of the search, as a family's are (a continuum traced
+    already: :mod:`sweepik.rough_continua`)."""
     theta = sample_grid(reduction, poses, lo, hi, n_samples)
     f = reduction.residual(poses, theta)
     if f is None:
@@ -725,6 +728,9 @@ def find_candidates(
     if skip:  # e.g. the other branches of a class of twins, which get their roots from its first (solver)
         valid[:, :, skip] = False
     spans, in_family = _families(reduction, poses, theta, f, valid, hi - lo)
+    if masked is not None:
+        for p, b, a, c in zip(masked.pose, masked.branch, masked.lo, masked.hi, strict=True):
+            in_family[p, (theta[p] >= a) & (theta[p] <= c), b] = True
     valid &= ~in_family
     search = _Search(reduction, poses, hi - lo)
     p = np.repeat(np.arange(N), B)

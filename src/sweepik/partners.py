@@ -1,0 +1,74 @@
+"""A close partner of a solution next to a fold of the solution set (issue 35, point 3: close roots).
+
+A pose just inside a singular set's image has two solutions 1e-6 ... 1e-3 apart on either side of the fold, both
+solving the pose to rounding. A sweep sees them as two roots a hair apart, often next to a branch-domain edge (a
+FANUC CRX-10iA pose: 1.5e-8 rad apart in theta*, 6e-8 from the edge); a closed form sees them as one branch's value
+split by rounding. Where only one of them came out (the Newton polish of a candidate between them converges to one),
+the other lies on the far side of the fold, along the Jacobian's nearly null direction: Newton from points along it
+converges to it.
+
+Only solutions that needed the polish are probed (a candidate the closed form or the sweep gave to rounding already
+is well conditioned, or was found with its partner), and only where the Jacobian is nearly singular
+(``PARTNER_SINGULAR``).
+A point found counts as a second solution when Newton from the midpoint between the two goes over to one of
+them (``PARTNER_STAY``): along a continuum, or a numerical one (a pose a hair off a self-motion), it stays where it
+is, and Newton from anywhere next to it lands on it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .continuation import scaled_singular
+from .polish import polished
+from .reductions.base import Array, IntArray
+from .robot import Robot
+from .solutions import joint_distance
+from .units import orientation_weight
+
+#: A solution is probed when its Jacobian's smallest singular value is at most this fraction of its largest (lengths
+#: over the arm's size): two roots d apart across a fold have a smallest singular value of order d (1e-3: roots up to
+#: ~1e-3 rad apart).
+PARTNER_SINGULAR = 1e-3
+#: Distances along the nearly null direction (radians, or length over the arm's size) Newton starts from, each way.
+PARTNER_STEPS = (1e-6, 1e-5, 1e-4, 1e-3, 1e-2)
+#: Newton steps from each start.
+PARTNER_NEWTON = 30
+#: A point found is the solution itself when every joint lies within this of it (radians; relative for a slide).
+PARTNER_SAME = 1e-9
+#: ... and a second solution only when Newton from the midpoint between them moves by more than this fraction of
+#: their distance (it goes over to one of them), or does not reach the pose: as ``solver.MEET_STAY`` tells a closed
+#: form's two close roots from one split by rounding.
+PARTNER_STAY = 0.1
+
+
+def close_partners(robot: Robot, q: Array, world: Array, tol: float) -> tuple[IntArray, Array, Array]:
+    """Second solutions next to the certified solutions ``q (K, n)`` of poses ``world (K, 4, 4)`` across a fold:
+    ``(row, q, error)``, ``row`` the solution each was found from (several may give the same one; none for most)."""
+    n = robot.n_joints
+    none = (np.zeros(0, dtype=np.intp), np.zeros((0, n)), np.zeros(0))
+    if q.shape[0] == 0:
+        return none
+    s, vt = scaled_singular(robot, q)
+    rows = np.nonzero(s[:, -1] <= PARTNER_SINGULAR * s[:, 0])[0]
+    if rows.size == 0:
+        return none
+    steps = np.array(PARTNER_STEPS)
+    signed = np.concatenate([steps, -steps])
+    v = vt[rows, -1, :n] * np.where(robot.is_revolute, 1.0, robot.length_scale)  # (back to joint units)
+    start = q[rows][:, None, :] + signed[None, :, None] * v[:, None, :]
+    k = np.repeat(rows, signed.size)
+    target = world[k]
+    weight = orientation_weight(robot.length_unit)
+    found, err = polished(robot, start.reshape(-1, n), target, weight, iterations=PARTNER_NEWTON, floor=1e-3 * tol)
+    d = joint_distance(robot, found, q[k])
+    same = np.all(d <= PARTNER_SAME * np.where(robot.is_revolute, 1.0, robot.length_scale), axis=-1)
+    ok = np.nonzero((err <= tol) & ~same)[0]
+    if ok.size == 0:
+        return none
+    # two roots: Newton from their midpoint goes over to one of them (or nowhere); along a continuum it stays
+    mid = 0.5 * (q[k[ok]] + found[ok])  # (Newton's steps from next to q: unwrapped, close to it)
+    m, m_err = polished(robot, mid, target[ok], weight, iterations=PARTNER_NEWTON, floor=1e-3 * tol)
+    moved = np.linalg.norm(m - mid, axis=-1) / np.linalg.norm(found[ok] - q[k[ok]], axis=-1)
+    ok = ok[(m_err > tol) | (moved > PARTNER_STAY)]
+    return k[ok].astype(np.intp), found[ok], err[ok]

@@ -1,0 +1,77 @@
+"""Continua that the swept closed form reproduces only roughly (issue 35, point 4: a UR5 with its wrist straight, 3-20 s
+a pose): the sweep along joint 4 sits at a branch-domain edge along the whole continuum, its residual carries the
+square root of rounding and crosses zero hundreds of times. ``sweepik.rough_continua`` recognises such stretches from
+the samples, traces the continuum and masks them from the search; a pose a hair off the continuum must keep its
+isolated solutions (nothing masked)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from singular import recovered
+
+import sweepik
+from sweepik.families import inner_off
+from sweepik.pose import pose_error_geodesic
+from sweepik.reductions import get_reduction
+from sweepik.rough_continua import rough_continua
+from sweepik.solver import ACCEPT_TOL_REL, POLISH_BELOW_REL, _chain_poses, _theta_range
+from sweepik.units import orientation_weight
+
+#: The issue's two UR5 configurations (the second in the limits, solved with them on)
+ISSUE = [
+    [0.86056, 5.46006, -2.88415, -3.03775, np.pi, 2.59342],
+    [2.2042858345559706, -0.9782962654771837, -0.9648341437830452, -2.7538323619714946, np.pi, -2.660267771237715],
+]
+
+
+def _certified(robot: sweepik.Robot, s: sweepik.Solutions, T: np.ndarray) -> None:
+    w = orientation_weight(robot.length_unit)
+    for f in s.families:
+        m = f.at(np.linspace(f.interval[0], f.interval[1], 9))
+        err = pose_error_geodesic(robot.fk(m), np.broadcast_to(T, (len(m), 4, 4)), w)
+        assert np.all(err <= 1e-9 * robot.length_scale), f
+    for i, f in enumerate(s.families):  # no family lies on another
+        others = tuple(g for j, g in enumerate(s.families) if j != i)
+        assert inner_off(robot, [f], others)[0], f
+
+
+@pytest.mark.parametrize("which", [0, 1])
+def test_the_wrist_straight_continuum_of_the_issue_comes_back_whole(which: int) -> None:
+    """Joints 1 and 6 do not change the planar loop of joints 2, 3, 4 and 6: every choice of them keeps the pose on
+    the rough continuum."""
+    robot = sweepik.load_robot("ur5")
+    rng = np.random.default_rng(35 + which)
+    for _ in range(3):
+        q = np.array(ISSUE[which])
+        q[[0, 5]] = rng.uniform(-np.pi, np.pi, 2)
+        T = robot.fk(q)
+        s = sweepik.solve(robot, T, limits=bool(which))
+        assert s.families and recovered(robot, s, q), q.tolist()
+        assert len(s) <= 8, "the continuum came back in pieces"
+        _certified(robot, s, T)
+
+
+@pytest.mark.parametrize("off", [0.0, 1e-11, 1e-7, 1e-5])
+def test_only_a_continuum_is_masked(off: float) -> None:
+    """On the continuum (and within rounding of it) its stretches are traced and masked; 1e-7 and more off it, where
+    the pose's solutions are isolated, nothing is masked, and the solve still finds the configuration."""
+    robot = sweepik.load_robot("ur5")
+    red = get_reduction(robot, get_reduction(robot, None).fallback)
+    q = np.array(ISSUE[0])
+    q[4] -= off
+    T = robot.fk(q)[None]
+    chain = _chain_poses(robot, T)
+    lo, hi = _theta_range(robot, red, chain)
+    scale = robot.length_scale
+    fams, _, _, masked = rough_continua(
+        robot, red, chain, T, lo, hi, 64, False, POLISH_BELOW_REL * scale, ACCEPT_TOL_REL * scale
+    )
+    if off < 1e-9:
+        assert fams.get(0) and len(masked)
+        for a, c in zip(masked.lo, masked.hi, strict=True):  # a masked stretch lies in a traced family's interval
+            assert any(f.interval[0] - 1e-9 <= a and c <= f.interval[1] + 1e-9 for f in fams[0]), (a, c)
+    else:
+        assert not fams and not len(masked)
+    s = sweepik.solve(robot, T[0], limits=False)
+    assert recovered(robot, s, q)
