@@ -84,3 +84,16 @@ def _geodesic(robot: Any, Q: np.ndarray, T: np.ndarray) -> np.ndarray:
 
     F = robot.fk(Q)
     return pose_error_geodesic(F, np.broadcast_to(T, F.shape), orientation_weight(robot.length_unit))
+
+
+def families_certified(robot: Any, sols: Any, T: np.ndarray, members: int = 9) -> None:
+    """Every family of ``sols`` (a ``sweepik.Solutions`` of pose ``T``) has its members (``members`` along each)
+    solve the pose to 1e-9 of the arm's size, and none lies on the others (``families.inner_off``)."""
+    from sweepik.families import inner_off
+
+    for f in sols.families:
+        m = f.at(np.linspace(f.interval[0], f.interval[1], members))
+        assert np.all(_geodesic(robot, m, T) <= 1e-9 * robot.length_scale), f
+    for i, f in enumerate(sols.families):
+        others = tuple(g for j, g in enumerate(sols.families) if j != i)
+        assert inner_off(robot, [f], others)[0], ("a family lies on the others", f)

@@ -8,32 +8,18 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from singular import recovered
+from singular import families_certified, recovered
 
 import sweepik
-from sweepik.families import inner_off
-from sweepik.pose import pose_error_geodesic
 from sweepik.reductions import get_reduction
 from sweepik.rough_continua import rough_continua
 from sweepik.solver import ACCEPT_TOL_REL, POLISH_BELOW_REL, _chain_poses, _theta_range
-from sweepik.units import orientation_weight
 
 #: The issue's two UR5 configurations (the second in the limits, solved with them on)
 ISSUE = [
     [0.86056, 5.46006, -2.88415, -3.03775, np.pi, 2.59342],
     [2.2042858345559706, -0.9782962654771837, -0.9648341437830452, -2.7538323619714946, np.pi, -2.660267771237715],
 ]
-
-
-def _certified(robot: sweepik.Robot, s: sweepik.Solutions, T: np.ndarray) -> None:
-    w = orientation_weight(robot.length_unit)
-    for f in s.families:
-        m = f.at(np.linspace(f.interval[0], f.interval[1], 9))
-        err = pose_error_geodesic(robot.fk(m), np.broadcast_to(T, (len(m), 4, 4)), w)
-        assert np.all(err <= 1e-9 * robot.length_scale), f
-    for i, f in enumerate(s.families):  # no family lies on another
-        others = tuple(g for j, g in enumerate(s.families) if j != i)
-        assert inner_off(robot, [f], others)[0], f
 
 
 @pytest.mark.parametrize("which", [0, 1])
@@ -49,7 +35,7 @@ def test_the_wrist_straight_continuum_of_the_issue_comes_back_whole(which: int) 
         s = sweepik.solve(robot, T, limits=bool(which))
         assert s.families and recovered(robot, s, q), q.tolist()
         assert len(s) <= 8, "the continuum came back in pieces"
-        _certified(robot, s, T)
+        families_certified(robot, s, T)
 
 
 @pytest.mark.parametrize("off", [0.0, 1e-11, 1e-7, 1e-5])

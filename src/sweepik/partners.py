@@ -10,9 +10,11 @@ converges to it.
 Only solutions that needed the polish are probed (a candidate the closed form or the sweep gave to rounding already
 is well conditioned, or was found with its partner), and only where the Jacobian is nearly singular
 (``PARTNER_SINGULAR``).
-A point found counts as a second solution when Newton from the midpoint between the two goes over to one of
-them (``PARTNER_STAY``): along a continuum, or a numerical one (a pose a hair off a self-motion), it stays where it
-is, and Newton from anywhere next to it lands on it.
+A point found counts as a second solution when the midpoint between the two misses the pose (``PARTNER_MIDPOINT``)
+and Newton from it goes over to one of them (``PARTNER_STAY``): along a continuum, or a numerical one (a pose a hair
+off a self-motion), it stays where it is; between two roots whose pose error stays below the certification's
+tolerance all the way, Newton ends anywhere between them (those two come from the closed form or the sweep as they
+are: ``solver.MEET_NEAR``).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .continuation import scaled_singular
-from .polish import polished
+from .polish import geodesic_errors, polished
 from .reductions.base import Array, IntArray
 from .robot import Robot
 from .solutions import joint_distance
@@ -34,11 +36,18 @@ PARTNER_SINGULAR = 1e-3
 PARTNER_STEPS = (1e-6, 1e-5, 1e-4, 1e-3, 1e-2)
 #: Newton steps from each start.
 PARTNER_NEWTON = 30
+#: A point found must solve the pose to the rounding of forward kinematics (this times the arm's size, as
+#: ``solver.MEET_ROUNDING_REL``), not merely within the certification's tolerance: between two roots 3e-4 apart next
+#: to a PUMA 560's elbow fold the pose error stays below 3 % of that tolerance along a curved valley, and Newton ends
+#: anywhere in it (6e-15 of the size); the CRX-10iA's partner: 2e-16.
+PARTNER_ROUNDING = 1e-15
 #: A point found is the solution itself when every joint lies within this of it (radians; relative for a slide).
 PARTNER_SAME = 1e-9
-#: ... and a second solution only when Newton from the midpoint between them moves by more than this fraction of
-#: their distance (it goes over to one of them), or does not reach the pose: as ``solver.MEET_STAY`` tells a closed
-#: form's two close roots from one split by rounding.
+#: ... and a second solution only when the midpoint between them misses the pose by more than this times the
+#: certification's tolerance (the CRX-10iA pair: 50 times) ...
+PARTNER_MIDPOINT = 4.0
+#: ... and Newton from that midpoint ends within this fraction of their distance of one of them (it goes over to it),
+#: or does not reach the pose.
 PARTNER_STAY = 0.1
 
 
@@ -63,12 +72,17 @@ def close_partners(robot: Robot, q: Array, world: Array, tol: float) -> tuple[In
     found, err = polished(robot, start.reshape(-1, n), target, weight, iterations=PARTNER_NEWTON, floor=1e-3 * tol)
     d = joint_distance(robot, found, q[k])
     same = np.all(d <= PARTNER_SAME * np.where(robot.is_revolute, 1.0, robot.length_scale), axis=-1)
-    ok = np.nonzero((err <= tol) & ~same)[0]
+    ok = np.nonzero((err <= PARTNER_ROUNDING * robot.length_scale) & ~same)[0]
     if ok.size == 0:
         return none
-    # two roots: Newton from their midpoint goes over to one of them (or nowhere); along a continuum it stays
+    # two roots: their midpoint misses the pose, and Newton from it goes over to one of them (or nowhere); along a
+    # continuum it stays, and between two roots that close that the pose error stays below the tolerance between
+    # them (a PUMA 560 1e-7 rad short of its elbow fold) Newton's end point is anywhere in the flat valley
     mid = 0.5 * (q[k[ok]] + found[ok])  # (Newton's steps from next to q: unwrapped, close to it)
+    barrier = geodesic_errors(robot, mid, target[ok], weight) > PARTNER_MIDPOINT * tol
+    ok, mid = ok[barrier], mid[barrier]
     m, m_err = polished(robot, mid, target[ok], weight, iterations=PARTNER_NEWTON, floor=1e-3 * tol)
-    moved = np.linalg.norm(m - mid, axis=-1) / np.linalg.norm(found[ok] - q[k[ok]], axis=-1)
-    ok = ok[(m_err > tol) | (moved > PARTNER_STAY)]
+    d = np.linalg.norm(found[ok] - q[k[ok]], axis=-1)
+    near = np.minimum(np.linalg.norm(m - q[k[ok]], axis=-1), np.linalg.norm(m - found[ok], axis=-1))
+    ok = ok[(m_err > tol) | (near <= PARTNER_STAY * d)]
     return k[ok].astype(np.intp), found[ok], err[ok]

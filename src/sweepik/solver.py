@@ -21,7 +21,7 @@ from .batch import Block, SolutionBatch, no_solution_reason
 from .companion import joined
 from .continuation import Traced, continuum_families, correct
 from .crossings import crossing_seeds
-from .dedupe import finish, merged_multiplicity, near_pairs, settle, wrap_inside
+from .dedupe import DEDUPE_ANGLE, DEDUPE_LENGTH_REL, finish, merged_multiplicity, near_pairs, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from .families import (
     MAX_ISOLATED_SOLUTIONS,
@@ -41,7 +41,7 @@ from .reductions.decompose import not_sweepable
 from .reductions.kernels import owned_kernel
 from .robot import Robot
 from .rough_continua import RoughRedo
-from .solutions import Family, Solutions
+from .solutions import Family, Solutions, joint_distance
 from .sweep import N_SAMPLES, Candidates, Spans, find_candidates, twin_copies
 from .units import mm_per_unit, orientation_weight
 
@@ -383,17 +383,15 @@ def _solve_chunk_by(
         mult = mult[keep]
     fallback: dict[int, Solutions] = {}
     if strategy == "precise" and use_fallback and red.fallback is not None:
-        deg = red.degenerate(chain)
-        if deg is not None and deg.any():
+        for by, deg in red.degenerate_fallbacks(chain):
             idx = np.nonzero(deg)[0]
-            alt = _solve_chunk(
-                robot, get_reduction(robot, red.fallback), poses[idx], strategy, limits, n_samples, False
-            )
+            alt_red = get_reduction(robot, by)
+            alt = _solve_chunk(robot, alt_red, poses[idx], strategy, limits, n_samples, False)
             if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
-                fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx)}
-                _trace_cut_continua(robot, red, chain, poses, idx, alt, limits, fams, fallback)
+                fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx)})
+                _trace_cut_continua(robot, alt_red, chain, poses, idx, alt, limits, fams, fallback)
             else:  # the reduction's blind spot: the fallback's families
-                fallback = {int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)}
+                fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)})
     # poses with families (few): their isolated solutions lying on a family are reported by the family; the
     # reduction's blind spot: the fallback reduction's families are added, and its isolated solutions when this
     # reduction has none (a closed form: always)
@@ -594,7 +592,7 @@ def _cut_short(robot: Robot, family: Family, target: Array, limits: bool) -> boo
 
 def _trace_cut_continua(
     robot: Robot,
-    red: Reduction,
+    sweep: Reduction,
     chain: Array,
     poses: Array,
     idx: NDArray[np.intp],
@@ -603,7 +601,7 @@ def _trace_cut_continua(
     fams: dict[int, list[Family]],
     fallback: dict[int, Solutions],
 ) -> None:
-    """A closed form's degenerate poses ``idx``, answered by its fallback sweep (``alt``): where the sweep's closed
+    """A closed form's degenerate poses ``idx``, answered by its fallback ``sweep`` (``alt``): where the sweep's closed
     form loses digits along a continuum (the C-Arm with joints 5 and 6 swapped, its elbow nearly straight), the
     continuum comes out as short pieces and isolated members. From those (each isolated solution, the middle of each
     piece) it is traced along the sweep's joint (:mod:`.continuation`: exact members, and only from a configuration
@@ -628,7 +626,7 @@ def _trace_cut_continua(
         p, q = p[off], q[off]
     traced: dict[int, list[Family]] = {}
     if p.size:
-        joint = np.full(p.size, get_reduction(robot, red.fallback).free_joint, dtype=np.intp)
+        joint = np.full(p.size, sweep.free_joint, dtype=np.intp)
         tol = ACCEPT_TOL_REL * robot.length_scale
         # (the continua's pieces that shrink to a point at a limit are left out: the fallback has them as solutions)
         traced, _, _ = continuum_families(robot, chain, poses, p, q, joint, limits, tol)
@@ -651,6 +649,20 @@ def _trace_cut_continua(
                 sol, families=known + tuple(f for f, o in zip(swept, uncovered, strict=True) if o.any())
             )
         fallback[i] = sol
+
+
+def _new_rows(
+    robot: Robot, pose_idx: NDArray[np.intp], q: Array, src: NDArray[np.intp], q_new: Array
+) -> NDArray[np.bool_]:
+    """``(K,)``: the configurations ``q_new (K, n)`` of the poses of rows ``src`` that are neither one of their pose's
+    rows of ``q`` nor an earlier one of ``q_new`` (within the duplicate tolerance, ``dedupe.DEDUPE_ANGLE``)."""
+    tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
+    out = np.zeros(src.size, dtype=bool)
+    for k in range(src.size):
+        mine = pose_idx == pose_idx[src[k]]
+        known = np.concatenate([q[mine], q_new[:k][out[:k] & (pose_idx[src[:k]] == pose_idx[src[k]])]])
+        out[k] = not np.any(np.all(joint_distance(robot, known, q_new[k]) <= tol, axis=-1))
+    return out
 
 
 def _rows(sol: Solutions, keep: NDArray[np.bool_]) -> Solutions:
@@ -797,6 +809,9 @@ def _settle_stepwise(
             # a polished solution next to a fold: its partner on the far side (:mod:`.partners`)
             polished_ok = near[take][eg[take] <= accept]
             row, q_p, _ = close_partners(robot, q[polished_ok], poses[pose_idx[polished_ok]], accept)
+            if row.size:  # (each once, and none its pose has already: found again, it would add to a multiplicity)
+                new = _new_rows(robot, pose_idx, q, polished_ok[row], q_p)
+                row, q_p = row[new], q_p[new]
             if row.size:  # (each after the solution it was found from: a pose's rows stay together)
                 src = polished_ok[row]
                 eg_p, ep_p = _errors(robot, q_p, poses[pose_idx[src]], weight)

@@ -163,6 +163,14 @@ class Reduction(ABC):
         """``(N,)`` True where this reduction cannot describe the pose's solutions (``fallback`` solves them)."""
         return None
 
+    def degenerate_fallbacks(self, poses: Array) -> list[tuple[str | Reduction, NDArray[np.bool_]]]:
+        """The poses ``degenerate`` gives, split by the reduction that solves them: ``[(fallback, mask (N,))]``
+        (``fallback`` for all of them, unless a reduction's blind spots differ in kind)."""
+        deg = self.degenerate(poses)
+        if self.fallback is None or deg is None or not deg.any():
+            return []
+        return [(self.fallback, deg)]
+
     def continuum_joints(
         self, poses: Array, pose: IntArray, theta: Array, branch: IntArray, error: Array | None = None, tol: float = 0.0
     ) -> IntArray | None:

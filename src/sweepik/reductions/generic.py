@@ -309,9 +309,42 @@ class GeometricReduction(Reduction):
                     return GeometricReduction(self.robot, p)
         return None
 
+    @cached_property
+    def _shoulder_continua(self) -> GeometricReduction | None:
+        """For the parallel family: a pair plan sweeping joint 6, then 1 (each turns whole turns along the continuum
+        where joint 6's point lies on joint 1's axis, ``geometric.parallel_shoulder``; joint 4 barely moves along it,
+        and a sweep of joint 4 places that point with joint 1, which it leaves free). None without one."""
+        if not self.plan.closed_form or self.plan.family != "parallel":
+            return None
+        from .decompose import plans  # local: decompose imports this module
+
+        pairs = [p for p in plans(self.robot) if p.family == "pair" and not p.conditional]
+        for j in (5, 0):
+            for p in pairs:
+                if p.free_joint == self.plan.joint(j):
+                    return GeometricReduction(self.robot, p)
+        return None
+
     @property
     def fallback(self) -> Reduction | None:  # type: ignore[override]
         return self._continua
+
+    def degenerate_fallbacks(self, poses: Array) -> list[tuple[str | Reduction, NDArray[np.bool_]]]:
+        """The parallel family's degenerate poses whose joint 1 turns freely go to ``_shoulder_continua``, the others
+        (and every family's) to ``fallback``."""
+        out = super().degenerate_fallbacks(poses)
+        shoulder = self._shoulder_continua
+        if not out or shoulder is None:
+            return out
+        from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
+
+        by, deg = out[0]
+        free = np.zeros(poses.shape[0], dtype=np.bool_)
+        parallel.run(geometric.parallel_shoulder, poses.shape[0], 2 * PARALLEL_MIN, self.kernel_params(poses), free)
+        free &= deg
+        if not free.any():
+            return out
+        return [(by, deg & ~free), (shoulder, free)] if (deg & ~free).any() else [(shoulder, free)]
 
     def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
         """Closed form: poses where a branch's wrist is singular or nearly so (``geometric.WRIST_SINGULAR``): the

@@ -657,14 +657,38 @@ def pose_rows(poses, base, tool, reverse, r_end, w_tool, row, out):
 WRIST_SINGULAR = 1e-6
 
 
+@inlined
+def _shoulder_flat(p):
+    """The parallel family (joint 1 revolute): joint 6's point ``W`` lies on joint 1's axis, within ``WRIST_SINGULAR``
+    of its distance from joint 1's point (``parallel_singular``)."""
+    if p[_REV] < 0.5:
+        return False
+    v = sub(_v(p, _T), _v(p, _P))
+    return norm(cross(_h(p, 0), v)) <= WRIST_SINGULAR * norm(v)
+
+
+@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
+def parallel_shoulder(params, out, start, stop):
+    """``out[i]`` for poses ``start .. stop - 1``: the poses of ``parallel_singular`` whose joint 1 turns freely
+    (``_shoulder_flat``; the others' continua turn joints 2-4 and 6)."""
+    for i in range(start, stop):
+        out[i] = _shoulder_flat(params[i])
+
+
 @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
 def parallel_singular(params, out, start, stop):
     """``out[i]`` for poses ``start .. stop - 1``: some exact branch of joint 1 leaves pose i with joint 6's axis
-    along the parallel axes (joint 6 and the sum of joints 2-4 then turn about one direction: a continuum)."""
+    along the parallel axes (joint 6 and the sum of joints 2-4 then turn about one direction: a continuum), or
+    joint 6's point ``W`` lies on joint 1's axis (within ``WRIST_SINGULAR`` of its distance from joint 1's point):
+    joint 1's ``sp4`` on the height of ``W`` no longer involves joint 1. Reachable only where that height is 0 (axes
+    1 and 2 meet: a Unitree Z1), and there joint 1 turns freely, the others following: a continuum."""
     h, h5 = _h(params[0], 1), _h(params[0], 5)
     for i in range(start, stop):
         p = params[i]
         out[i] = False
+        if _shoulder_flat(p):
+            out[i] = True
+            continue
         for b in range(0, 8, 2):
             m0, _, c0, _ = _parallel_first(p, b)
             if math.isnan(m0[0] + m0[2]) or not in_domain(c0):
