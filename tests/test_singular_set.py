@@ -367,3 +367,21 @@ def test_a_hair_off_the_wrist_on_joint_2_axis_is_not_unreachable(reduction: str,
         if len(sols):
             assert np.all(sols.error_geodesic <= 2e-13 * arm.length_scale)
             assert np.abs(arm.fk(sols.q) - T).max() < 1e-9
+
+
+@pytest.mark.parametrize("offset", [1e-11, 1e-9, 1e-8])
+def test_a_hair_off_the_theta2_self_motion_every_reduction_gives_its_numerical_continuum(offset: float) -> None:
+    """theta4 a hair off -90 deg (theta3 = 0, wrist on joint 2's axis): the theta2 self-motion is broken, but its
+    members solve the pose within the certification's tolerance over half a turn (issue 35: the default reduction
+    gave 2 isolated points, the nearest 1.39 rad from the configuration). Every reduction reports the numerical
+    continuum: the configuration and members a quarter turn away come back."""
+    from singular import families_certified, recovered
+
+    q = np.array([1342.3161008277336, np.pi, 0.0, -np.pi / 2 + offset, -1.6798806157027852, -0.9186248018997638])
+    T = CARM.fk(q)
+    for reduction in (None, "carm-d1", "auto"):
+        s = solve(CARM, T, limits=False, **({} if reduction is None else {"reduction": reduction}))
+        assert s.families and recovered(CARM, s, q), reduction
+        families_certified(CARM, s, T)
+        members = np.concatenate([f.sample(20) for f in s.families])
+        assert np.ptp(np.mod(members[:, 1], 2.0 * np.pi)) > 2.0, reduction  # (theta2 over most of the circle)

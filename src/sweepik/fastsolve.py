@@ -320,8 +320,9 @@ def _fixed(
         if one is None or not (one.n_samples is None or one.n_samples == n_samples):
             return None
         cls = red.__class__
-        if defining_class(cls, "continuum_joints") is not defining_class(cls, "continuum_kernel"):
-            return None
+        python_only = defining_class(cls, "continuum_joints") is not defining_class(cls, "continuum_kernel")
+        if python_only and defining_class(cls, "continuum_joints") is not defining_class(cls, "continuum_poses"):
+            return None  # (else the solver asks ``continuum_poses`` after the call)
         addr = np.zeros(_A_SIZE, dtype=np.int64)
         addr[_A_SEARCH] = address_of(one.kernel, _ONE_PASS_FN_SIG)
         addr[_A_CERTIFY] = address_of(_certify, _CERTIFY_FN_SIG)

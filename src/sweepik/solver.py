@@ -549,6 +549,9 @@ def _settled(
         return None
     if out.checked:  # (its singular set, checked in the call: ``Reduction.singular_kernel``)
         return out
+    near = red.continuum_poses(chain)  # (a continuum the call does not look for)
+    if near is not None and bool(near.any()):
+        return None
     if red.closed_form and type(red).continuum_joints is not Reduction.continuum_joints:
         pose = np.zeros(out.theta.size, dtype=np.intp)
         free = red.continuum_joints(chain, pose, out.theta, out.branch, out.err_all, SEED_TOL_REL * robot.length_scale)

@@ -171,6 +171,12 @@ class Reduction(ABC):
             return []
         return [(self.fallback, deg)]
 
+    def continuum_poses(self, poses: Array) -> NDArray[np.bool_] | None:
+        """``(N,)`` the poses where ``continuum_joints`` may flag a candidate, told from the pose alone (a reduction
+        that can tell: its poses elsewhere take the one compiled call, ``fastsolve``, without a continuum kernel);
+        None: it cannot tell without the candidates."""
+        return None
+
     def continuum_joints(
         self, poses: Array, pose: IntArray, theta: Array, branch: IntArray, error: Array | None = None, tol: float = 0.0
     ) -> IntArray | None:

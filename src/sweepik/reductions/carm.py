@@ -74,6 +74,11 @@ def carm_lengths(robot: Robot) -> tuple[float, float]:
     return L1, L2
 
 
+#: Poses this close to the theta2 self-motion (``_CArmBase._self_motion``: the wrist's distance from joint 2's axis
+#: over L1 + L2, and the orientation's terms that fix theta2) have their candidates traced along theta2.
+NEAR_SELF_MOTION = 1e-6
+
+
 class _CArmBase(Reduction):
     def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:
         super().__init__(robot, free_joint, n_branches)
@@ -103,6 +108,38 @@ class _CArmBase(Reduction):
             return np.ones(1, dtype=bool) if abs(float(poses[0, 0, 3])) <= tol else None
         near = np.abs(poses[:, 0, 3]) <= tol
         return near if near.any() else None
+
+    def _self_motion(self, poses: Array, tol: float) -> NDArray[np.bool_] | None:
+        """Poses on the theta2 self-motion to ``tol``: the wrist on joint 2's axis (``|Px| <= tol (L1 + L2)``) where
+        the orientation does not fix theta2 either (``CArmD1.degenerate``); None where none is."""
+        Px = poses[:, 0, 3]
+        near = np.abs(Px) <= max(tol, 1e-9) * (self.L1 + self.L2)
+        if not near.any():
+            return None
+        Py, z = poses[:, 1, 3], poses[:, :3, 2]
+        out = np.zeros(poses.shape[0], dtype=bool)
+        for eps in (1.0, -1.0):
+            c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))
+            with np.errstate(invalid="ignore"):
+                flat = (np.hypot(c34 * z[:, 0], c34 * z[:, 2]) <= tol) & (np.abs(s34 * z[:, 1]) <= tol)
+            out |= near & flat
+        return out
+
+    def continuum_poses(self, poses: Array) -> NDArray[np.bool_] | None:
+        return self._self_motion(poses, NEAR_SELF_MOTION)
+
+    def continuum_joints(
+        self, poses: Array, pose: IntArray, theta: Array, branch: IntArray, error: Array | None = None, tol: float = 0.0
+    ) -> IntArray | None:
+        """Candidates of poses within ``NEAR_SELF_MOTION`` of the theta2 self-motion (``_self_motion``): joint 2. A
+        pose 1e-9 rad off it (theta4) holds a numerical continuum along theta2 over half a turn, every member solving
+        the pose within the certification's tolerance; the sweep gives a few of its points, 0.1 ... 1.4 rad apart.
+        The solver traces the continuum from them (nothing where the candidates are isolated solutions)."""
+        near = self.continuum_poses(poses)
+        if near is None or not near[pose].any():
+            return None
+        flag = near[pose] if error is None else near[pose] & (error <= tol)
+        return np.where(flag, 1, -1).astype(np.intp)
 
     def _position(self, poses: Array, theta: Array, branch: IntArray | None) -> tuple[Array, ...]:
         """(d1, C2, S2, u, Py, C34, S34, z, R) at theta*; each subclass ties theta2 and d1 its own way."""
@@ -235,18 +272,7 @@ class CArmD1(_CArmBase):
         """Wrist on joint 2's axis (Px = 0) where the orientation does not fix theta2 either (A = B = c = 0 in
         ``special_solutions``, e.g. theta3 = 0, theta4 = -90 deg, theta5 = 0): a continuum along theta2, which a
         d1 sweep cannot describe; carm-theta2 reports it as a family."""
-        tol = 1e-9
-        near = self._wrist_on_axis(poses)
-        if near is None:
-            return None
-        Py, z = poses[:, 1, 3], poses[:, :3, 2]
-        out = np.zeros(poses.shape[0], dtype=bool)
-        for eps in (1.0, -1.0):
-            c34, s34 = self._elbow(np.zeros_like(Py), Py, np.full_like(Py, eps))
-            with np.errstate(invalid="ignore"):
-                flat = (np.hypot(c34 * z[:, 0], c34 * z[:, 2]) <= tol) & (np.abs(s34 * z[:, 1]) <= tol)
-            out |= near & flat
-        return out
+        return self._self_motion(poses, 1e-9)
 
     def search_range(self, poses: Array) -> Array:
         return poses[:, 2, 3, None] + self._reach
