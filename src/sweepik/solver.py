@@ -811,6 +811,11 @@ def _settle_stepwise(
             q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
             # a polished solution next to a fold: its partner on the far side (:mod:`.partners`)
             polished_ok = near[take][eg[take] <= accept]
+            # (each distinct one once, and none of a pose with more of them than an arm has solutions: a numerical
+            # continuum, along which no partner is taken)
+            distinct = polished_ok[finish(robot, pose_idx[polished_ok], q[polished_ok], err_geo[polished_ok])[2]]
+            count = np.bincount(pose_idx[distinct], minlength=len(poses))
+            polished_ok = distinct[count[pose_idx[distinct]] <= MAX_ISOLATED_SOLUTIONS]
             row, q_p, _ = close_partners(robot, q[polished_ok], poses[pose_idx[polished_ok]], accept)
             if row.size:  # (each once, and none its pose has already: found again, it would add to a multiplicity)
                 new = _new_rows(robot, pose_idx, q, polished_ok[row], q_p)
