@@ -10,8 +10,9 @@ import numpy as np
 from singular import recovered, singular_configurations
 
 import sweepik
-from sweepik.partners import close_partners
-from sweepik.polish import polished
+from sweepik.continuation import scaled_singular
+from sweepik.partners import close_partners, valley_bottoms
+from sweepik.polish import geodesic_errors, polished
 from sweepik.solutions import joint_distance
 from sweepik.solver import ACCEPT_TOL_REL
 from sweepik.units import orientation_weight
@@ -59,3 +60,37 @@ def test_configurations_next_to_the_crx_singular_sets_come_back() -> None:
     for q in singular_configurations(robot, 40, np.random.default_rng(zlib.crc32(b"partners"))):
         s = sweepik.solve(robot, robot.fk(q), limits=False)
         assert recovered(robot, s, q), q.tolist()
+
+
+#: An I2RT YAM configuration on its singular set (axes 2-4 parallel to 3e-6 rad: a double root blurred into a flat
+#: valley): the polish stopped 4.6e-4 rad from it, at 7e-2 of the certification's tolerance.
+YAM = [-2.5969578377896116, -0.46585898160365735, -0.6487270256316182, -1.8713330559425263, -1.570714931440159,
+       -2.5460932206476232]  # fmt: skip
+
+
+def test_a_blurred_double_root_comes_back_at_the_bottom_of_its_valley() -> None:
+    robot = sweepik.load_robot("i2rt_yam")
+    q = np.array(YAM)
+    s = sweepik.solve(robot, robot.fk(q), limits=False)
+    assert recovered(robot, s, q)
+
+
+def test_the_valley_bottom_is_lower_and_nearer_the_root() -> None:
+    """From a point 3e-4 rad along the valley (polished with the joint the valley moves most held), the bottom found
+    solves the pose better and lies nearer the configuration."""
+    robot = sweepik.load_robot("i2rt_yam")
+    q = np.array(YAM)
+    T = robot.fk(q)
+    weight = orientation_weight(robot.length_unit)
+    tol = ACCEPT_TOL_REL * robot.length_scale
+    _, vt = scaled_singular(robot, q[None])
+    v = vt[0, -1]
+    held = np.zeros((1, 6), dtype=bool)
+    held[0, int(np.argmax(np.abs(v)))] = True
+    x, e0 = polished(robot, (q + 3e-4 * v)[None], T[None], weight, iterations=30, fixed=held)
+    assert tol * 1e-3 < e0[0] <= tol  # (a point of the valley: certified, above rounding)
+    y, moved = valley_bottoms(robot, x, T[None], tol)
+    assert moved[0]
+    e1 = geodesic_errors(robot, y, T[None], weight)
+    assert e1[0] < e0[0]
+    assert np.max(joint_distance(robot, y, q[None])) < np.max(joint_distance(robot, x, q[None]))

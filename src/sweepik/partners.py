@@ -20,6 +20,7 @@ are: ``solver.MEET_NEAR``).
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .continuation import scaled_singular
 from .polish import geodesic_errors, polished
@@ -86,3 +87,58 @@ def close_partners(robot: Robot, q: Array, world: Array, tol: float) -> tuple[In
     near = np.minimum(np.linalg.norm(m - q[k[ok]], axis=-1), np.linalg.norm(m - found[ok], axis=-1))
     ok = ok[(m_err > tol) | (near <= PARTNER_STAY * d)]
     return k[ok].astype(np.intp), found[ok], err[ok]
+
+
+#: A polished solution whose pose error stays above FK rounding (``PARTNER_ROUNDING``) next to a fold lies in a flat
+#: valley of near-solutions (a double root that a near-structure blurs: an I2RT YAM, axes 2-4 parallel to 3e-6 rad,
+#: its polish stopping 1e-5 ... 5e-4 rad from the root at 4e-3 ... 7e-2 of the tolerance). Its lowest point is searched
+#: along the nearly null direction within this reach each way (radians; times the length scale for a slide) ...
+VALLEY_REACH = 2e-3
+#: ... on this many samples (each corrected by Newton with the joint that direction moves most held), then by golden
+#: section between the neighbours of the least (``families.golden_least``) until at rounding level.
+VALLEY_SAMPLES = 41
+VALLEY_STEPS = 30
+
+
+def valley_bottoms(robot: Robot, q: Array, world: Array, tol: float) -> tuple[Array, NDArray[np.bool_]]:
+    """Certified solutions ``q (K, n)`` of poses ``world (K, 4, 4)`` (``tol``: the certification's) moved to the lowest
+    point of their valley where they lie in one (nearly singular, error above rounding): ``(q, moved)``, a row moved
+    only where its error drops."""
+    from .families import golden_least  # local: families imports the solver's modules
+
+    weight = orientation_weight(robot.length_unit)
+    err = geodesic_errors(robot, q, world, weight)
+    out, moved = q.copy(), np.zeros(q.shape[0], dtype=bool)
+    floor = PARTNER_ROUNDING * robot.length_scale
+    rows = np.nonzero((err > floor) & (err <= tol))[0]
+    if rows.size == 0:
+        return out, moved
+    s, vt = scaled_singular(robot, q[rows])
+    keep = s[:, -1] <= PARTNER_SINGULAR * s[:, 0]
+    rows, vt = rows[keep], vt[keep]
+    if rows.size == 0:
+        return out, moved
+    n = robot.n_joints
+    v = vt[:, -1, :n] * np.where(robot.is_revolute, 1.0, robot.length_scale)
+    held = np.zeros((rows.size, n), dtype=bool)
+    held[np.arange(rows.size), np.argmax(np.abs(vt[:, -1, :n]), axis=1)] = True
+
+    def corrected(t: Array) -> tuple[Array, Array]:  # (t (R, M): M points along each row's direction)
+        M = t.shape[1]
+        start = (q[rows][:, None, :] + t[..., None] * v[:, None, :]).reshape(-1, n)
+        m, e = polished(robot, start, np.repeat(world[rows], M, axis=0), weight, iterations=PARTNER_NEWTON,
+                        fixed=np.repeat(held, M, axis=0), floor=1e-3 * floor)  # fmt: skip
+        return m.reshape(rows.size, M, n), e.reshape(rows.size, M)
+
+    grid = np.broadcast_to(np.linspace(-VALLEY_REACH, VALLEY_REACH, VALLEY_SAMPLES), (rows.size, VALLEY_SAMPLES))
+    _, e = corrected(grid)
+    b = np.argmin(e, axis=1)
+    idx = np.arange(rows.size)
+    a_, c_ = grid[idx, np.maximum(b - 1, 0)], grid[idx, np.minimum(b + 1, VALLEY_SAMPLES - 1)]
+    x, _ = golden_least(
+        lambda t: corrected(t[:, None])[1][:, 0] - floor, a_, c_, grid[idx, b], e[idx, b] - floor, steps=VALLEY_STEPS
+    )
+    m, e_m = corrected(x[:, None])
+    better = e_m[:, 0] < err[rows]
+    out[rows[better]], moved[rows[better]] = m[better, 0], True
+    return out, moved

@@ -33,7 +33,7 @@ from .families import (
 )
 from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
-from .partners import close_partners
+from .partners import close_partners, valley_bottoms
 from .polish import geodesic_errors, polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, automatic_for_held, get_reduction, is_default
@@ -811,6 +811,12 @@ def _settle_stepwise(
             q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
             # a polished solution next to a fold: its partner on the far side (:mod:`.partners`)
             polished_ok = near[take][eg[take] <= accept]
+            # ... one in a flat valley next to a fold: at the valley's lowest point (:mod:`.partners`)
+            if polished_ok.size:
+                q_v, moved = valley_bottoms(robot, q[polished_ok], poses[pose_idx[polished_ok]], accept)
+                rows = polished_ok[moved]
+                q[rows] = q_v[moved]
+                err_geo[rows], err_paper[rows] = _errors(robot, q[rows], poses[pose_idx[rows]], weight)
             # (each distinct one once, and none of a pose with more of them than an arm has solutions: a numerical
             # continuum, along which no partner is taken)
             distinct = polished_ok[finish(robot, pose_idx[polished_ok], q[polished_ok], err_geo[polished_ok])[2]]
