@@ -92,10 +92,12 @@ def close_partners(robot: Robot, q: Array, world: Array, tol: float) -> tuple[In
 #: A polished solution whose pose error stays above FK rounding (``PARTNER_ROUNDING``) next to a fold lies in a flat
 #: valley of near-solutions (a double root that a near-structure blurs: an I2RT YAM, axes 2-4 parallel to 3e-6 rad,
 #: its polish stopping 1e-5 ... 5e-4 rad from the root at 4e-3 ... 7e-2 of the tolerance). Its lowest point is searched
-#: along the nearly null direction within this reach each way (radians; times the length scale for a slide) ...
-VALLEY_REACH = 2e-3
+#: along the nearly null direction within this reach each way (radians; times the length scale for a slide; the YAM
+#: valley above is certified to 2e-3 each way, 20 times the tolerance at 1e-2) ...
+VALLEY_REACH = 1e-2
 #: ... on this many samples (each corrected by Newton with the joint that direction moves most held), then by golden
-#: section between the neighbours of the least (``families.golden_least``) until at rounding level.
+#: section between the neighbours of the least (``families.golden_least``). A valley whose
+#: ends at the reach still solve the pose is a continuum's stretch: no point of it is moved.
 VALLEY_SAMPLES = 41
 VALLEY_STEPS = 30
 
@@ -132,12 +134,17 @@ def valley_bottoms(robot: Robot, q: Array, world: Array, tol: float) -> tuple[Ar
 
     grid = np.broadcast_to(np.linspace(-VALLEY_REACH, VALLEY_REACH, VALLEY_SAMPLES), (rows.size, VALLEY_SAMPLES))
     _, e = corrected(grid)
+    # a valley ends within the reach both ways (its ends do not solve the pose); along a continuum, which holds
+    # solutions all the way, a point is where it is (the continuum is reported by its family)
+    bounded = (e[:, 0] > tol) & (e[:, -1] > tol)
+    rows, grid, e, v, held = rows[bounded], grid[bounded], e[bounded], v[bounded], held[bounded]
+    if rows.size == 0:
+        return out, moved
     b = np.argmin(e, axis=1)
     idx = np.arange(rows.size)
     a_, c_ = grid[idx, np.maximum(b - 1, 0)], grid[idx, np.minimum(b + 1, VALLEY_SAMPLES - 1)]
-    x, _ = golden_least(
-        lambda t: corrected(t[:, None])[1][:, 0] - floor, a_, c_, grid[idx, b], e[idx, b] - floor, steps=VALLEY_STEPS
-    )
+    # (all its steps: near the bottom the error is at rounding level over a stretch, whose middle the search nears)
+    x, _ = golden_least(lambda t: corrected(t[:, None])[1][:, 0], a_, c_, grid[idx, b], e[idx, b], steps=VALLEY_STEPS)
     m, e_m = corrected(x[:, None])
     better = e_m[:, 0] < err[rows]
     out[rows[better]], moved[rows[better]] = m[better, 0], True

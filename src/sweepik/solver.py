@@ -814,6 +814,7 @@ def _settle_stepwise(
             # ... one in a flat valley next to a fold: at the valley's lowest point (:mod:`.partners`)
             if polished_ok.size:
                 q_v, moved = valley_bottoms(robot, q[polished_ok], poses[pose_idx[polished_ok]], accept)
+                moved &= robot.within_limits(q_v) | ~robot.within_limits(q[polished_ok])  # (as ``drift`` above)
                 rows = polished_ok[moved]
                 q[rows] = q_v[moved]
                 err_geo[rows], err_paper[rows] = _errors(robot, q[rows], poses[pose_idx[rows]], weight)
