@@ -20,7 +20,7 @@ from ._jit import alive, inlined, unowned
 from ._wrap import wrap_pi
 from .dedupe import limit_args
 from .fastsweep import AVAILABLE, PARALLEL_MIN, writable
-from .polish import PINV_WIDEN, SETTLED, SETTLED_BACKTRACK
+from .polish import PINV_WIDEN
 from .pose import GIMBAL_TOL
 from .reductions.kernels import address_of, lazy_njit, owned_kernel
 from .units import orientation_weight
@@ -599,15 +599,12 @@ if AVAILABLE:
                     for r in range(6):
                         J[r, i] = 0.0 if fixed[k, i] else (J[r, i] * weight if r >= 3 else J[r, i])
                 improved = False
-                settled = cur <= SETTLED * floor  # (``polish.SETTLED``)
-                levels = 1 if settled else len(PINV_WIDEN)
-                halvings = min(backtrack, SETTLED_BACKTRACK) if settled else backtrack
-                for widen in range(levels):  # (the step with more small directions dropped, if need be)
+                for widen in range(len(PINV_WIDEN)):  # (the step with more small directions dropped, if need be)
                     step = np.linalg.pinv(J, rcond * PINV_WIDEN[widen]) @ e
                     for i in range(n):  # (a held joint's zero column gives a step of rounding size: none at all)
                         if fixed[k, i]:
                             step[i] = 0.0
-                    for _ in range(halvings + 1):
+                    for _ in range(backtrack + 1):
                         for i in range(n):
                             trial[i] = q[k, i] + step[i]
                         new = _geodesic(_poe_fk(H, P, rev, R_end, trial), Td, weight)[0]

@@ -115,6 +115,12 @@ def valley_bottoms(robot: Robot, q: Array, world: Array, tol: float) -> tuple[Ar
     rows = np.nonzero((err > floor) & (err <= tol))[0]
     if rows.size == 0:
         return out, moved
+    # a root the solver's polish left just above rounding (two PUMA 560 roots 1.8e-4 apart: 2e-15 of its size) gets
+    # there with more steps: it is no valley point (whose bottom could be the other root)
+    again, e_again = polished(robot, q[rows], world[rows], weight, iterations=PARTNER_NEWTON, floor=1e-3 * floor)
+    rows = rows[e_again > floor]
+    if rows.size == 0:
+        return out, moved
     s, vt = scaled_singular(robot, q[rows])
     keep = s[:, -1] <= PARTNER_SINGULAR * s[:, 0]
     rows, vt = rows[keep], vt[keep]

@@ -56,11 +56,6 @@ ITERATIONS = 8
 #: two ranks (a KR 6 with its wrist centre on axis 1 and its elbow straight) the step from a member interpolated
 #: between traced ones points far along the nearly null direction: 8 halvings never got below its 6e-5 error, 20 do.
 BACKTRACK = 20
-#: A configuration within this factor of the polish's ``floor`` is settled: a step that does not lower its error
-#: after ``SETTLED_BACKTRACK`` halvings (no wider pseudo-inverse tried) ends its polish. It stops at rounding level
-#: there; the full backtracking (3 x 21 evaluations) only cost time, ~60 % of a trace's corrections.
-SETTLED = 10.0
-SETTLED_BACKTRACK = 2
 
 
 def polish(
@@ -115,21 +110,12 @@ def polished(
             Js = np.where(fixed[active][:, None, :], 0.0, Js)
         improved = np.zeros(active.size, dtype=bool)
         todo = np.arange(active.size)
-        settled = err[active] <= SETTLED * floor  # (see SETTLED)
-        for level, widen in enumerate(PINV_WIDEN):
-            if level:
-                todo = todo[~settled[todo]]
-                if todo.size == 0:
-                    break
+        for widen in PINV_WIDEN:
             # pseudo-inverse per candidate: singular Jacobians (rank-deficient arms poses) stay bounded
             step = np.einsum("kij,kj->ki", np.linalg.pinv(Js, rcond=PINV_RCOND * widen), e)
             if fixed is not None:  # (a held joint's zero column gives a step of rounding size: none at all)
                 step = np.where(fixed[active], 0.0, step)
-            for halving in range(BACKTRACK + 1):
-                if halving > SETTLED_BACKTRACK:
-                    todo = todo[~settled[todo]]
-                    if todo.size == 0:
-                        break
+            for _ in range(BACKTRACK + 1):
                 q_new = qa[todo] + step[todo]
                 err_new = geodesic_errors(robot, q_new, ta[todo], weight)
                 better = np.isfinite(err_new) & (err_new < err[active[todo]])
