@@ -36,6 +36,7 @@ __all__ = [
     "limit_args",
     "merged_multiplicity",
     "near_pairs",
+    "duplicate_tolerance",
     "DEDUPE_ANGLE",
     "DEDUPE_LENGTH_REL",
 ]
@@ -51,7 +52,9 @@ _PARALLEL_ROWS = 4096
 
 
 @lru_cache(maxsize=64)
-def _tolerance(robot: Robot) -> Array:
+def duplicate_tolerance(robot: Robot) -> Array:
+    """Per joint, how close two solutions are to be the same (``DEDUPE_ANGLE``, ``DEDUPE_LENGTH_REL``; cached per
+    robot: not to be written)."""
     return np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
 
 
@@ -94,7 +97,7 @@ def finish(
     if not (AVAILABLE and q.shape[0]):
         return w, inside, _dedupe(robot, pose_idx, w, score)
     keep = np.empty(q.shape[0], dtype=np.bool_)
-    _dedupe_compiled(pose_idx.astype(np.int64), w, score, limit_args(robot)[0], _tolerance(robot), keep)
+    _dedupe_compiled(pose_idx.astype(np.int64), w, score, limit_args(robot)[0], duplicate_tolerance(robot), keep)
     return w, inside, keep
 
 
@@ -150,7 +153,7 @@ def settle(
         ltol,
         beyond,
         reach,
-        _tolerance(robot),
+        duplicate_tolerance(robot),
         float(robot.length_scale),
         due,
         rows,
@@ -176,7 +179,7 @@ def merged_multiplicity(
     the solution they share is a multiple root. The dropped candidates are few (singular poses): compared in
     NumPy."""
     out = np.array(mult, dtype=np.intp)
-    tol = _tolerance(robot)
+    tol = duplicate_tolerance(robot)
     kept = np.nonzero(keep)[0]
     for d in np.nonzero(~keep)[0]:
         k = kept[pose_idx[kept] == pose_idx[d]]
@@ -234,7 +237,7 @@ def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> N
     keep = np.ones(K, dtype=bool)
     if K == 0:
         return keep
-    tol = _tolerance(robot)
+    tol = duplicate_tolerance(robot)
     order = np.argsort(pose_idx, kind="stable")
     starts = np.concatenate([[0], np.flatnonzero(np.diff(pose_idx[order])) + 1])
     sizes = np.diff(np.concatenate([starts, [K]]))

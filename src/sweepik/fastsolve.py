@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import fastsweep
-from .dedupe import _tolerance, limit_args
+from .dedupe import duplicate_tolerance, limit_args
 from .fastcertify import chain_args
 from .fastsweep import AVAILABLE, _plan, writable
 from .reductions.kernels import (
@@ -304,7 +304,17 @@ def _tail(robot: Any, thresholds: tuple[float, ...], reach: Array) -> tuple[Any,
     H, P, crev, R_end = chain_args(robot)
     weight = float(orientation_weight(robot.length_unit))
     thr = np.array(thresholds, dtype=np.float64)
-    settling = (thr, rev, lower, upper, ltol, beyond, writable(reach), _tolerance(robot), float(robot.length_scale))
+    settling = (
+        thr,
+        rev,
+        lower,
+        upper,
+        ltol,
+        beyond,
+        writable(reach),
+        duplicate_tolerance(robot),
+        float(robot.length_scale),
+    )
     return (H, P, crev, R_end, weight, *settling)
 
 

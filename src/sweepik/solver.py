@@ -21,7 +21,7 @@ from .batch import Block, SolutionBatch, no_solution_reason
 from .companion import joined
 from .continuation import Traced, continuum_families, correct
 from .crossings import crossing_seeds
-from .dedupe import DEDUPE_ANGLE, DEDUPE_LENGTH_REL, finish, merged_multiplicity, near_pairs, settle, wrap_inside
+from .dedupe import duplicate_tolerance, finish, merged_multiplicity, near_pairs, settle, wrap_inside
 from .errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from .families import (
     MAX_ISOLATED_SOLUTIONS,
@@ -654,12 +654,58 @@ def _trace_cut_continua(
         fallback[i] = sol
 
 
+def _next_to_folds(
+    robot: Robot,
+    poses: Array,
+    pose_idx: NDArray[np.intp],
+    q: Array,
+    mult: NDArray[np.intp],
+    err_geo: Array,
+    err_paper: Array,
+    rows: NDArray[np.intp],
+) -> tuple[NDArray[np.intp], Array, NDArray[np.intp], Array, Array]:
+    """The certified solutions ``rows`` the polish gave, next to a fold of the solution set (:mod:`.partners`): one in
+    a flat valley moved to its bottom (in place; never out of the limits, as the polish's drift), and a close partner
+    on the far side of the fold added after the solution it was found from (a pose's rows stay together): the
+    candidates ``(pose_idx, q, mult, err_geo, err_paper)``."""
+    if rows.size == 0:
+        return pose_idx, q, mult, err_geo, err_paper
+    accept = ACCEPT_TOL_REL * robot.length_scale
+    weight = orientation_weight(robot.length_unit)
+    q_v, moved = valley_bottoms(robot, q[rows], poses[pose_idx[rows]], accept)
+    moved &= robot.within_limits(q_v) | ~robot.within_limits(q[rows])
+    m = rows[moved]
+    q[m] = q_v[moved]
+    err_geo[m], err_paper[m] = _errors(robot, q[m], poses[pose_idx[m]], weight)
+    # each distinct one once, and none of a pose with more of them than an arm has solutions (a numerical continuum,
+    # along which no partner is taken)
+    distinct = rows[finish(robot, pose_idx[rows], q[rows], err_geo[rows])[2]]
+    count = np.bincount(pose_idx[distinct], minlength=len(poses))
+    distinct = distinct[count[pose_idx[distinct]] <= MAX_ISOLATED_SOLUTIONS]
+    row, q_p, _ = close_partners(robot, q[distinct], poses[pose_idx[distinct]], accept)
+    if row.size:  # (each once, and none its pose has already: found again, it would add to a multiplicity)
+        new = _new_rows(robot, pose_idx, q, distinct[row], q_p)
+        row, q_p = row[new], q_p[new]
+    if row.size == 0:
+        return pose_idx, q, mult, err_geo, err_paper
+    src = distinct[row]
+    eg_p, ep_p = _errors(robot, q_p, poses[pose_idx[src]], weight)
+    order = np.argsort(np.concatenate([np.arange(pose_idx.size), src]), kind="stable")
+    return (
+        np.concatenate([pose_idx, pose_idx[src]])[order],
+        np.concatenate([q, q_p])[order],
+        np.concatenate([mult, np.ones(src.size, dtype=mult.dtype)])[order],
+        np.concatenate([err_geo, eg_p])[order],
+        np.concatenate([err_paper, ep_p])[order],
+    )
+
+
 def _new_rows(
     robot: Robot, pose_idx: NDArray[np.intp], q: Array, src: NDArray[np.intp], q_new: Array
 ) -> NDArray[np.bool_]:
     """``(K,)``: the configurations ``q_new (K, n)`` of the poses of rows ``src`` that are neither one of their pose's
-    rows of ``q`` nor an earlier one of ``q_new`` (within the duplicate tolerance, ``dedupe.DEDUPE_ANGLE``)."""
-    tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
+    rows of ``q`` nor an earlier one of ``q_new`` (within ``dedupe.duplicate_tolerance``)."""
+    tol = duplicate_tolerance(robot)
     out = np.zeros(src.size, dtype=bool)
     for k in range(src.size):
         mine = pose_idx == pose_idx[src[k]]
@@ -809,33 +855,11 @@ def _settle_stepwise(
             drift = (err_geo[near] <= accept) & robot.within_limits(q[near]) & ~robot.within_limits(polished)
             take = np.nonzero(~drift)[0]
             q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
-            # a polished solution next to a fold: its partner on the far side (:mod:`.partners`)
+            # next to a fold of the solution set: a valley's bottom, a close partner
             polished_ok = near[take][eg[take] <= accept]
-            # ... one in a flat valley next to a fold: at the valley's lowest point (:mod:`.partners`)
-            if polished_ok.size:
-                q_v, moved = valley_bottoms(robot, q[polished_ok], poses[pose_idx[polished_ok]], accept)
-                moved &= robot.within_limits(q_v) | ~robot.within_limits(q[polished_ok])  # (as ``drift`` above)
-                rows = polished_ok[moved]
-                q[rows] = q_v[moved]
-                err_geo[rows], err_paper[rows] = _errors(robot, q[rows], poses[pose_idx[rows]], weight)
-            # (each distinct one once, and none of a pose with more of them than an arm has solutions: a numerical
-            # continuum, along which no partner is taken)
-            distinct = polished_ok[finish(robot, pose_idx[polished_ok], q[polished_ok], err_geo[polished_ok])[2]]
-            count = np.bincount(pose_idx[distinct], minlength=len(poses))
-            polished_ok = distinct[count[pose_idx[distinct]] <= MAX_ISOLATED_SOLUTIONS]
-            row, q_p, _ = close_partners(robot, q[polished_ok], poses[pose_idx[polished_ok]], accept)
-            if row.size:  # (each once, and none its pose has already: found again, it would add to a multiplicity)
-                new = _new_rows(robot, pose_idx, q, polished_ok[row], q_p)
-                row, q_p = row[new], q_p[new]
-            if row.size:  # (each after the solution it was found from: a pose's rows stay together)
-                src = polished_ok[row]
-                eg_p, ep_p = _errors(robot, q_p, poses[pose_idx[src]], weight)
-                order = np.argsort(np.concatenate([np.arange(pose_idx.size), src]), kind="stable")
-                pose_idx = np.concatenate([pose_idx, pose_idx[src]])[order]
-                q = np.concatenate([q, q_p])[order]
-                mult = np.concatenate([mult, np.ones(src.size, dtype=mult.dtype)])[order]
-                err_geo = np.concatenate([err_geo, eg_p])[order]
-                err_paper = np.concatenate([err_paper, ep_p])[order]
+            pose_idx, q, mult, err_geo, err_paper = _next_to_folds(
+                robot, poses, pose_idx, q, mult, err_geo, err_paper, polished_ok
+            )
     if strategy == "precise":
         certified = err_geo <= accept
     else:
