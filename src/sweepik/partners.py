@@ -1,4 +1,5 @@
-"""A close partner of a solution next to a fold of the solution set (issue 35, point 3: close roots).
+"""Next to a fold of the solution set (issue 35, point 3: close roots): a solution's close partner on the far side,
+and the bottom of a flat valley a solution stopped in (``valley_bottoms``, below).
 
 A pose just inside a singular set's image has two solutions 1e-6 ... 1e-3 apart on either side of the fold, both
 solving the pose to rounding. A sweep sees them as two roots a hair apart, often next to a branch-domain edge (a
@@ -23,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .continuation import scaled_singular
+from .families import golden_least
 from .polish import geodesic_errors, polished
 from .reductions.base import Array, IntArray
 from .robot import Robot
@@ -106,8 +108,6 @@ def valley_bottoms(robot: Robot, q: Array, world: Array, tol: float) -> tuple[Ar
     """Certified solutions ``q (K, n)`` of poses ``world (K, 4, 4)`` (``tol``: the certification's) moved to the lowest
     point of their valley where they lie in one (nearly singular, error above rounding): ``(q, moved)``, a row moved
     only where its error drops."""
-    from .families import golden_least  # local: families imports the solver's modules
-
     weight = orientation_weight(robot.length_unit)
     err = geodesic_errors(robot, q, world, weight)
     out, moved = q.copy(), np.zeros(q.shape[0], dtype=bool)
