@@ -19,8 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .kinematics import geometric_jacobian
-from .polish import polished
+from .polish import polished, pose_and_jacobian
 from .reductions.base import Reduction
 from .robot import Robot
 from .solutions import Family, weighted_joint_distance
@@ -68,7 +67,7 @@ PROBE_ERROR = 1e-2
 def scaled_singular(robot: Robot, q: Array) -> tuple[Array, Array]:
     """Singular values ``(K, 6)`` (decreasing) and right singular vectors ``(K, n, n)`` (rows) of the Jacobian at
     configurations ``q (K, n)``, lengths over the arm's length scale (a slide's column: per length scale)."""
-    J = geometric_jacobian(robot, q)
+    J = pose_and_jacobian(robot, q)[1]
     J[:, :3, :] /= robot.length_scale
     J[:, :, ~robot.is_revolute] *= robot.length_scale
     _, s, vt = np.linalg.svd(J)

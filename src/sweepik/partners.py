@@ -32,13 +32,14 @@ from .solutions import joint_distance
 from .units import orientation_weight
 
 #: A solution is probed when its Jacobian's smallest singular value is at most this fraction of its largest (lengths
-#: over the arm's size): two roots d apart across a fold have a smallest singular value of order d (1e-3: roots up to
-#: ~1e-3 rad apart).
-PARTNER_SINGULAR = 1e-3
+#: over the arm's size): across a fold (the pose error ~ a x^2 along the nearly null direction) two roots d apart have
+#: a smallest singular value of ~a d (the CRX-10iA pair, 2e-5 apart: 8.7e-7, a = 0.04), so 1e-4 takes roots up to
+#: ~1e-3 apart on such a fold, and fewer solutions of random poses than 1e-3 (each probe is 8 short Newton runs).
+PARTNER_SINGULAR = 1e-4
 #: Distances along the nearly null direction (radians, or length over the arm's size) Newton starts from, each way.
-PARTNER_STEPS = (1e-6, 1e-5, 1e-4, 1e-3, 1e-2)
-#: Newton steps from each start.
-PARTNER_NEWTON = 30
+PARTNER_STEPS = (1e-6, 1e-5, 1e-4, 1e-3)
+#: Newton steps from each start (it converges in ~5 from next to a root; a start that does not is no partner).
+PARTNER_NEWTON = 12
 #: A point found must solve the pose to the rounding of forward kinematics (this times the arm's size, as
 #: ``solver.MEET_ROUNDING_REL``), not merely within the certification's tolerance: between two roots 3e-4 apart next
 #: to a PUMA 560's elbow fold the pose error stays below 3 % of that tolerance along a curved valley, and Newton ends
@@ -52,6 +53,15 @@ PARTNER_MIDPOINT = 4.0
 #: ... and Newton from that midpoint ends within this fraction of their distance of one of them (it goes over to it),
 #: or does not reach the pose.
 PARTNER_STAY = 0.1
+
+
+def nearly_singular(robot: Robot, q: Array) -> NDArray[np.bool_]:
+    """``(K,)``: the configurations ``q (K, n)`` whose Jacobian's smallest singular value is at most
+    ``PARTNER_SINGULAR`` of its largest (the only ones ``close_partners`` and ``valley_bottoms`` look at)."""
+    if q.shape[0] == 0:
+        return np.zeros(0, dtype=bool)
+    s, _ = scaled_singular(robot, q)
+    return np.asarray(s[:, -1] <= PARTNER_SINGULAR * s[:, 0])
 
 
 def close_partners(robot: Robot, q: Array, world: Array, tol: float) -> tuple[IntArray, Array, Array]:

@@ -31,11 +31,13 @@ PINV_RCOND = 1e-10
 PINV_WIDEN = (1.0, 1e4, 1e7)
 
 
-def _pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:
-    from .fastcertify import AVAILABLE, pose_and_jacobian
+def pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:
+    """World tool poses and geometric Jacobians at the tool point of configurations ``q (K, n)``: compiled when Numba
+    is present, else :func:`sweepik.kinematics.geometric_jacobian`."""
+    from . import fastcertify
 
-    if AVAILABLE:
-        return pose_and_jacobian(robot, q)
+    if fastcertify.AVAILABLE:
+        return fastcertify.pose_and_jacobian(robot, q)
     return _pose(robot, q), kinematics.geometric_jacobian(robot, q)
 
 
@@ -100,7 +102,7 @@ def polished(
     active = np.arange(q.shape[0])
     for _ in range(iterations):
         qa, ta = q[active], target[active]
-        T, J = _pose_and_jacobian(robot, qa)
+        T, J = pose_and_jacobian(robot, qa)
         dp = ta[:, :3, 3] - T[:, :3, 3]
         dR = ta[:, :3, :3] @ np.swapaxes(T[:, :3, :3], -1, -2)
         w = 0.5 * np.stack([dR[:, 2, 1] - dR[:, 1, 2], dR[:, 0, 2] - dR[:, 2, 0], dR[:, 1, 0] - dR[:, 0, 1]], -1)

@@ -33,7 +33,7 @@ from .families import (
 )
 from .origin_axis import HeldJoints, hold_joints
 from .paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_candidates
-from .partners import close_partners, valley_bottoms
+from .partners import close_partners, nearly_singular, valley_bottoms
 from .polish import geodesic_errors, polish
 from .pose import pose_error_geodesic, pose_error_paper
 from .reductions import Reduction, automatic_for_held, get_reduction, is_default
@@ -668,15 +668,18 @@ def _next_to_folds(
     a flat valley moved to its bottom (in place; never out of the limits, as the polish's drift), and a close partner
     on the far side of the fold added after the solution it was found from (a pose's rows stay together): the
     candidates ``(pose_idx, q, mult, err_geo, err_paper)``."""
+    if rows.size:  # (only nearly singular ones: most polished solutions are not)
+        rows = rows[nearly_singular(robot, q[rows])]
     if rows.size == 0:
         return pose_idx, q, mult, err_geo, err_paper
     accept = ACCEPT_TOL_REL * robot.length_scale
     weight = orientation_weight(robot.length_unit)
     q_v, moved = valley_bottoms(robot, q[rows], poses[pose_idx[rows]], accept)
-    moved &= robot.within_limits(q_v) | ~robot.within_limits(q[rows])
-    m = rows[moved]
-    q[m] = q_v[moved]
-    err_geo[m], err_paper[m] = _errors(robot, q[m], poses[pose_idx[m]], weight)
+    if moved.any():
+        moved &= robot.within_limits(q_v) | ~robot.within_limits(q[rows])
+        m = rows[moved]
+        q[m] = q_v[moved]
+        err_geo[m], err_paper[m] = _errors(robot, q[m], poses[pose_idx[m]], weight)
     # each distinct one once, and none of a pose with more of them than an arm has solutions (a numerical continuum,
     # along which no partner is taken)
     distinct = rows[finish(robot, pose_idx[rows], q[rows], err_geo[rows])[2]]
@@ -855,11 +858,13 @@ def _settle_stepwise(
             drift = (err_geo[near] <= accept) & robot.within_limits(q[near]) & ~robot.within_limits(polished)
             take = np.nonzero(~drift)[0]
             q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
-            # next to a fold of the solution set: a valley's bottom, a close partner
-            polished_ok = near[take][eg[take] <= accept]
-            pose_idx, q, mult, err_geo, err_paper = _next_to_folds(
-                robot, poses, pose_idx, q, mult, err_geo, err_paper, polished_ok
-            )
+            # a sweep's solution next to a fold of the solution set: a valley's bottom, a close partner (a closed form
+            # gives every branch's root, a pair split by rounding included: ``MEET_REL``)
+            if not red.closed_form:
+                polished_ok = near[take][eg[take] <= accept]
+                pose_idx, q, mult, err_geo, err_paper = _next_to_folds(
+                    robot, poses, pose_idx, q, mult, err_geo, err_paper, polished_ok
+                )
     if strategy == "precise":
         certified = err_geo <= accept
     else:
