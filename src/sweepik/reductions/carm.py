@@ -112,8 +112,10 @@ class _CArmBase(Reduction):
     def _self_motion(self, poses: Array, tol: float) -> NDArray[np.bool_] | None:
         """Poses on the theta2 self-motion to ``tol``: the wrist on joint 2's axis (``|Px| <= tol (L1 + L2)``) where
         the orientation does not fix theta2 either (``CArmD1.degenerate``); None where none is."""
-        Px = poses[:, 0, 3]
-        near = np.abs(Px) <= max(tol, 1e-9) * (self.L1 + self.L2)
+        reach = max(tol, 1e-9) * (self.L1 + self.L2)
+        if poses.shape[0] == 1 and abs(float(poses[0, 0, 3])) > reach:  # (one pose, the common case: no NumPy calls)
+            return None
+        near = np.abs(poses[:, 0, 3]) <= reach
         if not near.any():
             return None
         Py, z = poses[:, 1, 3], poses[:, :3, 2]
