@@ -1,4 +1,4 @@
-"""Benchmark script: the same code as ``sweepik bench`` (see sweepik.bench); run from the repository root.
+"""Benchmark script: the same code as ``sweepik bench`` (see sweepik.experiments.bench); run from the repository root.
 
 python benchmarks/bench.py            # full run (a)-(d), table
 python benchmarks/bench.py --json     # machine-readable
@@ -10,8 +10,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from sweepik import fastsweep
-from sweepik.bench import format_bench, run_bench
+from sweepik.engine import search
+from sweepik.experiments.bench import format_bench, run_bench
 
 
 def main() -> None:
@@ -21,7 +21,7 @@ def main() -> None:
     parser.add_argument("--memory", type=int, default=100_000)
     args = parser.parse_args()
     if args.numpy:
-        fastsweep.AVAILABLE = False  # the solver then runs the NumPy reference engine
+        search.AVAILABLE = False  # the solver then runs the NumPy reference engine
     result = run_bench(memory=0 if args.numpy else args.memory)
     print(json.dumps(result, indent=2) if args.json else format_bench(result))
 

@@ -29,7 +29,7 @@ IN_PROCESS = """
 import json, sys, time
 import numpy as np
 import sweepik
-from sweepik.store import merge_blocks
+from sweepik.io.store import merge_blocks
 arm = sweepik.load_robot(sys.argv[1])
 P = np.load(sys.argv[2], mmap_mode="r")
 sweepik.solve_many(arm, np.ascontiguousarray(P[:4096]))

@@ -20,8 +20,9 @@ import numba
 import numpy as np
 
 import sweepik
-from sweepik import fastsweep, solver
-from sweepik.bench import grid_configurations
+from sweepik import solving
+from sweepik.engine import search
+from sweepik.experiments.bench import grid_configurations
 
 
 def best(fn: Callable[[], object], repeats: int) -> float:
@@ -44,12 +45,12 @@ def main() -> None:
     numba.set_num_threads(1)
     for name in sys.argv[1:] or ["carm", "fanuc_crx10ia"]:
         robot = sweepik.load_robot(name)
-        red = sweepik.get_reduction(robot, None)
+        red = sweepik.reductions.get_reduction(robot, None)
         rng = np.random.default_rng(0)
-        chain = solver._chain_poses(robot, robot.fk(rng.uniform(robot.lower, robot.upper, size=(2000, 6))))
-        lo, hi = solver._theta_range(robot, red, chain)
-        fastsweep.search(red, chain[:10], lo[:10], hi[:10], 64)  # compile or load the kernels
-        t = best(lambda: fastsweep.search(red, chain, lo, hi, 64), 5)  # noqa: B023 (called right here)
+        chain = solving._chain_poses(robot, robot.fk(rng.uniform(robot.lower, robot.upper, size=(2000, 6))))
+        lo, hi = solving._theta_range(robot, red, chain)
+        search.search(red, chain[:10], lo[:10], hi[:10], 64)  # compile or load the kernels
+        t = best(lambda: search.search(red, chain, lo, hi, 64), 5)  # noqa: B023 (called right here)
         print(f"  {name}: compiled search {t / len(chain) * 1e6:.1f} us/pose (one thread, {red.name})")
 
 

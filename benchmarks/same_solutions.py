@@ -26,7 +26,7 @@ import sys
 import numpy as np
 
 import sweepik
-from sweepik.bench import grid_configurations
+from sweepik.experiments.bench import grid_configurations
 
 sys.path.insert(0, "tests")
 from test_any_arm import FAMILIES, _arm  # noqa: E402
@@ -45,7 +45,7 @@ def configurations(robot: sweepik.Robot, n: int) -> np.ndarray:
 
 def arms(numpy_engine: bool) -> list[tuple[str, sweepik.Robot]]:
     out = []
-    for path in sorted(glob.glob("src/sweepik/robots/*.toml")):
+    for path in sorted(glob.glob("src/sweepik/io/robots/*.toml")):
         robot = sweepik.load_robot(os.path.basename(path)[:-5])
         if robot.n_joints == 6:
             out.append((robot.name, robot))

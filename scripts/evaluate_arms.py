@@ -32,7 +32,7 @@ from oracles import (  # noqa: E402
 )
 
 import sweepik  # noqa: E402
-from sweepik.robot_file import bundled_robots  # noqa: E402
+from sweepik.io.robot_file import bundled_robots  # noqa: E402
 
 
 def main() -> None:

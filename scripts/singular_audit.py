@@ -23,8 +23,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 from singular import recovered, singular_configurations  # noqa: E402
 
 import sweepik  # noqa: E402
-from sweepik.pose import pose_error_geodesic  # noqa: E402
-from sweepik.units import orientation_weight  # noqa: E402
+from sweepik.model.pose import pose_error_geodesic  # noqa: E402
+from sweepik.model.units import orientation_weight  # noqa: E402
 
 
 def main() -> None:

@@ -30,7 +30,7 @@ from rewrites import rewrite  # noqa: E402
 from singular import recovered, singular_configurations  # noqa: E402
 
 import sweepik  # noqa: E402
-from sweepik.robot import Joint, Robot  # noqa: E402
+from sweepik.model.robot import Joint, Robot  # noqa: E402
 
 
 def ssik_module(name: str):  # type: ignore[no-untyped-def]

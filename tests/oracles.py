@@ -30,7 +30,7 @@ EAIK and IK-Geo describe the arm in product-of-exponentials form, which ``robot.
 ``P (n + 1, 3)``, ``R_end``; world frame at q = 0). Their end effector has orientation I at q = 0, so their
 target orientation is ``R_target @ R_end.T``. Quirk: ik_geo 1.0.3's Python layer reads the rotation matrix
 transposed (and returns its own ``forward_kinematics`` rotation transposed), so it is handed ``R.T``. ssik gets the
-same chain as a list of joint transforms (``sweepik.peers.ssik_manipulator``), in metres.
+same chain as a list of joint transforms (``sweepik.experiments.peers.ssik_manipulator``), in metres.
 """
 
 from __future__ import annotations
@@ -40,11 +40,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.peers import chain_arrays as _chain_arrays
-from sweepik.peers import eaik_robot as _eaik_robot
-from sweepik.peers import ikgeo_setup as _ikgeo_setup
-from sweepik.peers import metres_per_unit as _metres_per_unit
-from sweepik.peers import ssik_manipulator as _ssik_manipulator
+from sweepik.experiments.peers import chain_arrays as _chain_arrays
+from sweepik.experiments.peers import eaik_robot as _eaik_robot
+from sweepik.experiments.peers import ikgeo_setup as _ikgeo_setup
+from sweepik.experiments.peers import metres_per_unit as _metres_per_unit
+from sweepik.experiments.peers import ssik_manipulator as _ssik_manipulator
 
 Array = NDArray[np.float64]
 
@@ -547,7 +547,7 @@ def ssik_solutions(robot: Any, pose: np.ndarray, *, info: dict[str, Any] | None 
 def in_metres(robot: Any, name: str) -> Any:
     """The DH ``robot`` (length unit mm) written again in metres, from a robot file's dict: the same arm through
     another description (lengths, prismatic limits, centres of mass / 1000; masses and gravity unchanged)."""
-    from sweepik.robot_file import robot_from_dict
+    from sweepik.io.robot_file import robot_from_dict
 
     assert robot.length_unit == "mm" and robot.dh_convention != "none"
     joints = []

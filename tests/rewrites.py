@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from sweepik import Joint, Robot
-from sweepik.origin_axis import origin_axis_form
+from sweepik.model.origin_axis import origin_axis_form
 
 Array = np.ndarray
 

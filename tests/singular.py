@@ -79,8 +79,8 @@ def recovered(robot: Any, sols: Any, q: np.ndarray, tol: float = 1e-6) -> bool:
 
 
 def _geodesic(robot: Any, Q: np.ndarray, T: np.ndarray) -> np.ndarray:
-    from sweepik.pose import pose_error_geodesic
-    from sweepik.units import orientation_weight
+    from sweepik.model.pose import pose_error_geodesic
+    from sweepik.model.units import orientation_weight
 
     F = robot.fk(Q)
     return pose_error_geodesic(F, np.broadcast_to(T, F.shape), orientation_weight(robot.length_unit))
@@ -89,7 +89,7 @@ def _geodesic(robot: Any, Q: np.ndarray, T: np.ndarray) -> np.ndarray:
 def families_certified(robot: Any, sols: Any, T: np.ndarray, members: int = 9) -> None:
     """Every family of ``sols`` (a ``sweepik.Solutions`` of pose ``T``) has its members (``members`` along each)
     solve the pose to 1e-9 of the arm's size, and none lies on the others (``families.inner_off``)."""
-    from sweepik.families import inner_off
+    from sweepik.engine.families import inner_off
 
     for f in sols.families:
         m = f.at(np.linspace(f.interval[0], f.interval[1], members))

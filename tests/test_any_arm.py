@@ -26,9 +26,9 @@ from oracles import (
 
 import sweepik
 from sweepik import NoReductionError
+from sweepik.io.robot_file import bundled_robots, robot_from_dict
+from sweepik.model.structure import near_structure
 from sweepik.reductions.decompose import plans
-from sweepik.robot_file import bundled_robots, robot_from_dict
-from sweepik.structure import near_structure
 
 # the six-joint bundled arms (the seven-joint ones are solved with a joint locked: tests/test_locked.py)
 BUNDLED = [n for n in bundled_robots() if sweepik.load_robot(n).n_joints == 6]
@@ -546,8 +546,8 @@ def test_swept_slide_range_counts_the_other_slides():
     """A rail along the Stanford arm's first axis, its last joint held: PRRPRR with the rail swept. The rail's
     search range must include the travel of the arm's own slide (d3): without it, 12 of 20 poses were answered
     'unreachable'."""
-    from sweepik.origin_axis import hold_joints, origin_axis_form
-    from sweepik.robot import Joint, Robot
+    from sweepik.model.origin_axis import hold_joints, origin_axis_form
+    from sweepik.model.robot import Joint, Robot
 
     st = origin_axis_form(sweepik.load_robot("stanford"))
     rail = Joint(

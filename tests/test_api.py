@@ -35,7 +35,7 @@ def test_import_leaves_the_tools_a_solve_does_not_need_unloaded() -> None:
     import subprocess
     import sys
 
-    lazy = ("sweepik.design", "sweepik.distributed", "sweepik.urdf", "sweepik.workspace")
+    lazy = ("sweepik.experiments.design", "sweepik.distributed", "sweepik.io.urdf", "sweepik.experiments.workspace")
     code = f"import sys, sweepik; print([m for m in {lazy!r} if m in sys.modules])"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
@@ -54,7 +54,7 @@ MODULES = sorted(
 
 @pytest.mark.parametrize("module_name", MODULES)
 def test_docstring_examples_run(module_name: str) -> None:
-    if module_name == "sweepik.plot":
+    if module_name == "sweepik.experiments.plot":
         pytest.importorskip("matplotlib")
     module = importlib.import_module(module_name)
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False)

@@ -16,12 +16,12 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import solver
-from sweepik.cli import main
-from sweepik.robot_file import MAX_ANGLE_DEG, MAX_LENGTH, MAX_LIMIT, MAX_ROBOT_FILE_BYTES
+from sweepik import solving
+from sweepik.cli.app import main
+from sweepik.io.robot_file import MAX_ANGLE_DEG, MAX_LENGTH, MAX_LIMIT, MAX_ROBOT_FILE_BYTES
 from sweepik.trajectory import MAX_NPY_POSES, MAX_POSE_TEXT_BYTES, load_poses
 
-CARM_TOML = (Path(sweepik.__file__).parent / "robots" / "carm.toml").read_text()
+CARM_TOML = (Path(sweepik.__file__).parent / "io" / "robots" / "carm.toml").read_text()
 CARM = sweepik.load_robot("carm")
 Q_GOOD = np.array([700.0, 0.4, 0.3, -0.5, 0.6, 0.2])
 GOOD_POSE = CARM.fk(Q_GOOD)
@@ -252,15 +252,15 @@ def test_file_growing_after_stat_is_read_only_up_to_the_limit(tmp_path: Path, mo
     """The size seen by stat is not trusted: at most limit + 1 bytes are read."""
     path = tmp_path / "grows.toml"
     path.write_bytes(b"#" * (MAX_ROBOT_FILE_BYTES + 100))
-    from sweepik import _validate
+    from sweepik.model import validate
 
-    real = _validate.file_status
+    real = validate.file_status
 
     def stale(p: Path, error: type[sweepik.SweepikError], what: str) -> os.stat_result | None:
         st = real(p, error, what)
         return None if st is None else os.stat_result((st.st_mode, *[0] * 5, 10, *[0] * 3))
 
-    monkeypatch.setattr(_validate, "file_status", stale)
+    monkeypatch.setattr(validate, "file_status", stale)
     with pytest.raises(sweepik.RobotFileError, match="larger than"):
         sweepik.load_robot(path)
 
@@ -545,7 +545,7 @@ def test_pose_path_of_wrong_type(path: object) -> None:
         {"n_samples": None},
         {"n_samples": [64]},
         {"n_samples": 10**9},
-        {"n_samples": solver.MAX_SAMPLES + 1},
+        {"n_samples": solving.MAX_SAMPLES + 1},
         {"n_samples": 2**200},
         {"n_samples": 7},
         {"n_samples": -64},
@@ -576,7 +576,7 @@ def test_bad_solver_arguments(kwargs: dict[str, object]) -> None:
             sweepik.solve_many(CARM, batch, **kwargs)  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize("chunk", [0, -3, 2.5, 3.0, "10", None, True, solver.MAX_CHUNK + 1])
+@pytest.mark.parametrize("chunk", [0, -3, 2.5, 3.0, "10", None, True, solving.MAX_CHUNK + 1])
 def test_bad_chunk_size(chunk: object) -> None:
     for batch in (GOOD_POSE[None], []):
         with pytest.raises(sweepik.UnknownOptionError, match="chunk_size"):
@@ -659,16 +659,16 @@ def test_accepted_numpy_scalars_and_object_arrays() -> None:
 def test_large_n_samples_runs_in_small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     """Memory stays bounded by construction: chunk x n_samples <= SAMPLE_BUDGET, whatever chunk_size says."""
     sizes: list[int] = []
-    real = solver._solve_chunk
+    real = solving._solve_chunk
 
     def spy(robot: sweepik.Robot, red: Any, poses: np.ndarray, *args: Any, **kwargs: Any) -> Any:
         sizes.append(poses.shape[0])
         return real(robot, red, poses, *args, **kwargs)
 
-    monkeypatch.setattr(solver, "_solve_chunk", spy)
+    monkeypatch.setattr(solving, "_solve_chunk", spy)
     P = np.repeat(GOOD_POSE[None], 5, axis=0)
-    n = solver.SAMPLE_BUDGET // 2
-    assert n <= solver.MAX_SAMPLES
+    n = solving.SAMPLE_BUDGET // 2
+    assert n <= solving.MAX_SAMPLES
     many = sweepik.solve_many(CARM, P, n_samples=n, chunk_size=1000)
     assert sizes == [2, 2, 1] and len(many) == 5
     sizes.clear()

@@ -9,7 +9,7 @@ import pytest
 from oracles import in_limit_configurations
 
 import sweepik
-from sweepik.batch import SolutionBatch
+from sweepik.results import SolutionBatch
 
 
 def _poses(robot, rng, n):
@@ -83,7 +83,7 @@ def test_empty_batch():
 def test_read_only_poses(name: str, tmp_path) -> None:
     """Poses in a read-only array (a memory-mapped .npy file) solve like writable ones."""
     robot = sweepik.load_robot(name)
-    from sweepik.verify import random_configurations
+    from sweepik.experiments.verify import random_configurations
 
     poses = robot.fk(random_configurations(robot, 12, np.random.default_rng(4)))
     np.save(tmp_path / "p.npy", poses)

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import kinematics
-from sweepik.chain import rotation_about
 from sweepik.errors import RobotDefinitionError
-from sweepik.robot import Joint, Robot
+from sweepik.model import kinematics
+from sweepik.model.chain import rotation_about
+from sweepik.model.robot import Joint, Robot
 
 BUNDLED = sweepik.bundled_robots()
 
@@ -133,7 +133,7 @@ def test_unpickled_robot_solves() -> None:
     q = np.array([700.0, 0.3, 0.2, -0.4, 0.5, 0.1])
     sols = sweepik.solve(clone, arm.fk(q))
     assert np.min(np.abs(sols.q - q).max(axis=1)) < 1e-6
-    red = sweepik.CArmD1(arm)  # built for the original, used with its unpickled copy
+    red = sweepik.reductions.CArmD1(arm)  # built for the original, used with its unpickled copy
     assert sweepik.solve(clone, arm.fk(q), reduction=red).q.shape == sols.q.shape
 
 

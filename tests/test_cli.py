@@ -1,4 +1,4 @@
-"""The ``sweepik`` command line (sweepik.cli.main)."""
+"""The ``sweepik`` command line (sweepik.cli.app)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import pytest
 
 import sweepik
 from sweepik import load_robot
-from sweepik.cli import main
+from sweepik.cli.app import main
 
 CARM_ZERO = ["500", "0", "0", "0", "0", "0"]
 
@@ -269,7 +269,7 @@ def test_unreadable_robot_file_is_one_line(capsys: pytest.CaptureFixture[str], t
 )
 def test_cli_refuses_at_once(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     """Bad options and unwritable outputs fail before any computation: one stderr line, exit status 2."""
-    from sweepik.cli import main
+    from sweepik.cli.app import main
 
     assert main(argv) == 2
     err = capsys.readouterr().err
@@ -281,7 +281,7 @@ def test_interrupt_is_one_line_and_status_130(
 ) -> None:
     """Ctrl-C during a command (here: while a solve prints) ends with one line on stderr and status 130, not a
     traceback."""
-    import sweepik.cli as cli
+    import sweepik.cli.app as cli
 
     def interrupted(args: object) -> int:
         print("first pose")

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik.cli import main
+from sweepik.cli.app import main
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -40,7 +40,7 @@ def test_analyze_cli_text_and_json(capsys):
 
 
 def test_analyze_cli_outside_the_catalogue(capsys, tmp_path: Path):
-    text = (Path(sweepik.__file__).parent / "robots" / "puma560.toml").read_text()
+    text = (Path(sweepik.__file__).parent / "io" / "robots" / "puma560.toml").read_text()
     # joint 5's axis 30 mm off joint 4's and 6's: no spherical wrist, no two axes meeting at either end
     text = text.replace("alpha = 90.0\nlimits = [-100.0, 100.0]", "a = 0.03\nalpha = 90.0\nlimits = [-100.0, 100.0]")
     text = text.replace(

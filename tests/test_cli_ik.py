@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import bench, load_robot
-from sweepik.cli import main
-from sweepik.pose import xyz_zyz_from_pose
+from sweepik import load_robot
+from sweepik.cli.app import main
+from sweepik.experiments import bench
+from sweepik.model.pose import xyz_zyz_from_pose
 
 CARM = load_robot("carm")
 
@@ -85,7 +86,7 @@ def test_path_writes_joint_csv(capsys: pytest.CaptureFixture[str], tmp_path: Pat
 
 
 def test_verify_json_contract(monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
-    import sweepik.verify as verify
+    import sweepik.experiments.verify as verify
 
     full = verify.grid_configurations
 
@@ -105,7 +106,7 @@ def test_verify_json_contract(monkeypatch: pytest.MonkeyPatch, tmp_path: Path, c
 
 
 def test_bench_runs_small(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
-    import sweepik.bench as bench
+    import sweepik.experiments.bench as bench
 
     monkeypatch.setattr(bench, "grid_configurations", lambda include_singular=False: bench_grid_small())
     argv = ["bench", "--single", "20", "--paper", "5", "--memory", "0", "--repeats", "1", "--batch", "8", "--json"]
@@ -143,7 +144,7 @@ def test_bench_times_the_solvers_of_an_arm_in_turn(monkeypatch: pytest.MonkeyPat
     solver."""
     import numpy as np
 
-    from sweepik.bench import _side_by_side
+    from sweepik.experiments.bench import _side_by_side
 
     monkeypatch.setattr(bench, "SINGLE_BLOCK", 2)
 
@@ -172,7 +173,7 @@ def test_bench_arms_unknown_robot_is_one_line(capsys: pytest.CaptureFixture[str]
 
 
 def bench_grid_small() -> np.ndarray:
-    from sweepik.verify import grid_configurations
+    from sweepik.experiments.verify import grid_configurations
 
     return grid_configurations(False)[::159][:100]
 

@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import sweepik.cli_common as cli_common
-import sweepik.cli_solve as cli_solve
-import sweepik.solver as solver
+import sweepik.cli.common as cli_common
+import sweepik.cli.solve as cli_solve
+import sweepik.solving as solver
 from sweepik import load_robot, solve_many
-from sweepik.cli import main
-from sweepik.cli_common import _is_number, _print_json, _print_json_stream, _Progress
+from sweepik.cli.app import main
+from sweepik.cli.common import _is_number, _print_json, _print_json_stream, _Progress
 from sweepik.trajectory import follow_path
 
 CARM = load_robot("carm")
@@ -215,8 +215,8 @@ def test_progress_class(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 def test_bench_progress_on_a_terminal(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
-    import sweepik.bench as bench
-    from sweepik.verify import grid_configurations
+    import sweepik.experiments.bench as bench
+    from sweepik.experiments.verify import grid_configurations
 
     monkeypatch.setattr(bench, "grid_configurations", lambda include_singular=False: grid_configurations()[:20])
     monkeypatch.setattr(cli_common, "PROGRESS_AFTER_S", 0.0)
@@ -236,9 +236,9 @@ def test_bench_progress_on_a_terminal(capsys: pytest.CaptureFixture[str], monkey
 
 def _no_work(monkeypatch: pytest.MonkeyPatch) -> None:
     """Make every long computation fail the test if it starts."""
-    import sweepik.bench as bench
+    import sweepik.experiments.bench as bench
+    import sweepik.experiments.verify as verify
     import sweepik.trajectory as trajectory
-    import sweepik.verify as verify
 
     def fail(*args: object, **kwargs: object) -> None:
         raise AssertionError("computation started before the bad argument was refused")
@@ -407,7 +407,7 @@ def test_multiplicity_column_only_where_a_root_is_multiple(capsys: pytest.Captur
 
 
 def test_format_table_with_known_numeric_columns_is_unchanged() -> None:
-    from sweepik.cli_common import _format_table
+    from sweepik.cli.common import _format_table
 
     header = ["#", "d1 [mm]", "theta2 [deg]", "J [mm]", "in limits", "multiplicity"]
     rows = [

@@ -13,7 +13,7 @@ import sys
 
 import pytest
 
-from sweepik import fastsweep
+from sweepik.engine import search
 
 SCRIPT = """
 import numpy as np, sweepik
@@ -24,7 +24,7 @@ for name, kw in (("ur5", {}), ("carm", {"reduction": "auto"}), ("fanuc_crx10ia",
 """
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="the NumPy engine compiles nothing")
+@pytest.mark.skipif(not search.AVAILABLE, reason="the NumPy engine compiles nothing")
 def test_second_process_compiles_nothing():
     env = dict(os.environ, NUMBA_DEBUG_CACHE="1")
     run = [sys.executable, "-c", SCRIPT]

@@ -1,4 +1,5 @@
-"""Continua along a joint other than theta*, traced numerically (sweepik.continuation): the automatic decomposition
+"""Continua along a joint other than theta*, traced numerically (sweepik.engine.continuation): the automatic
+decomposition
 of the C-Arm (rail swept) on its theta2 self-motion, the closed-form wrist arm (carm_swapped) on its own, joint
 limits on the traced joint, batches, and no false alarm at random poses. The traced members are checked against an
 independent reduction (the hand-written carm-theta2, which sweeps theta2) and by forward kinematics."""
@@ -13,12 +14,12 @@ import numpy as np
 import pytest
 
 from sweepik import SweepikError, load_robot, solve, solve_many
-from sweepik.pose import pose_error_geodesic
+from sweepik.io.robot_file import robot_from_dict
+from sweepik.model.pose import pose_error_geodesic
+from sweepik.model.units import orientation_weight
 from sweepik.reductions import get_reduction
-from sweepik.robot_file import robot_from_dict
-from sweepik.solutions import joint_distance
-from sweepik.solver import ACCEPT_TOL_REL, _chain_poses
-from sweepik.units import orientation_weight
+from sweepik.results import joint_distance
+from sweepik.solving import ACCEPT_TOL_REL, _chain_poses
 
 CARM = load_robot("carm")
 #: "the same configuration": every joint within this (mm, radians modulo 2 pi)
@@ -95,7 +96,7 @@ def test_closed_form_with_a_position_continuum() -> None:
 
 
 def _carm_with_theta2_limits(lo: float, hi: float):
-    data = copy.deepcopy(tomllib.loads((resources.files("sweepik") / "robots" / "carm.toml").read_text()))
+    data = copy.deepcopy(tomllib.loads((resources.files("sweepik.io") / "robots" / "carm.toml").read_text()))
     data["joints"][1]["limits"] = [lo, hi]
     data["name"] = "carm_theta2_limited"
     return robot_from_dict(data, "variant.toml")
@@ -135,7 +136,7 @@ def test_no_continuum_at_random_poses(name: str) -> None:
 def _elbow_manipulator():
     """The PUMA 560 without its shoulder offsets (axes 1 and 2 meet): a spherical-wrist closed form whose shoulder
     singularity (the wrist centre on joint 1's axis) leaves joint 1 free."""
-    data = copy.deepcopy(tomllib.loads((resources.files("sweepik") / "robots" / "puma560_std.toml").read_text()))
+    data = copy.deepcopy(tomllib.loads((resources.files("sweepik.io") / "robots" / "puma560_std.toml").read_text()))
     data["joints"][2]["a"], data["joints"][2]["d"] = 0.0, 0.0
     for joint in data["joints"]:
         joint["limits"] = [-180.0, 180.0]
@@ -148,7 +149,7 @@ def test_shoulder_singularity_of_an_elbow_manipulator() -> None:
     (two elbows, two wrists), each certified, one of them holding the generating configuration."""
     from scipy.optimize import brentq
 
-    from sweepik.kinematics import chain_frames
+    from sweepik.model.kinematics import chain_frames
 
     robot = _elbow_manipulator()
     rng = np.random.default_rng(8)

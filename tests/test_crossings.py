@@ -13,8 +13,8 @@ from scipy.optimize import brentq
 from singular import recovered
 
 import sweepik
-from sweepik.pose import pose_error_geodesic
-from sweepik.units import orientation_weight
+from sweepik.model.pose import pose_error_geodesic
+from sweepik.model.units import orientation_weight
 
 
 def _shoulder_singular(robot: sweepik.Robot, rng: np.random.Generator) -> np.ndarray:

@@ -24,18 +24,11 @@ import pytest
 from distributed import Client, LocalCluster
 from test_store import CARM, CARM_FAMILY_Q, UR5, UR5_FAMILY_Q, assert_same_batch, test_poses, write_store
 
-from sweepik import (
-    CArmD1,
-    InvalidPoseError,
-    StoreError,
-    UnknownOptionError,
-    load_solutions,
-    solve_dask,
-    solve_many,
-)
+from sweepik import InvalidPoseError, StoreError, UnknownOptionError, load_solutions, solve_dask, solve_many
 from sweepik import errors as sweepik_errors
-from sweepik.cli import main
-from sweepik.store import store_info
+from sweepik.cli.app import main
+from sweepik.io.store import store_info
+from sweepik.reductions import CArmD1
 
 #: Seconds to wait for a subprocess to store chunks or to end (generous: the machine may be busy).
 WAIT_S = 120
@@ -289,7 +282,7 @@ def test_default_chunking_is_solve_many_bit_for_bit_on_a_swept_arm(client: Clien
     import sweepik
 
     arm = sweepik.load_robot("fanuc_crx10ia")
-    from sweepik.verify import random_configurations
+    from sweepik.experiments.verify import random_configurations
 
     P = arm.fk(random_configurations(arm, 2500, np.random.default_rng(5)))
     assert_same_batch(solve_dask(arm, P, client, out=tmp_path / "f.zarr"), solve_many(arm, P))

@@ -1,4 +1,4 @@
-"""The compiled wrap/limits/dedupe pass (``sweepik.dedupe.finish``) equals its NumPy reference, and both keep one
+"""The compiled wrap/limits/dedupe pass (``sweepik.engine.dedupe.finish``) equals its NumPy reference, and both keep one
 of each set of equal candidates: the best, ties to the earliest, across the +-pi seam and beyond-pi limits."""
 
 from __future__ import annotations
@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import dedupe, fastsweep
+from sweepik.engine import dedupe, search
 
-pytestmark = pytest.mark.skipif(not fastsweep.AVAILABLE, reason="compares the compiled pass with the reference")
+pytestmark = pytest.mark.skipif(not search.AVAILABLE, reason="compares the compiled pass with the reference")
 
 
 def _candidates(robot: sweepik.Robot, rng: np.random.Generator, n_poses: int, per_pose: int):
@@ -82,7 +82,7 @@ def test_a_continuum_across_the_seam_deduplicates_as_the_reference(joint: int, m
 def test_a_continuum_of_tens_of_thousands_of_points_collapses_in_bounded_memory() -> None:
     """40,000 certified points along one arc of a pose (a numerical continuum) and 5 isolated ones: the arc is
     reported by one medoid (before, the all-pairs comparison asked for (K, K, 6) floats: 77 GB)."""
-    from sweepik.families import collapse_continua
+    from sweepik.engine.families import collapse_continua
 
     robot = sweepik.load_robot("ur5")
     t = np.linspace(-1.0, 1.0, 40_000)
@@ -103,7 +103,8 @@ def test_one_pass_settling_equals_the_solver_steps(
     snap onto a limit left to the solver's steps, the others settled at once, in parts on the batch threads) gives
     bit for bit what the steps alone give: batches with singular wrists, solutions at a joint limit, random poses,
     with and without limits."""
-    from sweepik import parallel, solver
+    from sweepik import solving
+    from sweepik.engine import parallel
 
     monkeypatch.setattr(parallel, "threads", lambda: 3)  # parts on threads, whatever the machine's cores
     monkeypatch.setattr(dedupe, "_PARALLEL_ROWS", 64)
@@ -125,11 +126,11 @@ def test_one_pass_settling_equals_the_solver_steps(
         settled.append(0 if out is None else out[1].size)
         return out
 
-    monkeypatch.setattr(solver, "settle", counting)
+    monkeypatch.setattr(solving, "settle", counting)
     got = [sweepik.solve_many(robot, poses, reduction=reduction, limits=lim) for lim in (True, False)]
     assert sum(due) > 0, "no pose was due the solver's steps: the mixed case is not exercised"
     assert sum(settled) > 0, "no candidate was settled in one pass"
-    monkeypatch.setattr(solver, "settle", lambda *args, **kwargs: None)
+    monkeypatch.setattr(solving, "settle", lambda *args, **kwargs: None)
     ref = [sweepik.solve_many(robot, poses, reduction=reduction, limits=lim) for lim in (True, False)]
     for a, b in zip(got, ref, strict=True):
         for column in ("offsets", "q", "error", "error_geodesic", "within_limits", "multiplicity", "n_reachable"):

@@ -10,10 +10,10 @@ import pytest
 from oracles import in_metres
 
 from sweepik import load_robot
-from sweepik.cli import main
-from sweepik.design import compare_designs
+from sweepik.cli.app import main
 from sweepik.errors import UnknownOptionError
-from sweepik.statics import gravity_torques
+from sweepik.experiments.design import compare_designs
+from sweepik.experiments.statics import gravity_torques
 
 SMALL = {"samples": 120, "workspace_samples": 20_000}
 

@@ -16,9 +16,9 @@ from oracles import recovers, same_solution_set
 from rewrites import rewrite
 
 from sweepik import load_robot, solve
-from sweepik.robot_file import bundled_robots
-from sweepik.units import mm_per_unit
-from sweepik.urdf import read_urdf, urdf_text
+from sweepik.io.robot_file import bundled_robots
+from sweepik.io.urdf import read_urdf, urdf_text
+from sweepik.model.units import mm_per_unit
 
 ARMS = [name for name in bundled_robots() if load_robot(name).n_joints == 6]
 

@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import fastsolve, fastsweep, load_robot, solver
+from sweepik import load_robot, solving
+from sweepik.engine import one_pose, search
 
-pytestmark = pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+pytestmark = pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 
 
 def _poses(robot: sweepik.Robot, seed: int) -> np.ndarray:
@@ -44,7 +45,7 @@ def _assert_same(a: sweepik.Solutions, b: sweepik.Solutions) -> None:
 
 def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, poses: np.ndarray, **kw: Any) -> list[Any]:
     with monkeypatch.context() as m:
-        m.setattr(solver, "_settled", lambda *args: None)
+        m.setattr(solving, "_settled", lambda *args: None)
         return [sweepik.solve(robot, T, **kw) for T in poses]
 
 
@@ -52,14 +53,14 @@ def _counted(monkeypatch: pytest.MonkeyPatch) -> Counter[int]:
     """Counts of ``settle_one``'s statuses from now on."""
     seen: Counter[int] = Counter()
     for name in ("settle_one", "settle_closed"):
-        real = getattr(fastsolve, name)
+        real = getattr(one_pose, name)
 
         def counting(*args: Any, real: Any = real) -> Any:
             out = real(*args)
             seen[-1 if out is None else out.status] += 1
             return out
 
-        monkeypatch.setattr(fastsolve, name, counting)
+        monkeypatch.setattr(one_pose, name, counting)
     return seen
 
 
@@ -96,7 +97,7 @@ def test_one_call_is_the_general_path(
     robot = load_robot(name)
     poses = _poses(robot, 5)
     seen = _both_ways(monkeypatch, robot, poses, reduction=reduction, limits=limits)
-    assert seen[fastsolve.OK] >= len(poses) // 2  # (the one-call path is what is tested)
+    assert seen[one_pose.OK] >= len(poses) // 2  # (the one-call path is what is tested)
 
 
 @pytest.mark.parametrize("name", ["ur5", "fanuc_crx10ia", "carm"])
@@ -111,18 +112,18 @@ def test_unreachable_poses_meeting_branches_singular_wrists(name: str, monkeypat
     far = np.eye(4)
     far[:3, 3] = 10.0 * robot.length_scale
     seen = _both_ways(monkeypatch, robot, far[None])
-    assert seen[fastsolve.OK] == 1
+    assert seen[one_pose.OK] == 1
     sol = sweepik.solve(robot, far)
     assert len(sol) == 0 and sol.reason is not None and "unreachable" in sol.reason
     if name == "ur5":
         q = np.random.default_rng(13).uniform(robot.lower, robot.upper, (6, 6))
         q[:, 2] = 0.0
-        assert _both_ways(monkeypatch, robot, robot.fk(q)) == {fastsolve.MEET: len(q)}
+        assert _both_ways(monkeypatch, robot, robot.fk(q)) == {one_pose.MEET: len(q)}
         assert all((sweepik.solve(robot, T).multiplicity == 2).any() for T in robot.fk(q))
         q[:, 2] = 0.4
         q[:, 4] = 0.0
         seen = _both_ways(monkeypatch, robot, robot.fk(q))  # (the wrist's branches meet there too: MEET first)
-        assert fastsolve.OK not in seen and seen[fastsolve.SINGULAR] > 0
+        assert one_pose.OK not in seen and seen[one_pose.SINGULAR] > 0
         assert all(sweepik.solve(robot, T).families for T in robot.fk(q))
 
 
@@ -130,10 +131,10 @@ def test_a_class_overriding_the_singular_checks_keeps_them(monkeypatch: pytest.M
     """A closed form whose class overrides ``degenerate`` (and not ``singular_kernel``) has it asked in Python on every
     pose the one call settles: here it flags every pose, so each goes to the fallback sweep, the general way."""
     robot = load_robot("ur5")
-    red = sweepik.get_reduction(robot, None)
+    red = sweepik.reductions.get_reduction(robot, None)
     asked: list[int] = []
 
-    class EveryPoseDegenerate(sweepik.GeometricReduction):
+    class EveryPoseDegenerate(sweepik.reductions.GeometricReduction):
         def degenerate(self, poses: np.ndarray) -> np.ndarray:
             asked.append(len(poses))
             return np.ones(len(poses), dtype=bool)
@@ -142,11 +143,11 @@ def test_a_class_overriding_the_singular_checks_keeps_them(monkeypatch: pytest.M
     poses = _poses(robot, 14)[24:30]  # (random ones: the kernel would flag none)
     seen = _counted(monkeypatch)
     settled: list[object] = []
-    real = solver._settled
-    monkeypatch.setattr(solver, "_settled", lambda *args: settled.append(real(*args)) or settled[-1])
+    real = solving._settled
+    monkeypatch.setattr(solving, "_settled", lambda *args: settled.append(real(*args)) or settled[-1])
     for T in poses:
         assert len(sweepik.solve(robot, T, reduction=own)) > 0
-    assert seen[fastsolve.OK] == len(poses) and asked and settled == [None] * len(poses)
+    assert seen[one_pose.OK] == len(poses) and asked and settled == [None] * len(poses)
 
 
 @pytest.mark.parametrize(("name", "names"), [("ur5", ["auto"]), ("carm", ["carm-d1", "d1"])])
@@ -161,7 +162,7 @@ def test_the_default_reduction_named_takes_the_one_call(
     robot = load_robot(name)
     poses = _poses(robot, 15)[20:26]
     want = [sweepik.solve(robot, T) for T in poses]
-    monkeypatch.setattr(solver, "_prepare", lambda *args: pytest.fail("options checked again"))
+    monkeypatch.setattr(solving, "_prepare", lambda *args: pytest.fail("options checked again"))
     for r in names:
         assert is_default(robot, r)
         for a, b in zip([sweepik.solve(robot, T, reduction=r) for T in poses], want, strict=True):
@@ -178,7 +179,7 @@ def test_a_locked_arm_takes_the_one_call(name: str, monkeypatch: pytest.MonkeyPa
     """A seven-joint arm with a joint locked (its held arm a closed form) takes the one call too, its solutions full
     length with the held value in place, the general path's bit for bit; poses with the held arm's wrist singular
     go the general way."""
-    from sweepik.bench import _bench_lock
+    from sweepik.experiments.bench import _bench_lock
 
     robot = load_robot(name)
     locked = _bench_lock(robot)
@@ -187,7 +188,7 @@ def test_a_locked_arm_takes_the_one_call(name: str, monkeypatch: pytest.MonkeyPa
     for j, v in locked.items():
         q[:, j] = v
     seen = _both_ways(monkeypatch, robot, robot.fk(q), locked=locked)
-    assert seen[fastsolve.OK] >= len(q) // 2
+    assert seen[one_pose.OK] >= len(q) // 2
     for T, qq in zip(robot.fk(q), q, strict=True):
         sols = sweepik.solve(robot, T, locked=locked)
         assert sols.q.shape[1] == robot.n_joints and np.all(sols.q[:, list(locked)] == list(locked.values()))
@@ -199,8 +200,8 @@ def test_overflowing_buffers_go_the_general_way(monkeypatch: pytest.MonkeyPatch)
     it), with the same solutions."""
     robot = load_robot("fanuc_crx10ia")
     poses = _poses(robot, 6)[::6]
-    monkeypatch.setattr(fastsweep, "MAX_CAND", 1)
-    assert _both_ways(monkeypatch, robot, poses) == {fastsolve.SEARCH_ELSEWHERE: len(poses)}
+    monkeypatch.setattr(search, "MAX_CAND", 1)
+    assert _both_ways(monkeypatch, robot, poses) == {one_pose.SEARCH_ELSEWHERE: len(poses)}
     assert all(len(sweepik.solve(robot, T)) > 0 for T in poses)
 
 
@@ -209,9 +210,9 @@ def test_a_pose_due_a_polish_goes_the_general_way(monkeypatch: pytest.MonkeyPatc
     sends its pose the general way, which polishes it."""
     robot = load_robot("carm")
     poses = _poses(robot, 7)[20:26]
-    monkeypatch.setattr(solver, "POLISH_ABOVE_REL", 0.0)
-    monkeypatch.setattr(solver, "POLISH_PAPER_ABOVE_REL", 0.0)
-    assert _both_ways(monkeypatch, robot, poses) == {fastsolve.DUE: len(poses)}
+    monkeypatch.setattr(solving, "POLISH_ABOVE_REL", 0.0)
+    monkeypatch.setattr(solving, "POLISH_PAPER_ABOVE_REL", 0.0)
+    assert _both_ways(monkeypatch, robot, poses) == {one_pose.DUE: len(poses)}
     assert all(len(sweepik.solve(robot, T)) > 0 for T in poses)
 
 
@@ -223,4 +224,4 @@ def test_other_sample_counts(name: str, n_samples: int, one_call: bool, monkeypa
     only its own (the pose goes the general way); the same solutions either way."""
     robot = load_robot(name)
     poses = _poses(robot, 9)[::4]
-    assert (_both_ways(monkeypatch, robot, poses, n_samples=n_samples)[fastsolve.OK] > 0) == one_call
+    assert (_both_ways(monkeypatch, robot, poses, n_samples=n_samples)[one_pose.OK] > 0) == one_call

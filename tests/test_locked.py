@@ -22,10 +22,10 @@ from oracles import ikgeo_solutions, in_limit_configurations, numerical_solution
 
 import sweepik
 from sweepik import LockedJointError
-from sweepik.cli import main
-from sweepik.origin_axis import hold_joints, joint_origins, origin_axis_form
-from sweepik.robot import Joint, Robot
-from sweepik.robot_file import _parse, robot_to_toml
+from sweepik.cli.app import main
+from sweepik.io.robot_file import _parse, robot_to_toml
+from sweepik.model.origin_axis import hold_joints, joint_origins, origin_axis_form
+from sweepik.model.robot import Joint, Robot
 
 SEVEN = ["franka_panda", "kuka_iiwa14"]
 

@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import RobotDefinitionError, fastsweep, load_robot, solve, solve_many
-from sweepik.families import MAX_ISOLATED_SOLUTIONS
-from sweepik.pose import pose_error_geodesic
-from sweepik.robot_file import robot_from_dict
-from sweepik.solutions import joint_distance
+from sweepik import RobotDefinitionError, load_robot, solve, solve_many
+from sweepik.engine import search
+from sweepik.engine.families import MAX_ISOLATED_SOLUTIONS
+from sweepik.io.robot_file import robot_from_dict
+from sweepik.model.pose import pose_error_geodesic
+from sweepik.results import joint_distance
 
 CARM = load_robot("carm")
 REDUCTIONS = ["carm-d1", "carm-theta2"]
@@ -137,7 +138,7 @@ def test_near_continuum_is_not_hundreds_of_copies(scale: float, rng: np.random.G
         assert _certified(sol, TT)
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize("reduction", REDUCTIONS)
 def test_engines_agree_on_the_singular_set(
     reduction: str, rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
@@ -149,7 +150,7 @@ def test_engines_agree_on_the_singular_set(
     q = q[CARM.within_limits(q)]
     T = CARM.fk(q)
     fast = solve_many(CARM, T, reduction=reduction)
-    monkeypatch.setattr(fastsweep, "AVAILABLE", False)
+    monkeypatch.setattr(search, "AVAILABLE", False)
     ref = solve_many(CARM, T, reduction=reduction)
     for a, b, qq in zip(fast, ref, q, strict=True):
         assert _index_of(a, qq) is not None and _index_of(b, qq) is not None
@@ -158,7 +159,7 @@ def test_engines_agree_on_the_singular_set(
 
 
 def _carm_variant(joint: int, field: str, value: object) -> dict:
-    data = tomllib.loads((resources.files("sweepik") / "robots" / "carm.toml").read_text())
+    data = tomllib.loads((resources.files("sweepik.io") / "robots" / "carm.toml").read_text())
     data = copy.deepcopy(data)
     data["joints"][joint][field] = value
     return data
@@ -248,7 +249,7 @@ def test_closed_form_elbow_double_root_is_one_solution_at_the_root(family: str) 
 def test_near_pairs_compiled_is_the_reference(rng: np.random.Generator) -> None:
     """``dedupe.near_pairs`` (compiled) finds the pairs its NumPy reference finds: rows of one pose within a reach
     per joint, revolute ones modulo 2 pi (pairs straddling +-pi included), dropped rows left out."""
-    from sweepik import dedupe
+    from sweepik.engine import dedupe
 
     robot = load_robot("stanford")  # (a slide among the joints)
     K = 400

@@ -1,4 +1,5 @@
-"""Batch kernels on threads (sweepik.parallel): every item once, in parts, serial for small batches or one thread."""
+"""Batch kernels on threads (sweepik.engine.parallel): every item once, in parts, serial for small batches or one
+thread."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import threading
 import numpy as np
 import pytest
 
-from sweepik import fastsweep, parallel
+from sweepik.engine import parallel, search
 
 
 def _record(out, seen, start, stop):
@@ -37,7 +38,7 @@ def test_kernel_error_is_raised():
         parallel.run(fail, 1000, 1)
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="Numba's thread setting")
+@pytest.mark.skipif(not search.AVAILABLE, reason="Numba's thread setting")
 def test_numba_thread_setting_is_honoured():
     import numba
 
@@ -84,7 +85,7 @@ def test_in_order_threads_see_the_callers_setting():
     assert parallel.threads() == n  # (the setting is the chunk threads' own)
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="Numba's thread setting")
+@pytest.mark.skipif(not search.AVAILABLE, reason="Numba's thread setting")
 def test_in_order_with_one_thread_runs_in_the_calling_thread():
     import numba
 
@@ -119,21 +120,21 @@ def test_a_generic_sweeps_small_batch_is_split_in_two(name: str, split: bool, mo
     import numba
 
     import sweepik
-    from sweepik import solver
+    from sweepik import solving
 
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("one thread: nothing to split for")
     robot = sweepik.load_robot(name)
-    n = 3 * solver.SPLIT_MIN + 1
+    n = 3 * solving.SPLIT_MIN + 1
     T = robot.fk(np.random.default_rng(3).uniform(robot.lower, robot.upper, (n, 6)))
     seen: list[tuple[int, int]] = []
-    real = solver._solve_chunk
+    real = solving._solve_chunk
 
     def chunk(r: object, red: object, P: np.ndarray, *a: object) -> object:
         seen.append((len(P), parallel.threads()))
         return real(r, red, P, *a)
 
-    monkeypatch.setattr(solver, "_solve_chunk", chunk)
+    monkeypatch.setattr(solving, "_solve_chunk", chunk)
     before = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
@@ -144,8 +145,8 @@ def test_a_generic_sweeps_small_batch_is_split_in_two(name: str, split: bool, mo
         both = sweepik.solve_many(robot, T)
         assert sorted(seen) == ([(n // 2, 1), (n - n // 2, 1)] if split else [(n, 2)])
         seen.clear()
-        sweepik.solve_many(robot, T[: solver.SPLIT_MIN * parallel.IN_FLIGHT - 1])
-        assert seen == [(solver.SPLIT_MIN * parallel.IN_FLIGHT - 1, 2)]
+        sweepik.solve_many(robot, T[: solving.SPLIT_MIN * parallel.IN_FLIGHT - 1])
+        assert seen == [(solving.SPLIT_MIN * parallel.IN_FLIGHT - 1, 2)]
     finally:
         numba.set_num_threads(before)
     for column in ("q", "error", "error_geodesic", "multiplicity", "within_limits", "offsets"):

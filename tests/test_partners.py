@@ -1,5 +1,5 @@
 """Two close solutions across a fold (issue 35, point 3): next to a singular set a pose has two solutions a hair apart,
-and the polish of a candidate between them converges to one. ``sweepik.partners`` finds the other along the
+and the polish of a candidate between them converges to one. ``sweepik.engine.partners`` finds the other along the
 Jacobian's nearly null direction; along a continuum it finds nothing (Newton from the midpoint stays there)."""
 
 from __future__ import annotations
@@ -10,12 +10,12 @@ import numpy as np
 from singular import recovered, singular_configurations
 
 import sweepik
-from sweepik.continuation import scaled_singular
-from sweepik.partners import close_partners, valley_bottoms
-from sweepik.polish import geodesic_errors, polished
-from sweepik.solutions import joint_distance
-from sweepik.solver import ACCEPT_TOL_REL
-from sweepik.units import orientation_weight
+from sweepik.engine.continuation import scaled_singular
+from sweepik.engine.partners import close_partners, valley_bottoms
+from sweepik.engine.polish import geodesic_errors, polished
+from sweepik.model.units import orientation_weight
+from sweepik.results import joint_distance
+from sweepik.solving import ACCEPT_TOL_REL
 
 #: A CRX-10iA configuration 1e-5 off its singular set whose pose has a second solution 2e-5 rad away (1.5e-8 rad
 #: apart in the sweep's joint 1, 6e-8 rad from the edge of its branch's domain); only that one came back.

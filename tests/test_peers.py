@@ -1,4 +1,5 @@
-"""The ssik adapter of sweepik.peers (skipped without ``ssik``): the chain handed to ssik reproduces the arm's FK,
+"""The ssik adapter of sweepik.experiments.peers (skipped without ``ssik``): the chain handed to ssik reproduces the
+arm's FK,
 a prebuilt artifact is found only for the same geometry (base and tool transforms fitted), and ssik's solve under
 the options the benchmark uses returns the set sweepik's default returns (joint limits applied, one configuration
 per geometric branch: no second 2 pi winding of a joint whose limits span more than 2 pi). Arms chosen so that no
@@ -13,7 +14,7 @@ import pytest
 from oracles import in_limit_configurations, same_solution_set
 
 import sweepik
-from sweepik.peers import metres_per_unit, ssik_manipulator, ssik_prebuilt, ssik_solver, ssik_status
+from sweepik.experiments.peers import metres_per_unit, ssik_manipulator, ssik_prebuilt, ssik_solver, ssik_status
 
 pytest.importorskip("ssik")
 

@@ -18,11 +18,11 @@ from rewrites import rotation
 
 import sweepik
 from sweepik import load_robot, solve
-from sweepik.origin_axis import origin_axis_form
+from sweepik.io.robot_file import bundled_robots
+from sweepik.model.origin_axis import origin_axis_form
+from sweepik.model.structure import NEAR_TOL, PARALLEL_TOL, near_structure
 from sweepik.plan_check import N_CHECK, check_plan
 from sweepik.reductions import decompose
-from sweepik.robot_file import bundled_robots
-from sweepik.structure import NEAR_TOL, PARALLEL_TOL, near_structure
 
 
 def _tilted(name: str, joint: int, angle: float) -> sweepik.Robot:

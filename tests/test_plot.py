@@ -1,4 +1,4 @@
-"""Tests of sweepik.plot under the Agg backend: figures are produced, carry the data, and never show()."""
+"""Tests of sweepik.experiments.plot under the Agg backend: figures are produced, carry the data, and never show()."""
 
 from __future__ import annotations
 
@@ -10,15 +10,10 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt  # noqa: E402
 
-import sweepik.verify as V  # noqa: E402
+import sweepik.experiments.verify as V  # noqa: E402
 from sweepik import load_robot  # noqa: E402
 from sweepik.errors import SweepikError  # noqa: E402
-from sweepik.plot import (  # noqa: E402
-    plot_figure4,
-    plot_joints_along_path,
-    plot_trajectory_3d,
-    save_verification_figures,
-)
+from sweepik.experiments.plot import plot_figure4, plot_joints_along_path, plot_trajectory_3d, save_verification_figures  # noqa: E402
 
 CARM = load_robot("carm")
 

@@ -6,15 +6,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sweepik import fastcertify, load_robot
-from sweepik.polish import geodesic_errors, polish
-from sweepik.units import orientation_weight
+from sweepik import load_robot
+from sweepik.engine import certify
+from sweepik.engine.polish import geodesic_errors, polish
+from sweepik.model.units import orientation_weight
 
 
 @pytest.mark.parametrize("name", ["ur5", "carm", "stanford", "kinova_jaco2"])
 @pytest.mark.parametrize("held", [False, True])
 def test_compiled_polish_is_the_numpy_polish(name: str, held: bool, monkeypatch: pytest.MonkeyPatch) -> None:
-    if not fastcertify.AVAILABLE:
+    if not certify.AVAILABLE:
         pytest.skip("needs Numba")
     robot = load_robot(name)
     rng = np.random.default_rng(5)
@@ -31,7 +32,7 @@ def test_compiled_polish_is_the_numpy_polish(name: str, held: bool, monkeypatch:
         start = np.where(fixed, exact, start)
     w = orientation_weight(robot.length_unit)
     compiled = polish(robot, start, target, w, fixed=fixed)
-    monkeypatch.setattr(fastcertify, "AVAILABLE", False)
+    monkeypatch.setattr(certify, "AVAILABLE", False)
     numpy = polish(robot, start, target, w, fixed=fixed)
     monkeypatch.undo()
     tol = 1e-11 * robot.length_scale

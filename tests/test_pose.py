@@ -1,4 +1,4 @@
-"""Z-Y-Z Euler angles, pose construction and the pose error metrics (sweepik.pose)."""
+"""Z-Y-Z Euler angles, pose construction and the pose error metrics (sweepik.model.pose)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from sweepik import (
     xyz_zyz_from_pose,
     zyz_from_matrix,
 )
-from sweepik.pose import GIMBAL_TOL
+from sweepik.model.pose import GIMBAL_TOL
 
 angles = st.floats(-np.pi, np.pi, allow_nan=False)
 #: Betas at and near both gimbal cases, and regular ones.
@@ -287,10 +287,10 @@ def test_compiled_wrap_is_the_numpy_wrap_bit_for_bit() -> None:
     """``_wrap.wrap_pi`` (compiled code's wrap, with a fast path for |pi - x| < 2 pi) gives exactly what the NumPy
     expression gives: at the fast path's ends, at multiples of pi, at +-0, an ulp from the ends, far out, inf, NaN."""
     numba = pytest.importorskip("numba")
-    from sweepik import fastsweep
-    from sweepik._wrap import wrap_pi
+    from sweepik.engine import search
+    from sweepik.subproblems.trig import wrap_pi
 
-    if not fastsweep.AVAILABLE:
+    if not search.AVAILABLE:
         pytest.skip("the NumPy engine runs without compiled code")
 
     @numba.njit

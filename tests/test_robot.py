@@ -26,7 +26,7 @@ from sweepik import (
     load_robot,
     robot_from_dict,
 )
-from sweepik.robot import LIMIT_TOL
+from sweepik.model.robot import LIMIT_TOL
 
 CARM_TOML = """\
 name = "mycarm"

@@ -1,6 +1,7 @@
 """Continua that the swept closed form reproduces only roughly (issue 35, point 4: a UR5 with its wrist straight, 3-20 s
 a pose): the sweep along joint 4 sits at a branch-domain edge along the whole continuum, its residual carries the
-square root of rounding and crosses zero hundreds of times. ``sweepik.rough_continua`` recognises such stretches from
+square root of rounding and crosses zero hundreds of times. ``sweepik.engine.rough_continua`` recognises such stretches
+from
 the samples, traces the continuum and masks them from the search; a pose a hair off the continuum must keep its
 isolated solutions (nothing masked)."""
 
@@ -11,9 +12,9 @@ import pytest
 from singular import families_certified, recovered
 
 import sweepik
+from sweepik.engine.rough_continua import rough_continua
 from sweepik.reductions import get_reduction
-from sweepik.rough_continua import rough_continua
-from sweepik.solver import ACCEPT_TOL_REL, POLISH_BELOW_REL, _chain_poses, _theta_range
+from sweepik.solving import ACCEPT_TOL_REL, POLISH_BELOW_REL, _chain_poses, _theta_range
 
 #: The issue's two UR5 configurations (the second in the limits, solved with them on)
 ISSUE = [

@@ -15,8 +15,8 @@ import pytest
 from singular import recovered, singular_configurations
 
 import sweepik
-from sweepik.pose import pose_error_geodesic
-from sweepik.units import orientation_weight
+from sweepik.model.pose import pose_error_geodesic
+from sweepik.model.units import orientation_weight
 
 KNOWN_MISSES = {"i2rt_yam"}
 ARMS = [

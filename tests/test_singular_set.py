@@ -26,10 +26,10 @@ from scipy.optimize import brentq
 
 import sweepik
 from sweepik import Robot, load_robot, solve
-from sweepik.families import MAX_ISOLATED_SOLUTIONS
-from sweepik.pose import pose_error_geodesic
-from sweepik.robot_file import robot_from_dict
-from sweepik.solutions import joint_distance
+from sweepik.engine.families import MAX_ISOLATED_SOLUTIONS
+from sweepik.io.robot_file import robot_from_dict
+from sweepik.model.pose import pose_error_geodesic
+from sweepik.results import joint_distance
 
 CARM = load_robot("carm")
 REDUCTIONS = ("carm-d1", "carm-theta2", "auto")
@@ -40,7 +40,7 @@ FOUND = 1e-4
 
 
 def _variant(L1: float, L2: float) -> Robot:
-    data = copy.deepcopy(tomllib.loads((resources.files("sweepik") / "robots" / "carm.toml").read_text()))
+    data = copy.deepcopy(tomllib.loads((resources.files("sweepik.io") / "robots" / "carm.toml").read_text()))
     data["joints"][3]["a"], data["joints"][4]["d"] = L1, L2
     data["name"] = f"carm_{L1:g}_{L2:g}"
     return robot_from_dict(data, "variant.toml")
@@ -296,7 +296,7 @@ def test_near_the_singular_set(name: str, delta: float) -> None:
 
 def test_grid_triple_roots_are_one_solution_of_multiplicity_3() -> None:
     """The 45 grid points with theta2 = 0, theta5 = 0, theta3 + theta4 = +-90 deg."""
-    from sweepik.verify import grid_configurations
+    from sweepik.experiments.verify import grid_configurations
 
     g = grid_configurations(include_singular=True)
     on = (g[:, 1] == 0.0) & (g[:, 4] == 0.0) & np.isclose(np.abs(g[:, 2] + g[:, 3]), np.pi / 2, atol=1e-12)

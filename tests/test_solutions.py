@@ -1,4 +1,4 @@
-"""``Solutions`` (sweepik.solutions): the nearest solution to a reference, on isolated solutions and on self-motion
+"""``Solutions`` (sweepik.results): the nearest solution to a reference, on isolated solutions and on self-motion
 families, including a family whose theta* turns through a whole circle (its two ends are the same member)."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik.solutions import joint_distance
+from sweepik.results import joint_distance
 
 
 @pytest.mark.parametrize("name", ["puma560", "kuka_kr6_r900", "stanford"])
@@ -34,7 +34,7 @@ def test_families_with_limits_stay_inside_the_limits(name: str, lock: str | None
     cut on (the iiwa's A7, +-175 deg, over a tenth of A5's range: 97 of 400 such poses reported out-of-limit members
     before). Families sampled at 2,001 members."""
     if name == "puma_narrow_wrist":  # joint 6 kept off +-pi, as the iiwa's A7
-        data = tomllib.loads(resources.files("sweepik.robots").joinpath("puma560.toml").read_text())
+        data = tomllib.loads(resources.files("sweepik.io.robots").joinpath("puma560.toml").read_text())
         data["joints"][5]["limits"] = [-172.0, 172.0]
         robot = sweepik.robot_from_dict(data)
     else:

@@ -11,7 +11,6 @@ from hypothesis import strategies as st
 
 import sweepik
 from sweepik import (
-    CArmD1,
     InvalidPoseError,
     NonFiniteError,
     ShapeError,
@@ -22,8 +21,9 @@ from sweepik import (
     solve,
     solve_many,
 )
-from sweepik.pose import pose_error_geodesic, pose_error_paper, zyz_from_matrix
-from sweepik.solutions import joint_distance
+from sweepik.model.pose import pose_error_geodesic, pose_error_paper, zyz_from_matrix
+from sweepik.reductions import CArmD1
+from sweepik.results import joint_distance
 
 CARM = load_robot("carm")
 #: "contains q": every joint within this (mm for d1, rad modulo 2 pi for the angles)
@@ -161,7 +161,7 @@ def near_singular_set(q: np.ndarray) -> bool:
 def test_theta2_self_motion_is_a_family(reduction: str) -> None:
     """theta3 = 0 with theta4 = -90 deg: joint 5's axis on joint 2's, theta2 free (a self-motion, docs/carm.md). The
     default decomposition reports the family (its fallback, carm-theta2, sweeps theta2); the automatic one sweeps the
-    rail, sees theta2 left free at its candidates and traces the family along theta2 (sweepik.continuation)."""
+    rail, sees theta2 left free at its candidates and traces the family along theta2 (sweepik.engine.continuation)."""
     for q in ([500.0, 0.3, 0.0, -np.pi / 2, 0.2, 1.0], [1200.0, -1.1, 0.0, -np.pi / 2, -0.7, 2.5]):
         sol = solve(CARM, CARM.fk(np.array(q)), reduction=reduction)
         assert_certified(sol, CARM.fk(np.array(q)))
@@ -251,7 +251,7 @@ def test_solve_many_equals_solve(batch) -> None:  # type: ignore[no-untyped-def]
 
 
 def test_iter_solve_streams_what_solve_many_returns(monkeypatch) -> None:  # type: ignore[no-untyped-def]
-    import sweepik.solver as solver_mod
+    import sweepik.solving as solver_mod
 
     T = CARM.fk(np.random.default_rng(11).uniform(CARM.lower, CARM.upper, (9, 6)))
     ref = solve_many(CARM, T)

@@ -1,4 +1,5 @@
-"""Static holding torques (sweepik.statics): against finite differences of the gravity potential (virtual work),
+"""Static holding torques (sweepik.experiments.statics): against finite differences of the gravity potential (virtual
+work),
 through every way an arm can be written (DH either convention, origin + axis, joints held), and the robot file's
 gravity and link masses."""
 
@@ -13,13 +14,13 @@ from oracles import in_metres
 
 from sweepik import load_robot
 from sweepik.errors import LockedJointError, RobotDefinitionError, RobotFileError, UnknownOptionError
-from sweepik.origin_axis import hold_joints, origin_axis_form
-from sweepik.robot import Robot
-from sweepik.robot_file import robot_from_dict, robot_to_toml
-from sweepik.statics import STANDARD_GRAVITY, gravity_torques, potential_energy
-from sweepik.store import robot_from_json, robot_to_json
-from sweepik.units import mm_per_unit
-from sweepik.verify import random_configurations
+from sweepik.experiments.statics import STANDARD_GRAVITY, gravity_torques, potential_energy
+from sweepik.experiments.verify import random_configurations
+from sweepik.io.robot_file import robot_from_dict, robot_to_toml
+from sweepik.io.store import robot_from_json, robot_to_json
+from sweepik.model.origin_axis import hold_joints, origin_axis_form
+from sweepik.model.robot import Robot
+from sweepik.model.units import mm_per_unit
 
 ARMS = ["carm", "carm_swapped", "ur5", "puma560_std", "kuka_kr6_r900", "stanford", "kuka_iiwa14"]
 
@@ -180,7 +181,7 @@ def test_bad_arguments() -> None:
 
 def test_urdf_masses_round_trip() -> None:
     """urdf_text writes each link's mass and centre; robot_from_urdf reads them back (same torques)."""
-    from sweepik.urdf import robot_from_urdf, urdf_text
+    from sweepik.io.urdf import robot_from_urdf, urdf_text
 
     rng = np.random.default_rng(21)
     for name in ("carm", "puma560_std"):
@@ -195,7 +196,7 @@ def test_urdf_masses_round_trip() -> None:
 
 def test_urdf_inertials_of_fixed_links_merge() -> None:
     """A link on a fixed joint after the last moving one rides on it; a link before the first rides on the base."""
-    from sweepik.urdf import robot_from_urdf
+    from sweepik.io.urdf import robot_from_urdf
 
     text = """<robot name="r">
       <link name="base"><inertial><mass value="50"/></inertial></link>

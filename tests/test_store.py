@@ -1,4 +1,5 @@
-"""The on-disk solution store (``sweepik.store``): what ``load_solutions`` reads equals ``solve_many`` (same solutions,
+"""The on-disk solution store (``sweepik.io.store``): what ``load_solutions`` reads equals ``solve_many`` (same
+solutions,
 same order, errors, flags, multiplicities, reasons, self-motion families, robot), on the C-Arm (a sweep) and UR5 (a
 closed form with a fallback sweep), with unreachable, out-of-limit and self-motion poses; a 7-joint arm with a lock;
 a store interrupted between chunks (or inside one) is refused as incomplete and never looks complete; a store is
@@ -19,7 +20,7 @@ import zarr
 import sweepik
 from sweepik import Robot, SolutionBatch, StoreError, load_robot, load_solutions, solve_many
 from sweepik.distributed import _checked_options, _solve_task
-from sweepik.store import CHUNKS, StoreWriter, robot_from_json, robot_to_json, store_info
+from sweepik.io.store import CHUNKS, StoreWriter, robot_from_json, robot_to_json, store_info
 
 CARM = load_robot("carm")
 UR5 = load_robot("ur5")
@@ -185,7 +186,7 @@ def test_empty_batch_round_trip(tmp_path: Path) -> None:
 
 def test_robot_content_round_trips_exactly() -> None:
     # the robot file (degrees) is not always exact (franka_panda moves by an ulp); the stored content is
-    held = sweepik.origin_axis.hold_joints(load_robot("kuka_iiwa14"), {2: 0.25}).arm
+    held = sweepik.model.origin_axis.hold_joints(load_robot("kuka_iiwa14"), {2: 0.25}).arm
     for robot in [load_robot(name) for name in sweepik.bundled_robots()] + [held]:
         back = robot_from_json(robot_to_json(robot))
         assert back == robot and hash(back) == hash(robot), robot.name
@@ -225,7 +226,7 @@ def test_resume_checks_robot_options_poses_and_size(tmp_path: Path) -> None:
         StoreWriter(path, CARM, opts, len(P), 11, resume=True)
     writer = StoreWriter(path, CARM, opts, len(P), 10, resume=True)
     done = writer.done()
-    from sweepik.store import poses_digest
+    from sweepik.io.store import poses_digest
 
     writer.check_poses(0, done[0], poses_digest(P[:10]))  # the same poses: accepted
     moved = P[:10].copy()
@@ -277,7 +278,7 @@ def test_a_second_writer_and_another_version_are_refused(tmp_path: Path) -> None
 
     import zarr
 
-    from sweepik.store import LOCK_FILE
+    from sweepik.io.store import LOCK_FILE
 
     P = test_poses(CARM, 20, CARM_FAMILY_Q, seed=3)
     path = tmp_path / "s.zarr"
@@ -303,7 +304,7 @@ def test_a_second_writer_and_another_version_are_refused(tmp_path: Path) -> None
 
 def test_traced_families_round_trip(tmp_path: Path) -> None:
     """Families traced numerically (the C-Arm's theta2 self-motion under the automatic decomposition,
-    sweepik.continuation) are stored with their nodes and give the same members when loaded."""
+    sweepik.engine.continuation) are stored with their nodes and give the same members when loaded."""
     q = np.array([[500.0, 0.3, 0.0, -np.pi / 2, 0.2, 1.0], [1200.0, -1.1, 0.0, -np.pi / 2, -0.7, 2.5]])
     rng = np.random.default_rng(5)
     P = np.concatenate([CARM.fk(q), CARM.fk(rng.uniform(CARM.lower, CARM.upper, (5, 6)))])

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sweepik.chain import rotation_about
+from sweepik.model.chain import rotation_about
 from sweepik.subproblems import in_domain, lines2, lines3, lp1, lp3, lp4, sp1, sp2, sp3, sp4, sp5, sp6, trig2_roots
 
 RNG = np.random.default_rng(20261123)

@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import fastsweep, load_robot, solve_many
-from sweepik.bench import grid_configurations
-from sweepik.rootfind import find_roots
-from sweepik.solutions import joint_distance
+from sweepik import load_robot, solve_many
+from sweepik.engine import search
+from sweepik.engine.rootfind import find_roots
+from sweepik.experiments.bench import grid_configurations
+from sweepik.results import joint_distance
 
 CARM = load_robot("carm")
 
@@ -26,12 +27,12 @@ def _stress(n: int, seed: int) -> np.ndarray:
     return q
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize("reduction", ["carm-d1", "carm-theta2"])
 def test_compiled_and_numpy_engines_agree(reduction: str, monkeypatch: pytest.MonkeyPatch) -> None:
     T = CARM.fk(_stress(600, seed=3))
     fast = solve_many(CARM, T, reduction=reduction)
-    monkeypatch.setattr(fastsweep, "AVAILABLE", False)
+    monkeypatch.setattr(search, "AVAILABLE", False)
     ref = solve_many(CARM, T, reduction=reduction)
     for a, b in zip(fast, ref, strict=True):
         assert len(a) == len(b)
@@ -79,27 +80,27 @@ def test_self_motion_reported_by_both_reductions_without_duplicates(reduction: s
 def test_subclass_overriding_the_residual_does_not_run_the_parents_kernel() -> None:
     arm = sweepik.load_robot("carm")
 
-    class NoResidual(sweepik.CArmD1):
+    class NoResidual(sweepik.reductions.CArmD1):
         def residual(self, poses, theta, branch=None):  # type: ignore[no-untyped-def]
             return None
 
-    class Renamed(sweepik.CArmD1):
+    class Renamed(sweepik.reductions.CArmD1):
         name = "renamed"
 
-    assert sweepik.CArmD1(arm).uses_kernel and Renamed(arm).uses_kernel
+    assert sweepik.reductions.CArmD1(arm).uses_kernel and Renamed(arm).uses_kernel
     assert not NoResidual(arm).uses_kernel
     q = np.array([700.0, 0.4, 0.3, -0.5, 0.6, 0.2])
     sols = sweepik.solve(arm, arm.fk(q), reduction=NoResidual(arm))
     assert np.abs(sols.nearest(q) - q).max() < 1e-6
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 def test_all_branch_kernel_is_bitwise_the_branch_kernel() -> None:
     """carm-d1's all-branch residual kernel (used for the uniform samples) gives exactly, bit for bit, what the
     one-branch kernel gives: same roots, same extrema, same families as branch-by-branch evaluation."""
     from sweepik.reductions import kernels
 
-    red = sweepik.get_reduction(CARM, "carm-d1")
+    red = sweepik.reductions.get_reduction(CARM, "carm-d1")
     q = _stress(400, seed=11)
     q[:20, 0] = 800.0  # with theta2 = 0 below: the wrist on joint 2's axis at d1 = Pz (r = 0)
     q[:20, 1] = 0.0
@@ -115,12 +116,12 @@ def test_all_branch_kernel_is_bitwise_the_branch_kernel() -> None:
             kernels.carm_d1_residuals(params[i], float(th), out)
             one = np.array([kernels.carm_d1_residual(params[i], float(th), b) for b in range(4)])
             np.testing.assert_array_equal(out, one)
-    assert fastsweep._kernel_residuals(red) is kernels.carm_d1_residuals
+    assert search._kernel_residuals(red) is kernels.carm_d1_residuals
 
-    class OwnKernel(sweepik.CArmD1):
+    class OwnKernel(sweepik.reductions.CArmD1):
         kernel = (kernels.carm_theta2_residual, kernels.carm_theta2_configuration)
 
-    assert fastsweep._kernel_residuals(OwnKernel(CARM)) is None
+    assert search._kernel_residuals(OwnKernel(CARM)) is None
 
 
 def test_carm_d1_twin_branches_have_the_same_residual_bit_for_bit() -> None:
@@ -128,7 +129,7 @@ def test_carm_d1_twin_branches_have_the_same_residual_bit_for_bit() -> None:
     hands its roots to the other): their residuals agree bit for bit, in the NumPy reference and in the kernels,
     also with the wrist on joint 2's axis (r = 0), outside the elbow's domain (NaN) and at range ends; their
     configurations differ."""
-    red = sweepik.get_reduction(CARM, "carm-d1")
+    red = sweepik.reductions.get_reduction(CARM, "carm-d1")
     assert red.twins == ((0, 3), (1, 2)) and red.search_branches == [0, 1]
     q = _stress(300, seed=12)
     q[:20, 0], q[:20, 1] = 800.0, 0.0  # the wrist on joint 2's axis at d1 = Pz
@@ -145,7 +146,7 @@ def test_carm_d1_twin_branches_have_the_same_residual_bit_for_bit() -> None:
         cfg_b = red.solve_rest(chain, theta, np.full(theta.shape, b))
         both = np.all(np.isfinite(cfg_a), axis=-1) & np.all(np.isfinite(cfg_b), axis=-1)
         assert both.any() and np.all(np.any(cfg_a[both] != cfg_b[both], axis=-1))
-    if fastsweep.AVAILABLE:
+    if search.AVAILABLE:
         from sweepik.reductions import kernels
 
         params = red.kernel_params(chain)
@@ -164,7 +165,7 @@ def test_carm_d1_hints_kernel_is_bitwise_sample_hints() -> None:
     ``sample_hints`` is not bypassed by the kernel."""
     from sweepik.reductions import kernels
 
-    red = sweepik.get_reduction(CARM, "carm-d1")
+    red = sweepik.reductions.get_reduction(CARM, "carm-d1")
     chain = CARM.fk(_stress(300, seed=12))
     chain[:10, 0, 3] = [0.0, -0.0, 1e-14, -1e-14, 1e-9, 3e-12, -3e-12, 1e-300, 5.0, -5.0]
     chain[10:20, :2, 3] *= 50.0  # out of reach of the outer circle
@@ -176,13 +177,13 @@ def test_carm_d1_hints_kernel_is_bitwise_sample_hints() -> None:
     for i in range(len(chain)):
         kernels.carm_d1_hints(params[i], out)
         np.testing.assert_array_equal(out, ref[i])
-    assert fastsweep._hints_kernel(red) is kernels.carm_d1_hints
+    assert search._hints_kernel(red) is kernels.carm_d1_hints
 
-    class OwnHints(sweepik.CArmD1):
+    class OwnHints(sweepik.reductions.CArmD1):
         def sample_hints(self, poses: np.ndarray) -> np.ndarray:
             return super().sample_hints(poses)[:, :5]
 
-    assert fastsweep._hints_kernel(OwnHints(CARM)) is None
+    assert search._hints_kernel(OwnHints(CARM)) is None
 
 
 def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
@@ -190,7 +191,8 @@ def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
     compiled samples are the reference's, the hints wrapped into [-pi, pi] the same way."""
     import numba
 
-    from sweepik import solver, sweep
+    from sweepik import solving
+    from sweepik.engine import sweep
     from sweepik.reductions import kernels
 
     values = np.array([0.3, 4.0, -7.5, np.nan, np.pi, -np.pi, 0.3, 1e3])
@@ -199,8 +201,8 @@ def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
         for k in range(values.size):
             out[k] = values[k] + 0.0 * p[0]
 
-    class OwnHints(sweepik.CArmTheta2):
-        kernel = sweepik.CArmTheta2.kernel
+    class OwnHints(sweepik.reductions.CArmTheta2):
+        kernel = sweepik.reductions.CArmTheta2.kernel
         kernel_hints = numba.njit(kernels.HINTS_SIG)(hints_row)
         n_kernel_hints = values.size
 
@@ -208,16 +210,16 @@ def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
             return np.broadcast_to(values, (poses.shape[0], values.size)).copy()
 
     red = OwnHints(CARM)
-    assert red.periodic and fastsweep._hints_kernel(red) is OwnHints.kernel_hints
+    assert red.periodic and search._hints_kernel(red) is OwnHints.kernel_hints
     chain = CARM.fk(_stress(50, seed=13))
-    lo, hi = solver._theta_range(CARM, red, chain)
+    lo, hi = solving._theta_range(CARM, red, chain)
     ref = sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
-    grid, count = fastsweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
+    grid, count = search.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
     np.testing.assert_array_equal(grid, ref)  # (a hints kernel's NaN hint is a spare sample, as in the reference)
     assert (count == ref.shape[1]).all()
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="the compiled engine calls kernels by address")
+@pytest.mark.skipif(not search.AVAILABLE, reason="the compiled engine calls kernels by address")
 def test_a_kernel_of_the_wrong_signature_is_refused_and_one_without_is_compiled_for_the_engine() -> None:
     """A reduction's kernel is called through its address: one compiled for another signature (here a float32
     result) would read its arguments wrong and is refused with a clear error; a plain Python function too. A Numba
@@ -236,13 +238,13 @@ def test_a_kernel_of_the_wrong_signature_is_refused_and_one_without_is_compiled_
     def lazy(p, x, b):
         return kernels._carm_d1(p, x, b)
 
-    class Wrong(sweepik.CArmD1):
+    class Wrong(sweepik.reductions.CArmD1):
         kernel = (wrong, kernels.carm_d1_configuration)
 
-    class Plain(sweepik.CArmD1):
+    class Plain(sweepik.reductions.CArmD1):
         kernel = (lambda p, x, b: 0.0, kernels.carm_d1_configuration)
 
-    class Lazy(sweepik.CArmD1):
+    class Lazy(sweepik.reductions.CArmD1):
         kernel = (lazy, kernels.carm_d1_configuration)
 
     for red, match in ((Wrong(CARM), "compiled for"), (Plain(CARM), "must be a Numba function")):
@@ -252,15 +254,15 @@ def test_a_kernel_of_the_wrong_signature_is_refused_and_one_without_is_compiled_
     np.testing.assert_array_equal(got.q, ref.q)
     assert len(ref) > 0
 
-    class Uncounted(sweepik.CArmD1):
-        kernel = sweepik.CArmD1.kernel
+    class Uncounted(sweepik.reductions.CArmD1):
+        kernel = sweepik.reductions.CArmD1.kernel
         kernel_hints = kernels.carm_d1_hints
 
     with pytest.raises(sweepik.UnknownOptionError, match="n_kernel_hints"):
         sweepik.solve(CARM, pose, reduction=Uncounted(CARM))
 
 
-def _pair_reductions() -> list[sweepik.GeometricReduction]:
+def _pair_reductions() -> list[sweepik.reductions.GeometricReduction]:
     """Every pair plan (swept theta*) of the bundled swept arms and of the C-Arm (its four plans: three position
     cases, a prismatic and two revolute theta*)."""
     from sweepik.reductions.decompose import plans
@@ -270,29 +272,31 @@ def _pair_reductions() -> list[sweepik.GeometricReduction]:
         robot = load_robot(name)
         for plan in plans(robot):
             if plan.family == "pair":
-                out.append(sweepik.GeometricReduction(robot, plan))
+                out.append(sweepik.reductions.GeometricReduction(robot, plan))
     return out
 
 
 @pytest.mark.parametrize("red", _pair_reductions(), ids=lambda r: f"{r.robot.name}-{r.name}-{r.plan.case}")
-def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(red: sweepik.GeometricReduction) -> None:
+def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(
+    red: sweepik.reductions.GeometricReduction,
+) -> None:
     """The generic pair family's all-branch residual, margin and amplitude kernels (the position case's branches
     share their first steps) give exactly, bit for bit, what the one-branch kernels give, on the branches and steps
     the search asks for (twins and constant steps are skipped: their entries are never read); so does the kernel that
     computes the residuals and margins at once for the engine's uniform samples, where the plan has one
     (``EdgeSearch.every``)."""
-    from sweepik import solver
+    from sweepik import solving
 
     robot = red.robot
     rng = np.random.default_rng(3)
     q = rng.uniform(robot.lower, robot.upper, size=(60, robot.n_joints))
     q[:10, 4] = 0.0  # a straight wrist
-    chain = solver._chain_poses(robot, robot.fk(q))
+    chain = solving._chain_poses(robot, robot.fk(q))
     params = red.kernel_params(chain)
-    lo, hi = solver._theta_range(robot, red, chain)
+    lo, hi = solving._theta_range(robot, red, chain)
     ck = red._case_kernels
     branches, margins, amplitudes = red.search_branches, red._steps[0], red._steps[1]
-    assert branches and fastsweep._kernel_residuals(red) is ck.pair_residuals
+    assert branches and search._kernel_residuals(red) is ck.pair_residuals
     out = np.full(max(3, red.n_branches), np.nan)
     every = red.edge_search().every != 0
     assert every == (red.n_branches == 4 and {b // 2 for b in branches} == {0, 1})  # (both first-step branches)
@@ -320,7 +324,7 @@ def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(red: 
                     assert same(shared[4 + k], ck.pair_margin(params[i], float(th), k))
 
 
-def _closed_form_reductions() -> list[sweepik.GeometricReduction]:
+def _closed_form_reductions() -> list[sweepik.reductions.GeometricReduction]:
     """Every closed-form plan of the wrist family (spherical wrist) and the parallel family (UR-like) of bundled
     arms and of random arms of those structures (2 || 3 shoulder, Stanford-like RRP, Cartesian PPP; three parallel
     axes with and without a wrist offset, after a revolute joint or an oblique slide; base and tool transforms)."""
@@ -333,21 +337,27 @@ def _closed_form_reductions() -> list[sweepik.GeometricReduction]:
     rng = np.random.default_rng(8)
     families = ("wrist_parallel", "wrist_rrp", "wrist_ppp", "three_parallel", "three_parallel_offset")
     robots += [_arm(FAMILIES[f](rng), rng) for f in (*families, "slide_parallel", "slide_parallel_offset")]
-    return [sweepik.GeometricReduction(r, p) for r in robots for p in plans(r) if p.family in ("wrist", "parallel")]
+    return [
+        sweepik.reductions.GeometricReduction(r, p)
+        for r in robots
+        for p in plans(r)
+        if p.family in ("wrist", "parallel")
+    ]
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize(
     "red", _closed_form_reductions(), ids=lambda r: f"{r.robot.name}-{r.plan.family}-{r.plan.case}"
 )
 def test_closed_form_all_branch_configurations_are_bitwise_the_one_branch_ones(
-    red: sweepik.GeometricReduction,
+    red: sweepik.reductions.GeometricReduction,
 ) -> None:
     """A closed form's all-branch configuration kernel (branches share their first steps: position branches, a
     wrist's sp2, the planar arm's elbows) gives bit for bit the one-branch kernel's configurations, NaN rows
     included, also at and next to a singular wrist; the solver's every-branch certification equals the
     branch-by-branch one."""
-    from sweepik import fastcertify, solver
+    from sweepik import solving
+    from sweepik.engine import certify
     from sweepik.reductions import geometric
     from sweepik.reductions.kernels import owned_kernel
 
@@ -362,7 +372,7 @@ def test_closed_form_all_branch_configurations_are_bitwise_the_one_branch_ones(
     q[:10, 4] = 0.0  # joint 5 straight: joint 6's axis on joint 4's, a continuum
     q[10:20, 4] = rng.choice([-1.0, 1.0], 10) * 1e-7
     world = robot.fk(q)
-    chain = solver._chain_poses(robot, world)
+    chain = solving._chain_poses(robot, world)
     params = red.kernel_params(chain)
     out = np.full((red.n_branches, robot.n_joints), 7.0)
     one = np.empty(robot.n_joints)
@@ -371,19 +381,19 @@ def test_closed_form_all_branch_configurations_are_bitwise_the_one_branch_ones(
         for b in range(red.n_branches):
             one_kernel(params[i], 0.0, b, one)
             np.testing.assert_array_equal(out[b], one)
-    cand = solver._every_branch(len(q), red.n_branches)
-    every = fastcertify.certify_every_branch(robot, red, chain, world, params)
-    each = fastcertify.certify(robot, red, chain, world, cand.pose, cand.theta, cand.branch, params)
+    cand = solving._every_branch(len(q), red.n_branches)
+    every = certify.certify_every_branch(robot, red, chain, world, params)
+    each = certify.certify(robot, red, chain, world, cand.pose, cand.theta, cand.branch, params)
     for a, b in zip(every, each, strict=True):
         np.testing.assert_array_equal(a, b)
 
-    class OwnKernel(sweepik.GeometricReduction):
+    class OwnKernel(sweepik.reductions.GeometricReduction):
         kernel = (red.kernel[0], red.kernel[1])
 
     assert owned_kernel(OwnKernel(robot, red.plan), "kernel_configurations") is None
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize(
     ("name", "reduction"), [("carm", "carm-d1"), ("carm", "auto"), ("ur5", "auto"), ("xarm6", None)]
 )
@@ -392,48 +402,50 @@ def test_compiled_family_steps_are_the_numpy_ones(name: str, reduction: str | No
     (``fastcertify.locate_cuts`` against ``families._locate_cuts``, with and without limits) and
     the golden-section search for limit dips (``fastcertify.dip_search`` against ``families._golden_dips``,
     including members that do not exist, NaN limit excess, and the common stop of all dips)."""
-    from sweepik import families, fastcertify, solver
+    from sweepik import solving
+    from sweepik.engine import certify, families
 
     robot = load_robot(name)
-    red = sweepik.get_reduction(robot, reduction)
+    red = sweepik.reductions.get_reduction(robot, reduction)
     if red.closed_form:  # (its fallback sweep is what has families)
-        red = sweepik.get_reduction(robot, red.fallback)
+        red = sweepik.reductions.get_reduction(robot, red.fallback)
     rng = np.random.default_rng(6)
     q = rng.uniform(robot.lower, robot.upper, size=(40, robot.n_joints))
     q[:20, 4] = 0.0
     world = robot.fk(q)
-    chain = solver._chain_poses(robot, world)
-    lo, hi = solver._theta_range(robot, red, chain)
+    chain = solving._chain_poses(robot, world)
+    lo, hi = solving._theta_range(robot, red, chain)
     K = 300
     pose = rng.integers(0, len(q), K).astype(np.intp)
     branch = rng.integers(0, red.n_branches, K).astype(np.intp)
     a = lo[pose] + (hi - lo)[pose] * rng.random(K)
     b = a + (hi - lo)[pose] * rng.uniform(-0.1, 0.1, K)
-    tol = solver.ACCEPT_TOL_REL * robot.length_scale
+    tol = solving.ACCEPT_TOL_REL * robot.length_scale
     for limits in (True, False):
         for steps in (12, 32):
-            got = fastcertify.locate_cuts(robot, red, chain, world, pose, branch, a, b, steps, limits, tol)
+            got = certify.locate_cuts(robot, red, chain, world, pose, branch, a, b, steps, limits, tol)
             ref = families._locate_cuts(robot, red, chain, world, pose, branch, a, b, steps, limits, tol)
             np.testing.assert_array_equal(got[0], ref[0])
             np.testing.assert_array_equal(got[1], ref[1])
     best_x = 0.5 * (a + b)
     best_e = np.full(K, 10.0 * robot.length_scale)
     ref = families._golden_dips(robot, red, chain, pose, branch, a, b, best_x, best_e)
-    got = fastcertify.dip_search(robot, red, chain, pose, branch, a, b, best_x, best_e, families._DIP_STEPS)
+    got = certify.dip_search(robot, red, chain, pose, branch, a, b, best_x, best_e, families._DIP_STEPS)
     np.testing.assert_array_equal(got[0], ref[0])
     np.testing.assert_array_equal(got[1], ref[1])
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="the compiled merge (the reference is the NumPy engine's grid)")
+@pytest.mark.skipif(not search.AVAILABLE, reason="the compiled merge (the reference is the NumPy engine's grid)")
 def test_compiled_sample_grid_is_the_numpy_one() -> None:
     """``fastsweep.sample_grid`` (compiled merge) gives the reference's samples of each pose alone, bit for bit, with
     no sample for a NaN hint (the reference makes it a spare midpoint, so that its rows have one length): hints
     inside and outside the range, NaN hints, hints on the uniform grid and repeated (runs of equal samples spread),
     real reductions. A pose's samples therefore do not depend on the batch it is solved in."""
-    from sweepik import solver, sweep
+    from sweepik import solving
+    from sweepik.engine import sweep
 
-    def check(red: sweepik.Reduction, chain: np.ndarray, lo: np.ndarray, hi: np.ndarray, n: int) -> int:
-        grid, count = fastsweep.sample_grid(red, chain, lo, hi, n)
+    def check(red: sweepik.reductions.Reduction, chain: np.ndarray, lo: np.ndarray, hi: np.ndarray, n: int) -> int:
+        grid, count = search.sample_grid(red, chain, lo, hi, n)
         hints = sweep.grid_hints(red, chain)
         assert grid.shape[0] == count.shape[0] == chain.shape[0]
         dropped = 0
@@ -450,18 +462,18 @@ def test_compiled_sample_grid_is_the_numpy_one() -> None:
     dropped = 0
     for name, reduction in (("carm", "carm-d1"), ("carm", "carm-theta2"), ("carm", "auto"), ("xarm6", "auto")):
         robot = load_robot(name)
-        red = sweepik.get_reduction(robot, reduction)
-        chain = solver._chain_poses(robot, robot.fk(rng.uniform(robot.lower, robot.upper, (200, robot.n_joints))))
-        lo, hi = solver._theta_range(robot, red, chain)
-        if fastsweep._hints_kernel(red) is None:
+        red = sweepik.reductions.get_reduction(robot, reduction)
+        chain = solving._chain_poses(robot, robot.fk(rng.uniform(robot.lower, robot.upper, (200, robot.n_joints))))
+        lo, hi = solving._theta_range(robot, red, chain)
+        if search._hints_kernel(red) is None:
             dropped += check(red, chain, lo, hi, sweep.N_SAMPLES)
         else:  # (a hints kernel writes as many for every pose: the reference's grid exactly)
-            grid, count = fastsweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
+            grid, count = search.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
             np.testing.assert_array_equal(grid, sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES))
             assert (count == grid.shape[1]).all()
     assert dropped > 0  # (xArm 6's poses differ in their number of hints)
 
-    class Hinted(sweepik.CArmD1):
+    class Hinted(sweepik.reductions.CArmD1):
         def sample_hints(self, poses: np.ndarray) -> np.ndarray:
             return hints
 
@@ -475,31 +487,31 @@ def test_compiled_sample_grid_is_the_numpy_one() -> None:
     assert check(Hinted(CARM), np.broadcast_to(np.eye(4), (N, 4, 4)), lo, hi, n) > 0
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 def test_margins_made_per_call_share_their_pair_plans_engine_plan() -> None:
     """The generic sweeps' margins are a reduction made afresh for each solve: the engine's plan of them (kernels,
     branches, limits) is worked out once per pair plan (``plan_key``), and is the one a fresh plan would be."""
     from sweepik.reductions.generic import _Margins
 
     robot = load_robot("fanuc_crx10ia")
-    red = sweepik.get_reduction(robot, "auto")
+    red = sweepik.reductions.get_reduction(robot, "auto")
     m1, m2 = _Margins(red, np.zeros((1, 0))), _Margins(red, np.zeros((2, 0)))
-    assert fastsweep._plan(m1) is fastsweep._plan(m2)
-    fresh = fastsweep._make_plan(m2)
-    got = fastsweep._plan(m2)
+    assert search._plan(m1) is search._plan(m2)
+    fresh = search._make_plan(m2)
+    got = search._plan(m2)
     assert (got.residual, got.residuals, got.n_all, got.hints) == (fresh.residual, fresh.residuals, fresh.n_all, None)
     assert np.array_equal(got.branches, fresh.branches) and np.array_equal(got.ends, fresh.ends)
-    other = sweepik.get_reduction(load_robot("kinova_jaco2"), "auto")
+    other = sweepik.reductions.get_reduction(load_robot("kinova_jaco2"), "auto")
     if not other.closed_form:
-        assert fastsweep._plan(_Margins(other, np.zeros((1, 0)))) is not fastsweep._plan(m1)
+        assert search._plan(_Margins(other, np.zeros((1, 0)))) is not search._plan(m1)
 
 
 def _captured_cuts(monkeypatch: pytest.MonkeyPatch, solve: Any) -> list[tuple[Any, ...]]:
     """The arguments of every cut location a solve asks for (compiled or NumPy)."""
-    from sweepik import families, fastcertify
+    from sweepik.engine import certify, families
 
     seen: list[tuple[Any, ...]] = []
-    compiled, reference = fastcertify.locate_cuts, families._locate_cuts
+    compiled, reference = certify.locate_cuts, families._locate_cuts
 
     def spy_compiled(*args: Any) -> Any:
         seen.append(args)
@@ -509,7 +521,7 @@ def _captured_cuts(monkeypatch: pytest.MonkeyPatch, solve: Any) -> list[tuple[An
         seen.append(args)
         return reference(*args)
 
-    monkeypatch.setattr(fastcertify, "locate_cuts", spy_compiled)
+    monkeypatch.setattr(certify, "locate_cuts", spy_compiled)
     monkeypatch.setattr(families, "_locate_cuts", spy_reference)
     solve()
     monkeypatch.undo()
@@ -521,7 +533,7 @@ def test_family_cuts_are_where_bisection_puts_them(name: str, monkeypatch: pytes
     """The family pieces' ends (``families._locate_cuts``: false position on the limit excess, bisection elsewhere)
     on real cuts, with and without limits: the end stays a certified member and the point past it is not, the
     bracket is as narrow as asked, and the end is where 60 plain bisections of ``_members_ok`` put it."""
-    from sweepik import families
+    from sweepik.engine import families
 
     robot = load_robot(name)
     if name == "carm":
@@ -552,22 +564,23 @@ def test_family_cuts_are_where_bisection_puts_them(name: str, monkeypatch: pytes
         assert np.all(np.abs(got_a - ra) <= 2.0 * target), np.max(np.abs(got_a - ra) / target)
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 def test_search_without_multiplicities_finds_the_same_candidates() -> None:
     """``fastsweep.search(..., multiplicity=False)`` (the margins' search) gives the same candidates and spans, each
     with multiplicity 1; with multiplicities, poses with a double root (theta2 = +-90 deg, theta3 = 0, the paper's
     excluded grid points) and random ones have some above 1 and some of 1, so the comparison sees what it ignores."""
-    from sweepik import solver, sweep
+    from sweepik import solving
+    from sweepik.engine import sweep
 
-    red = sweepik.get_reduction(CARM, "carm-d1")
+    red = sweepik.reductions.get_reduction(CARM, "carm-d1")
     q = _stress(100, seed=5)
     q[:30, 1] = np.pi / 2
     q[:30, 2] = 0.0
     q[:30, 4] = 0.3
-    chain = solver._chain_poses(CARM, CARM.fk(q))
-    lo, hi = solver._theta_range(CARM, red, chain)
-    full, spans = fastsweep.search(red, chain, lo, hi, sweep.N_SAMPLES)
-    bare, spans2 = fastsweep.search(red, chain, lo, hi, sweep.N_SAMPLES, multiplicity=False)
+    chain = solving._chain_poses(CARM, CARM.fk(q))
+    lo, hi = solving._theta_range(CARM, red, chain)
+    full, spans = search.search(red, chain, lo, hi, sweep.N_SAMPLES)
+    bare, spans2 = search.search(red, chain, lo, hi, sweep.N_SAMPLES, multiplicity=False)
     for a, b in ((full.pose, bare.pose), (full.branch, bare.branch), (full.theta, bare.theta)):
         np.testing.assert_array_equal(a, b)
     assert (bare.mult == 1).all() and (full.mult > 1).any() and (full.mult == 1).any()
@@ -582,7 +595,7 @@ def _same_search(a: Any, b: Any) -> None:
         np.testing.assert_array_equal(x, y)
 
 
-@pytest.mark.skipif(not fastsweep.AVAILABLE, reason="numba not installed")
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize(
     ("name", "reduction"),
     [
@@ -602,31 +615,32 @@ def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeyp
     poses on the singular set (joint 5 at 0, joint 3 at 0, both). With the buffers cut to one candidate, every pose
     overflows and is redone by the NumPy engine, in both; cut to the median count (carm-d1), some are: the same
     candidates in the same order, twins' copies included."""
-    from sweepik import solver, sweep
+    from sweepik import solving
+    from sweepik.engine import sweep
 
     robot = load_robot(name)
-    red = sweepik.get_reduction(robot, reduction)
-    assert fastsweep._plan(red).one_pass is not None  # (the one-pass search is what is tested)
+    red = sweepik.reductions.get_reduction(robot, reduction)
+    assert search._plan(red).one_pass is not None  # (the one-pass search is what is tested)
     rng = np.random.default_rng(11)
     q = rng.uniform(robot.lower, robot.upper, (60, 6))
     q[:10, 4] = 0.0
     q[10:20, 2] = 0.0
     q[20:25, 2] = 0.0
     q[20:25, 4] = 0.0
-    chain = solver._chain_poses(robot, robot.fk(q))
-    lo, hi = solver._theta_range(robot, red, chain)
+    chain = solving._chain_poses(robot, robot.fk(q))
+    lo, hi = solving._theta_range(robot, red, chain)
     n = sweep.N_SAMPLES
-    one_pass = fastsweep.search(red, chain, lo, hi, n)
-    _same_search(one_pass, fastsweep.search(red, chain, lo, hi, n, one_pass=False))
+    one_pass = search.search(red, chain, lo, hi, n)
+    _same_search(one_pass, search.search(red, chain, lo, hi, n, one_pass=False))
     assert one_pass[0].pose.size >= chain.shape[0]  # (candidates found: the comparison is not of empty sets)
     for i in range(0, 60, 7):
-        one = fastsweep.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n)
-        _same_search(one, fastsweep.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n, one_pass=False))
-    monkeypatch.setattr(fastsweep, "MAX_CAND", 1)
+        one = search.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n)
+        _same_search(one, search.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n, one_pass=False))
+    monkeypatch.setattr(search, "MAX_CAND", 1)
     few = slice(0, 25, 6)
     _same_search(
-        fastsweep.search(red, chain[few], lo[few], hi[few], n),
-        fastsweep.search(red, chain[few], lo[few], hi[few], n, one_pass=False),
+        search.search(red, chain[few], lo[few], hi[few], n),
+        search.search(red, chain[few], lo[few], hi[few], n, one_pass=False),
     )
     if reduction == "auto":
         # (a generic sweep redoes a pose whose margins overflow as a whole, the staged search its margins alone:
@@ -636,8 +650,8 @@ def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeyp
     counts = np.bincount(one_pass[0].pose, minlength=chain.shape[0])
     cut = int(np.median(counts))
     assert (counts > cut).any() and (counts <= cut).any()
-    monkeypatch.setattr(fastsweep, "MAX_CAND", cut)
-    _same_search(fastsweep.search(red, chain, lo, hi, n), fastsweep.search(red, chain, lo, hi, n, one_pass=False))
+    monkeypatch.setattr(search, "MAX_CAND", cut)
+    _same_search(search.search(red, chain, lo, hi, n), search.search(red, chain, lo, hi, n, one_pass=False))
 
 
 def test_residual_rows_is_the_residual_of_those_rows() -> None:
@@ -647,7 +661,7 @@ def test_residual_rows_is_the_residual_of_those_rows() -> None:
     from sweepik.reductions.generic import GeometricReduction, _Margins
 
     robot = load_robot("fanuc_crx10ia")
-    red = sweepik.get_reduction(robot, None)
+    red = sweepik.reductions.get_reduction(robot, None)
     assert isinstance(red, GeometricReduction)
     rng = np.random.default_rng(3)
     poses = robot.fk(rng.uniform(robot.lower, robot.upper, (12, 6)))
@@ -678,18 +692,19 @@ def test_edge_samples_far_from_zero_are_no_candidates(engine: str, monkeypatch: 
     gives is then that close to zero; before, over half the CRX-10iA's candidates were such samples, far from it.
     (Next to a family's samples they stay candidates: the C-Arm's grid poses are unchanged, see docs/performance.md.)
     """
-    from sweepik import solver, sweep
+    from sweepik import solving
+    from sweepik.engine import sweep
 
-    if engine == "compiled" and not fastsweep.AVAILABLE:
+    if engine == "compiled" and not search.AVAILABLE:
         pytest.skip("numba not installed")
     if engine == "numpy":
-        monkeypatch.setattr(fastsweep, "AVAILABLE", False)
+        monkeypatch.setattr(search, "AVAILABLE", False)
     robot = load_robot("fanuc_crx10ia")
-    red = sweepik.get_reduction(robot, None)
-    chain = solver._chain_poses(robot, robot.fk(np.random.default_rng(4).uniform(robot.lower, robot.upper, (30, 6))))
-    lo, hi = solver._theta_range(robot, red, chain)
+    red = sweepik.reductions.get_reduction(robot, None)
+    chain = solving._chain_poses(robot, robot.fk(np.random.default_rng(4).uniform(robot.lower, robot.upper, (30, 6))))
+    lo, hi = solving._theta_range(robot, red, chain)
     if engine == "compiled":
-        cand, _ = fastsweep.search(red, chain, lo, hi, sweep.N_SAMPLES)
+        cand, _ = search.search(red, chain, lo, hi, sweep.N_SAMPLES)
     else:
         cand, _ = sweep.find_candidates(red, chain, lo, hi, sweep.N_SAMPLES)
     f = red.residual(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
@@ -704,17 +719,18 @@ def test_edge_intervals_left_alone_hide_no_roots(name: str, monkeypatch: pytest.
     densely (in the edge's coordinate, where a pair would sit), the residual changes sign exactly as often as its two
     ends show (once or not at all), and comes no nearer zero than they do unless it crosses. Random poses and poses
     on the singular set (joints at 0 and 90 deg)."""
-    from sweepik import solver, sweep
+    from sweepik import solving
+    from sweepik.engine import sweep
 
-    monkeypatch.setattr(fastsweep, "AVAILABLE", False)
+    monkeypatch.setattr(search, "AVAILABLE", False)
     robot = load_robot(name)
-    red = sweepik.get_reduction(robot, None)
+    red = sweepik.reductions.get_reduction(robot, None)
     rng = np.random.default_rng(8)
     q = rng.uniform(robot.lower, robot.upper, (40, 6))
     q[20:30, 4] = 0.0
     q[30:, 2] = np.pi / 2
-    chain = solver._chain_poses(robot, robot.fk(q))
-    lo, hi = solver._theta_range(robot, red, chain)
+    chain = solving._chain_poses(robot, robot.fk(q))
+    lo, hi = solving._theta_range(robot, red, chain)
     seen: list[tuple[Any, ...]] = []
     judge = sweep._Search._edge_at_sample
 
@@ -746,11 +762,11 @@ def test_compiled_parameter_rows_are_the_numpy_ones(name: str) -> None:
     """A generic sweep's parameter rows (``geometric.pose_rows``) are those NumPy computes, to rounding (the sums run
     in another order), on arms with a reversed chain (xArm 6), a base and a tool transform (KR6 R900), a base
     (JACO2), a tool (CRX-10iA) or neither (UR5); the probing rows too."""
-    from sweepik import solver
+    from sweepik import solving
 
     robot = load_robot(name)
-    red = sweepik.get_reduction(robot, "auto")
-    chain = solver._chain_poses(robot, robot.fk(np.random.default_rng(9).uniform(robot.lower, robot.upper, (40, 6))))
+    red = sweepik.reductions.get_reduction(robot, "auto")
+    chain = solving._chain_poses(robot, robot.fk(np.random.default_rng(9).uniform(robot.lower, robot.upper, (40, 6))))
     for probing in (False, True):
         fast, ref = red._params(chain, probing), red._params_numpy(chain, probing)
         assert fast.shape == ref.shape

@@ -10,9 +10,9 @@ import pytest
 
 from sweepik import SweepikError, load_robot
 from sweepik.errors import InvalidPoseError, NonFiniteError, ShapeError, UnknownOptionError
-from sweepik.pose import pose_from_xyz_zyz, zyz_from_matrix
-from sweepik.solutions import joint_distance
-from sweepik.solver import solve
+from sweepik.model.pose import pose_from_xyz_zyz, zyz_from_matrix
+from sweepik.results import joint_distance
+from sweepik.solving import solve
 from sweepik.trajectory import (
     BRANCH_SWITCH_ANGLE_RAD,
     PathResult,
@@ -235,7 +235,7 @@ def test_write_joint_path_rejects_bad_input(tmp_path) -> None:
 
 def test_nearest_and_follow_path_use_one_metric(rng: np.random.Generator) -> None:
     # the metric weighs 100 mm of rail like 1 rad: a reference far along the rail but close in angles
-    from sweepik.solutions import weighted_joint_distance
+    from sweepik.results import weighted_joint_distance
 
     arm = load_robot("carm")
     q = rng.uniform(arm.lower, arm.upper, (40, 6))

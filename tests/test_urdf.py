@@ -18,9 +18,7 @@ import yourdfpy
 
 import sweepik
 from sweepik.errors import RobotDefinitionError, SweepikError, UnknownOptionError, UrdfError
-from sweepik.pose import pose_from_xyz_zyz
-from sweepik.units import mm_per_unit
-from sweepik.urdf import (
+from sweepik.io.urdf import (
     MAX_URDF_BYTES,
     MAX_URDF_DEPTH,
     MAX_URDF_JOINTS,
@@ -29,6 +27,8 @@ from sweepik.urdf import (
     robot_from_urdf,
     urdf_text,
 )
+from sweepik.model.pose import pose_from_xyz_zyz
+from sweepik.model.units import mm_per_unit
 
 ROBOTS_DIR = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
 UR_URDF = {name: ROBOTS_DIR / "ur_description" / "urdf" / f"{name}_robot.urdf" for name in ("ur3", "ur5", "ur10")}

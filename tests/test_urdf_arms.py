@@ -78,7 +78,7 @@ def test_panda_urdf_with_a_locked_joint_solves_like_the_bundled_panda(value: flo
 
 
 def test_urdf_arm_through_the_cli(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
-    from sweepik.cli import main
+    from sweepik.cli.app import main
 
     path = str(_urdf("ur_description/urdf/ur5_robot.urdf"))
     assert main(["analyze", path, "--base-link", "base_link", "--tip-link", "tool0"]) == 0
@@ -109,7 +109,7 @@ def test_urdf_arm_through_the_cli(capsys: pytest.CaptureFixture[str], tmp_path: 
     ],
 )
 def test_bad_urdf_through_the_cli(text: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from sweepik.cli import main
+    from sweepik.cli.app import main
 
     path = tmp_path / "bad.urdf"
     path.write_text(text)
@@ -120,7 +120,7 @@ def test_bad_urdf_through_the_cli(text: str, tmp_path: Path, capsys: pytest.Capt
 
 
 def test_bench_arms_takes_a_urdf_chain(capsys: pytest.CaptureFixture[str]) -> None:
-    from sweepik.cli import main
+    from sweepik.cli.app import main
 
     path = str(_urdf("ur_description/urdf/ur5_robot.urdf"))
     argv = ["bench", "--arms", path, "--base-link", "base_link", "--tip-link", "tool0", "--single", "3"]

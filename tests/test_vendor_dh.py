@@ -56,7 +56,7 @@ import numpy as np
 import pytest
 
 import sweepik
-from sweepik import kinematics
+from sweepik.model import kinematics
 
 yourdfpy = pytest.importorskip("yourdfpy", reason="yourdfpy (independent URDF parser) is not installed")
 

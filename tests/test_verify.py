@@ -1,4 +1,5 @@
-"""Tests of sweepik.verify: the paper's section-6 experiments on small subsets (the full run is a CLI job)."""
+"""Tests of sweepik.experiments.verify: the paper's section-6 experiments on small subsets (the full run is a CLI
+job)."""
 
 from __future__ import annotations
 
@@ -9,10 +10,10 @@ import math
 import numpy as np
 import pytest
 
-import sweepik.verify as V
+import sweepik.experiments.verify as V
 from sweepik import load_robot
 from sweepik.errors import RobotDefinitionError, UnknownOptionError
-from sweepik.solver import iter_solve, solve_many
+from sweepik.solving import iter_solve, solve_many
 
 CARM = load_robot("carm")
 
@@ -117,7 +118,7 @@ def test_double_root_poses_are_found_to_1e_6() -> None:
 
 def test_missed_configurations_are_reported(monkeypatch) -> None:
     # Make every solve return nothing: each generating configuration is then missed.
-    import sweepik.verify as mod
+    import sweepik.experiments.verify as mod
 
     def nothing(robot, poses, **kw):
         return iter_solve(robot, poses + np.array([[0, 0, 0, 1e4], [0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0]]), **kw)

@@ -1,4 +1,5 @@
-"""Workspace volume (:mod:`sweepik.workspace`) against arms whose reachable workspace is known in closed form.
+"""Workspace volume (:mod:`sweepik.experiments.workspace`) against arms whose reachable workspace is known in closed
+form.
 
 Properties tested (each can fail):
 * five arms with analytic volumes (a Cartesian gantry: a box; the gantry with a tool offset: the box dilated by
@@ -26,9 +27,7 @@ import pytest
 
 import sweepik
 from sweepik.errors import RobotDefinitionError, UnknownOptionError
-from sweepik.robot import Joint, Robot
-from sweepik.robot_file import robot_from_dict
-from sweepik.workspace import (
+from sweepik.experiments.workspace import (
     MAX_CONFIGURATIONS,
     MIN_CONFIGURATIONS,
     WorkspaceVolume,
@@ -36,6 +35,8 @@ from sweepik.workspace import (
     _tool_positions,
     workspace_volume,
 )
+from sweepik.io.robot_file import robot_from_dict
+from sweepik.model.robot import Joint, Robot
 
 PI = math.pi
 

@@ -8,12 +8,10 @@ cluster, optionally into an on-disk store) and ``load_solutions``; design tools:
 docs/conventions.md for units and conventions.
 """
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING as _TYPE_CHECKING
 
-from . import plan_check as _plan_check  # noqa: F401 (registers the automatic decomposition's check)
-from .analysis import analyze
-from .batch import SolutionBatch
-from .errors import (
+from sweepik import plan_check as _plan_check  # registers the automatic decomposition's check
+from sweepik.errors import (
     InvalidPoseError,
     LockedJointError,
     NonFiniteError,
@@ -22,12 +20,16 @@ from .errors import (
     RobotDefinitionError,
     RobotFileError,
     ShapeError,
+    StoreError,
     SweepikError,
     UnknownOptionError,
     UnknownRobotError,
     UrdfError,
 )
-from .pose import (
+from sweepik.experiments.statics import gravity_torques
+from sweepik.io.robot_file import bundled_robots, load_robot, robot_from_dict, robot_to_toml
+from sweepik.io.store import load_solutions
+from sweepik.model.pose import (
     matrix_from_zyz,
     pose_error_geodesic,
     pose_error_paper,
@@ -37,49 +39,67 @@ from .pose import (
     xyz_zyz_from_pose,
     zyz_from_matrix,
 )
-from .reductions import REDUCTIONS, CArmD1, CArmTheta2, GeometricReduction, Plan, Reduction, get_reduction
-from .robot import Joint, Robot
-from .robot_file import bundled_robots, load_robot, robot_from_dict, robot_to_toml
-from .solutions import Family, Solutions
-from .solver import STRATEGIES, iter_solve, solve, solve_many
-from .statics import gravity_torques
-from .store import StoreError, load_solutions
+from sweepik.model.robot import Joint, Robot
+from sweepik.reductions.analysis import analyze
+from sweepik.results import Family, SolutionBatch, Solutions
+from sweepik.solving import iter_solve, solve, solve_many
 
-if TYPE_CHECKING:
-    from .design import DesignComparison, compare_designs
-    from .distributed import solve_dask
-    from .urdf import read_urdf, urdf_text
-    from .workspace import WorkspaceVolume, workspace_volume
+if _TYPE_CHECKING:
+    from sweepik.distributed import solve_dask
+    from sweepik.experiments.design import DesignComparison, compare_designs
+    from sweepik.experiments.workspace import WorkspaceVolume, workspace_volume
+    from sweepik.io.urdf import read_urdf, urdf_text
 
     __version__: str
+
+del _plan_check
 
 #: Names imported on first use (PEP 562): a solve should not pay for the design tools, Dask's entry point, the URDF
 #: reader or the package metadata (~100 ms of ``import sweepik`` together).
 _LAZY = {
-    "compare_designs": "design",
-    "DesignComparison": "design",
-    "solve_dask": "distributed",
-    "read_urdf": "urdf",
-    "urdf_text": "urdf",
-    "workspace_volume": "workspace",
-    "WorkspaceVolume": "workspace",
+    "compare_designs": "sweepik.experiments.design",
+    "DesignComparison": "sweepik.experiments.design",
+    "solve_dask": "sweepik.distributed",
+    "read_urdf": "sweepik.io.urdf",
+    "urdf_text": "sweepik.io.urdf",
+    "workspace_volume": "sweepik.experiments.workspace",
+    "WorkspaceVolume": "sweepik.experiments.workspace",
+}
+#: Engine names that ``sweepik`` exported before the packages were layered (issue 36): still served, with a
+#: ``DeprecationWarning`` naming where each now lives; not in ``__all__`` nor ``dir(sweepik)``.
+_MOVED = {
+    "STRATEGIES": "sweepik.solving",
+    "Reduction": "sweepik.reductions",
+    "CArmD1": "sweepik.reductions",
+    "CArmTheta2": "sweepik.reductions",
+    "REDUCTIONS": "sweepik.reductions",
+    "get_reduction": "sweepik.reductions",
+    "GeometricReduction": "sweepik.reductions",
+    "Plan": "sweepik.reductions",
 }
 
 
-if not TYPE_CHECKING:  # (hidden from type checkers: a module __getattr__ would make every misspelt name Any)
+if not _TYPE_CHECKING:  # (hidden from type checkers: a module __getattr__ would make every misspelt name valid)
 
-    def __getattr__(name: str) -> Any:
+    def __getattr__(name: str) -> object:
+        import importlib
+
         if name == "__version__":
             from importlib.metadata import PackageNotFoundError, version
 
             try:
-                value = version("sweepik")
+                value: object = version("sweepik")
             except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
                 value = "0.0.0"
         elif name in _LAZY:
-            import importlib
+            value = getattr(importlib.import_module(_LAZY[name]), name)
+        elif name in _MOVED:
+            import warnings
 
-            value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+            warnings.warn(
+                f"sweepik.{name} is deprecated: import it from {_MOVED[name]}", DeprecationWarning, stacklevel=2
+            )
+            return getattr(importlib.import_module(_MOVED[name]), name)
         else:
             raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
         globals()[name] = value
@@ -87,11 +107,13 @@ if not TYPE_CHECKING:  # (hidden from type checkers: a module __getattr__ would 
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY) | {"__version__"})
+    """The public names (``__all__``) and the module's dunders: the subpackages are reached by importing them."""
+    return sorted(set(__all__) | {k for k in globals() if k.startswith("__") and k.endswith("__")})
 
 
 __all__ = [
     "__version__",
+    # robots
     "Joint",
     "Robot",
     "load_robot",
@@ -100,28 +122,18 @@ __all__ = [
     "robot_to_toml",
     "read_urdf",
     "urdf_text",
+    # solving
     "solve",
     "solve_many",
     "iter_solve",
     "solve_dask",
     "load_solutions",
+    "analyze",
+    # results
     "Solutions",
     "SolutionBatch",
     "Family",
-    "STRATEGIES",
-    "Reduction",
-    "CArmD1",
-    "CArmTheta2",
-    "REDUCTIONS",
-    "get_reduction",
-    "GeometricReduction",
-    "Plan",
-    "analyze",
-    "compare_designs",
-    "DesignComparison",
-    "gravity_torques",
-    "workspace_volume",
-    "WorkspaceVolume",
+    # poses
     "zyz_from_matrix",
     "matrix_from_zyz",
     "pose_from_xyz_zyz",
@@ -130,17 +142,24 @@ __all__ = [
     "rotation_angle",
     "pose_error_paper",
     "pose_error_geodesic",
+    # design tools
+    "compare_designs",
+    "DesignComparison",
+    "gravity_torques",
+    "workspace_volume",
+    "WorkspaceVolume",
+    # errors
     "SweepikError",
     "RobotDefinitionError",
     "RobotFileError",
+    "UrdfError",
     "UnknownRobotError",
     "ShapeError",
     "NonFiniteError",
     "InvalidPoseError",
     "UnknownOptionError",
     "PoseFileError",
-    "NoReductionError",
     "LockedJointError",
-    "UrdfError",
+    "NoReductionError",
     "StoreError",
 ]

@@ -7,7 +7,7 @@ the same order. The robot travels by value (pickled with each task, ~1.5 kB); ea
 reductions and loads its compiled kernels once (they are cached per robot content).
 
 The client collects the chunks as they finish and (with ``out``) writes each one to the store
-(:mod:`sweepik.store`): one writer, so the store needs no locking and may live where only the client can write;
+(:mod:`sweepik.io.store`): one writer, so the store needs no locking and may live where only the client can write;
 the workers need no shared file system. At most ``IN_FLIGHT_PER_THREAD`` chunks per worker thread are submitted at
 once, so the client, the scheduler and the workers hold a bounded number of chunks whatever the number of poses.
 
@@ -34,13 +34,21 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._validate import as_float_array, check_int, check_poses, short_repr
-from .batch import Block, SolutionBatch
-from .errors import ShapeError, SweepikError, UnknownOptionError
-from .reductions import Reduction
-from .robot import Robot
-from .store import StoreError, StoreWriter, chunk_stats, load_solutions, merge_blocks, poses_digest, store_info
-from .sweep import N_SAMPLES
+from sweepik.engine.sweep import N_SAMPLES
+from sweepik.errors import ShapeError, SweepikError, UnknownOptionError
+from sweepik.io.store import (
+    StoreError,
+    StoreWriter,
+    chunk_stats,
+    load_solutions,
+    merge_blocks,
+    poses_digest,
+    store_info,
+)
+from sweepik.model.robot import Robot
+from sweepik.model.validate import as_float_array, check_int, check_poses, short_repr
+from sweepik.reductions import Reduction
+from sweepik.results import Block, SolutionBatch
 
 __all__ = ["solve_dask"]
 
@@ -77,8 +85,8 @@ def _dask() -> Any:
 def _solve_task(robot: Robot, poses: ArrayLike, options: Mapping[str, Any], start: int) -> Block:
     """The solutions of one chunk of poses ``(n, 4, 4)`` (poses ``start:start + n`` of the run), as one Block:
     ``solve_many`` on the chunk (a bad pose is named by its place in the run)."""
-    from .fastsweep import AVAILABLE
-    from .solver import solve_many
+    from sweepik.engine.search import AVAILABLE
+    from sweepik.solving import solve_many
 
     if AVAILABLE:  # Dask runs a task per worker thread: the compiled kernels must not fan out to every core too
         import numba
@@ -114,7 +122,7 @@ def _checked_options(
 ) -> dict[str, Any]:
     """The solver options, checked as ``solve_many`` checks them (before any cluster starts), normalised to plain
     Python values (the store keeps them as JSON)."""
-    from .solver import _held, _prepare
+    from sweepik.solving import _held, _prepare
 
     held = _held(robot, locked)
     arm = robot if held is None else held.arm
@@ -182,7 +190,7 @@ def _source(poses: Any) -> _Source:
 
 def _open_npy(path: Path) -> NDArray[Any]:
     """A ``.npy`` file of poses, memory-mapped (read a chunk at a time; never all in memory)."""
-    from .errors import PoseFileError
+    from sweepik.errors import PoseFileError
 
     if path.suffix.lower() != ".npy":
         raise PoseFileError(f"{path}: poses by path must be a .npy file (load other formats with load_poses)")
@@ -305,7 +313,7 @@ def auto_chunk_size(n_poses: int, threads: int) -> int:
     the solver's batches are ``solve_many``'s and so are the results, bit for bit (on arms whose sample hints depend
     on the batch, e.g. the generic sweeps, another chunking moves some solutions by rounding, ~1e-13);
     ``CHUNKS_PER_THREAD`` chunks per worker thread up to ``MAX_AUTO_CHUNK`` poses; up to ``CHUNK`` poses, one."""
-    from .solver import CHUNK
+    from sweepik.solving import CHUNK
 
     if n_poses <= CHUNK:  # one chunk, as solve_many solves it
         return max(1, n_poses)
@@ -518,7 +526,7 @@ def solve_dask(
     locked: Mapping[Any, float] | None = None,
 ) -> SolutionBatch:
     """All IK solutions of each pose in ``poses (N, 4, 4)``, solved on a Dask cluster: the same
-    :class:`~sweepik.batch.SolutionBatch` as ``solve_many(robot, poses, ...)`` (same solutions, same order).
+    :class:`~sweepik.results.SolutionBatch` as ``solve_many(robot, poses, ...)`` (same solutions, same order).
 
     Args:
         robot: the arm (travels to the workers by value).
@@ -527,8 +535,8 @@ def solve_dask(
         client: None: a local cluster on this machine (``n_workers`` processes, default one per core, one thread
             each), closed at the end; a ``dask.distributed.Client``; or a scheduler address
             (``"tcp://host:8786"``). The workers need sweepik (and its version) installed.
-        out: a directory to write the store to (Zarr, see :mod:`sweepik.store`), chunk by chunk as chunks finish,
-            marked complete at the end; :func:`~sweepik.store.load_solutions` reads it back. It must not exist,
+        out: a directory to write the store to (Zarr, see :mod:`sweepik.io.store`), chunk by chunk as chunks finish,
+            marked complete at the end; :func:`~sweepik.io.store.load_solutions` reads it back. It must not exist,
             unless ``resume``.
         chunk_size: poses per task (and per chunk of the store); default: :func:`auto_chunk_size` (a multiple of
             ``solve_many``'s 2,048-pose batches, so that the results are its results bit for bit; one chunk up to

@@ -25,9 +25,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from .reductions import GeometricReduction, Plan, set_plan_check
-from .robot import Robot
-from .solver import solve_many
+from sweepik.model.robot import Robot
+from sweepik.reductions import GeometricReduction, Plan, set_plan_check
+from sweepik.solving import solve_many
 
 __all__ = ["N_CHECK", "N_QUICK", "RECOVER_TOL", "PlanCheck", "check_plan", "checked_choice"]
 

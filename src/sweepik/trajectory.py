@@ -1,13 +1,13 @@
 """Following a Cartesian path with branch continuity, and reading/writing path files.
 
-* :func:`follow_path` solves every pose of a path (all solutions, :func:`sweepik.solver.solve_many`) and
+* :func:`follow_path` solves every pose of a path (all solutions, :func:`sweepik.solving.solve_many`) and
   picks, pose after pose, the solution nearest the previous configuration.
 * :func:`load_poses` reads poses from CSV, NPY or JSON; :func:`write_joint_path` writes the joint path as
   CSV or JSON (degrees for revolute joints, the robot's length unit for prismatic ones).
 
 Distances between configurations mix lengths and angles. The paper's own exchange rate is used (eq. 6c:
 100 mm of length weigh as much as 1 rad of angle), so a prismatic difference is divided by that weight
-(``sweepik.units.orientation_weight``) before the Euclidean norm; angles are compared modulo 2 pi.
+(``sweepik.model.units.orientation_weight``) before the Euclidean norm; angles are compared modulo 2 pi.
 """
 
 from __future__ import annotations
@@ -28,14 +28,22 @@ import numpy as np
 from numpy.lib import format as npy_format
 from numpy.typing import ArrayLike, NDArray
 
-from ._validate import as_path, check_configuration, check_poses, decode_text, file_status, read_file_bytes, short_repr
-from .errors import PoseFileError, ShapeError, UnknownOptionError
-from .pose import pose_error_paper, pose_from_xyz_zyz
-from .reductions import Reduction
-from .robot import Robot
-from .solutions import Solutions, joint_distance, weighted_joint_distance
-from .solver import Progress, iter_solve
-from .units import orientation_weight
+from sweepik.errors import PoseFileError, ShapeError, UnknownOptionError
+from sweepik.model.pose import pose_error_paper, pose_from_xyz_zyz
+from sweepik.model.robot import Robot
+from sweepik.model.units import orientation_weight
+from sweepik.model.validate import (
+    as_path,
+    check_configuration,
+    check_poses,
+    decode_text,
+    file_status,
+    read_file_bytes,
+    short_repr,
+)
+from sweepik.reductions import Reduction
+from sweepik.results import Solutions, joint_distance, weighted_joint_distance
+from sweepik.solving import Progress, iter_solve
 
 __all__ = [
     "BRANCH_SWITCH_ANGLE_RAD",

@@ -5,13 +5,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from functools import lru_cache
 
-from ..errors import UnknownOptionError
-from ..robot import Robot
-from . import decompose
-from .base import Reduction
-from .carm import CArmD1, CArmTheta2
-from .decompose import choose
-from .generic import GeometricReduction, Plan
+from sweepik.errors import UnknownOptionError
+from sweepik.model.robot import Robot
+from sweepik.reductions import decompose
+from sweepik.reductions.base import Reduction
+from sweepik.reductions.carm import CArmD1, CArmTheta2
+from sweepik.reductions.decompose import choose
+from sweepik.reductions.generic import GeometricReduction, Plan
 
 __all__ = [
     "Reduction",
@@ -76,7 +76,7 @@ def _cached(robot: Robot, name: str) -> Reduction:
 @lru_cache(maxsize=64)
 def _automatic(robot: Robot, free_joint: int | None) -> Reduction:
     red = GeometricReduction(robot, choose(robot, free_joint))
-    if free_joint is None:  # (an arm with a near-structure: a second plan's solutions joined, sweepik.companion)
+    if free_joint is None:  # (an arm with a near-structure: a second plan's solutions joined, sweepik.engine.companion)
         comp = decompose.companion_plan(robot)
         red.companion = None if comp is None else GeometricReduction(robot, comp)
     return red
@@ -103,7 +103,8 @@ def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduct
     """The automatic reduction of ``arm``, ``full`` with the joints ``held`` locked at some values: as
     ``get_reduction(arm, "auto")`` (on an arm with a near-structure every plan is checked on the arm, ``plan_check``),
     but the plan chosen for other values of the same joints (the same family, theta*, case and chain) is taken
-    when a shorter check at these values finds it (or else its companion, :mod:`sweepik.companion`) sound, the other
+    when a shorter check at these values finds it (or else its companion, :mod:`sweepik.engine.companion`) sound, the
+    other
     of the two as the companion:
     a new lock value every pose (a redundant arm's self-motion swept, a path with a changing elbow angle) would
     otherwise check every plan again."""

@@ -29,8 +29,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..robot import Robot
-from .kernels import kernel_owner
+from sweepik.model.robot import Robot
+from sweepik.reductions.kernels import kernel_owner
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.intp]
@@ -183,7 +183,7 @@ class Reduction(ABC):
         """For candidates ``(pose[k], theta[k], branch[k])`` of chain ``poses`` (with ``error``, only those whose pose
         error is at most ``tol``): ``(K,)`` a joint other than theta* that the closed form leaves free at the
         candidate (a continuum of solutions may run along it, which a sweep of theta* cannot see), -1 for none; None
-        when there is none. The solver traces such continua (:mod:`sweepik.continuation`). The base class cannot
+        when there is none. The solver traces such continua (:mod:`sweepik.engine.continuation`). The base class cannot
         tell (a reduction then needs ``fallback`` and ``degenerate`` for its blind spots)."""
         return None
 

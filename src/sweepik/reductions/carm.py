@@ -20,10 +20,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import RobotDefinitionError
-from ..robot import Robot
-from . import kernels
-from .base import Array, IntArray, Reduction
+from sweepik.errors import RobotDefinitionError
+from sweepik.model.robot import Robot
+from sweepik.reductions import kernels
+from sweepik.reductions.base import Array, IntArray, Reduction
 
 #: |Px| below this times L1 + L2 (7.5e-10 mm on the C-Arm) is taken as exactly 0: the wrist then lies in the
 #: plane of joint 2's axis and the rail, where theta2 = +-90 deg exactly; rounding of the pose would otherwise
@@ -365,7 +365,7 @@ class CArmTheta2(_CArmBase):
         For poses with |Px| below ``BLIND_PX_REL * (L1 + L2)`` the d1 sweep supplies the solutions with
         |cos(theta2)| <= ``BLIND_COS``; the theta2 sweep supplies all others.
         """
-        from ..sweep import find_candidates, twin_copies  # local import: the engine imports this package
+        from sweepik.engine.sweep import find_candidates, twin_copies  # local import: the engine imports this package
 
         Px = poses[:, 0, 3]
         idx = np.nonzero(np.abs(Px) <= BLIND_PX_REL * (self.L1 + self.L2))[0]

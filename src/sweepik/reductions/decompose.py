@@ -19,12 +19,19 @@ from typing import Any
 
 import numpy as np
 
-from ..chain import Chain, rotation_about
-from ..errors import NoReductionError
-from ..robot import Robot
-from ..structure import INTERSECT_TOL_REL, PARALLEL_TOL, Structure, line_relation, near_structure, structure_of
-from .generic import Plan
-from .position import BRANCHES, CASES, motion, reduce_chain
+from sweepik.errors import NoReductionError
+from sweepik.model.chain import Chain, rotation_about
+from sweepik.model.robot import Robot
+from sweepik.model.structure import (
+    INTERSECT_TOL_REL,
+    PARALLEL_TOL,
+    Structure,
+    line_relation,
+    near_structure,
+    structure_of,
+)
+from sweepik.reductions.generic import Plan
+from sweepik.reductions.position import BRANCHES, CASES, motion, reduce_chain
 
 _reduce_chain: Any = reduce_chain
 
@@ -427,7 +434,8 @@ def choice(robot: Robot, free_joint: int | None = None, hints: tuple[Plan, ...] 
 
 
 def companion_plan(robot: Robot) -> Plan | None:
-    """The plan solved beside the automatic choice on an arm with a near-structure (:mod:`sweepik.companion`): of the
+    """The plan solved beside the automatic choice on an arm with a near-structure (:mod:`sweepik.engine.companion`):
+    of the
     other checked plans that gave back every configuration of the check, the best scored one sweeping another joint
     or the other chain; None without a near-structure or such a plan."""
     try:

@@ -14,12 +14,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .. import parallel
-from ..chain import Chain
-from ..robot import Robot
-from . import geometric
-from .base import Array, IntArray, Reduction
-from .position import CASES, FINAL_JOINTS, STEP_JOINTS
+from sweepik.engine import parallel
+from sweepik.model.chain import Chain
+from sweepik.model.robot import Robot
+from sweepik.reductions import geometric
+from sweepik.reductions.base import Array, IntArray, Reduction
+from sweepik.reductions.position import CASES, FINAL_JOINTS, STEP_JOINTS
 
 #: A candidate where a step's amplitude (``amplitude`` of ``geometric.case_kernels``) is below this fraction of the
 #: step's typical amplitude leaves that step's joint free (``continuum_joints``): the tracer follows it where it can
@@ -121,7 +121,7 @@ def _chain_rows(chain: Chain) -> Array:
 class GeometricReduction(Reduction):
     """A reduction from a :class:`Plan`: the family's compiled kernels over the generic parameter row."""
 
-    #: A second reduction whose solutions the solver joins to this one's (:mod:`sweepik.companion`): set by the
+    #: A second reduction whose solutions the solver joins to this one's (:mod:`sweepik.engine.companion`): set by the
     #: automatic decomposition on an arm with a near-structure, None otherwise.
     companion: Reduction | None = None
 
@@ -249,7 +249,7 @@ class GeometricReduction(Reduction):
     def _continuum_args(self) -> tuple[int, int, Array, NDArray[np.int64]]:
         """``geometric.continuum_rows``'s arguments that do not change: the amplitude kernel's address, the branches
         per position branch (2 for the wrist family), the thresholds, the steps' joints."""
-        from .kernels import RESIDUAL_SIG, address_of
+        from sweepik.reductions.kernels import RESIDUAL_SIG, address_of
 
         address = address_of(self._case_kernels.amplitude, RESIDUAL_SIG)
         joints = np.array(self._step_joints, dtype=np.int64)
@@ -265,7 +265,7 @@ class GeometricReduction(Reduction):
         ``continuum_joints`` may flag a branch) and its thresholds; None for a sweep."""
         if not self.plan.closed_form:
             return None
-        from .kernels import SINGULAR_SIG, address_of  # (defined with Numba only)
+        from sweepik.reductions.kernels import SINGULAR_SIG, address_of  # (defined with Numba only)
 
         if self.plan.family == "parallel":
             return address_of(geometric.parallel_singular_flags, SINGULAR_SIG), np.zeros(4)
@@ -299,7 +299,7 @@ class GeometricReduction(Reduction):
         None when the arm has no such plan (the slide-first parallel arm with an offset wrist)."""
         if not self.plan.closed_form:
             return None
-        from .decompose import plans  # local: decompose imports this module
+        from sweepik.reductions.decompose import plans  # local: decompose imports this module
 
         moving = [3, 5] + ([1, 2] if self.plan.family == "parallel" else [])
         pairs = [p for p in plans(self.robot) if p.family == "pair" and not p.conditional]
@@ -316,7 +316,7 @@ class GeometricReduction(Reduction):
         and a sweep of joint 4 places that point with joint 1, which it leaves free). None without one."""
         if not self.plan.closed_form or self.plan.family != "parallel":
             return None
-        from .decompose import plans  # local: decompose imports this module
+        from sweepik.reductions.decompose import plans  # local: decompose imports this module
 
         pairs = [p for p in plans(self.robot) if p.family == "pair" and not p.conditional]
         for j in (5, 0):
@@ -336,7 +336,7 @@ class GeometricReduction(Reduction):
         shoulder = self._shoulder_continua
         if not out or shoulder is None:
             return out
-        from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
+        from sweepik.engine.search import PARALLEL_MIN  # local: the engine imports the reductions
 
         by, deg = out[0]
         free = np.zeros(poses.shape[0], dtype=np.bool_)
@@ -360,7 +360,7 @@ class GeometricReduction(Reduction):
         last = self._last_singular
         if last is not None and last[0] is poses:
             return last[1], last[2]
-        from ..fastsweep import PARALLEL_MIN  # local: the engine imports the reductions
+        from sweepik.engine.search import PARALLEL_MIN  # local: the engine imports the reductions
 
         N = poses.shape[0]
         out, low = np.zeros(N, dtype=np.bool_), np.zeros(N, dtype=np.bool_)
@@ -426,7 +426,7 @@ class GeometricReduction(Reduction):
         margin zeros."""
         if self.closed_form or poses.shape[0] == 0:
             return None
-        from ..sweep import N_SAMPLES  # local: the engine imports the reductions
+        from sweepik.engine.sweep import N_SAMPLES  # local: the engine imports the reductions
 
         lo, hi = self._range(poses)
         swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
@@ -454,13 +454,16 @@ class GeometricReduction(Reduction):
         (``fastsweep.EdgeSearch``, ``Reduction.edge_search``); None for a closed form (no sweep)."""
         if self.closed_form:
             return None
-        from .. import fastsweep, sweep  # local: the engine imports the reductions
-        from .kernels import RESIDUAL_SIG, RESIDUALS_SIG, SWING_SIG, address_of
+        from sweepik.engine import (
+            search,
+            sweep,  # local: the engine imports the reductions
+        )
+        from sweepik.reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG, SWING_SIG, address_of
 
         ck = self._case_kernels
         L, row = geometric.LAYOUT, self._solving_row
         every = row[L["pos_branches"]] == 4 and row[L["need"]] == 3  # (pair_every's plans: both first steps)
-        return fastsweep.EdgeSearch(
+        return search.EdgeSearch(
             margins=_Margins(self, np.empty((0, 0))),
             swing=address_of(geometric.swing, SWING_SIG),
             amplitude=address_of(ck.amplitude, RESIDUAL_SIG),
@@ -666,11 +669,14 @@ class _Margins(Reduction):
     def zeros(self, poses: Array, lo: Array, hi: Array, params: Array | None = None) -> Array:
         """Zeros ``(N, K)`` (NaN-padded) of every margin over theta*'s sweep range ``[lo, hi]`` (``params``: the pair
         plan's ``kernel_params(poses)``, if at hand)."""
-        from .. import fastsweep, sweep  # local: the engine imports the reductions
+        from sweepik.engine import (
+            search,
+            sweep,  # local: the engine imports the reductions
+        )
 
         N = poses.shape[0]
-        if fastsweep.AVAILABLE:
-            cand, _ = fastsweep.search(self, poses, lo, hi, sweep.N_SAMPLES, params, multiplicity=False)
+        if search.AVAILABLE:
+            cand, _ = search.search(self, poses, lo, hi, sweep.N_SAMPLES, params, multiplicity=False)
         else:
             cand, _ = sweep.find_candidates(self, poses, lo, hi, sweep.N_SAMPLES)
         if N == 1:

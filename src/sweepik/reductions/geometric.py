@@ -1,6 +1,6 @@
 """Kinematic families built from subproblems: one compiled kernel per family, over a generic parameter row.
 
-A family knows no arm: it reads the chain's product-of-exponentials geometry (:mod:`sweepik.chain`) and the
+A family knows no arm: it reads the chain's product-of-exponentials geometry (:mod:`sweepik.model.chain`) and the
 target from the parameter row (``LAYOUT``), which :mod:`.decompose` fills from the robot's structure. Two families:
 
 ``pair`` (one joint swept): the last two axes are revolute and meet at a point ``W`` (a wrist centre) that only
@@ -39,11 +39,9 @@ from numba import float64, int64, njit
 from numba.extending import register_jitable
 from numpy.typing import NDArray
 
-from .. import parallel
-from .._jit import ERROR_MODEL, inlined
-from ..subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
-from ..subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
-from .kernels import (
+from sweepik._jit import ERROR_MODEL, inlined
+from sweepik.engine import parallel
+from sweepik.reductions.kernels import (
     CONFIGURATION_SIG,
     CONFIGURATIONS_SIG,
     RESIDUAL_SIG,
@@ -56,7 +54,9 @@ from .kernels import (
     as_residuals,
     lazy_njit,
 )
-from .position import BOTH, CASES, FINAL_JOINTS, NEITHER, angle, motion, move, place, reduce_chain
+from sweepik.reductions.position import BOTH, CASES, FINAL_JOINTS, NEITHER, angle, motion, move, place, reduce_chain
+from sweepik.subproblems import in_domain, lp4, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, sp6
+from sweepik.subproblems.vec import add, cross, dot, norm, orthogonal, rot, rot_cs, scale, sub
 
 Array = NDArray[np.float64]
 
@@ -509,7 +509,7 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
     ``h``, where its angles turn by up to pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
     ``amplitude`` of ``case_kernels``: the arm's kernel, given as ``amplitude``, with ``amplitudes`` its all-step
     kernel, which must compute at least the steps ``ks``). Batches use both cores, as the engine's search."""
-    from ..fastsweep import PARALLEL_MIN, writable  # local: the engine imports the reductions
+    from sweepik.engine.search import PARALLEL_MIN, writable  # local: the engine imports the reductions
 
     parallel.run(
         swing,

@@ -1,4 +1,4 @@
-"""Scalar kernels of the C-Arm reductions, compiled with Numba for the generic engine (:mod:`sweepik.fastsweep`).
+"""Scalar kernels of the C-Arm reductions, compiled with Numba for the generic engine (:mod:`sweepik.engine.search`).
 
 A reduction's kernel is a pair of compiled functions with fixed signatures (``RESIDUAL_SIG``,
 ``CONFIGURATION_SIG``): ``residual(params, theta, branch) -> float`` and ``configuration(params, theta, branch,
@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from .._jit import ERROR_MODEL, internal
-from .._wrap import wrap_pi
-from ..errors import UnknownOptionError
+from sweepik._jit import ERROR_MODEL, internal
+from sweepik.errors import UnknownOptionError
+from sweepik.subproblems.trig import wrap_pi
 
 _njit: Any
 try:
@@ -276,7 +276,7 @@ as_hints: Any = None
 as_swing: Any = None
 as_singular: Any = None
 if _njit is not None:
-    from .._jit import function_at
+    from sweepik._jit import function_at
 
     #: In compiled code, the function at an address (``address_of``) of each kernel signature.
     as_residual = function_at(RESIDUAL_SIG)

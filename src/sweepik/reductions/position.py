@@ -41,9 +41,9 @@ import math
 from numba import njit, types
 from numba.extending import overload
 
-from .._jit import ERROR_MODEL, inlined
-from ..subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
-from ..subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
+from sweepik._jit import ERROR_MODEL, inlined
+from sweepik.subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
+from sweepik.subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
 __all__ = [
     "CASES",

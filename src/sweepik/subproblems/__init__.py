@@ -4,9 +4,22 @@ They know no robot: a kinematic family (:mod:`sweepik.reductions.families`) comp
 points. See docs/subproblems.md for each equation, its solution set and its degenerate cases.
 """
 
-from .prismatic import lines2, lines3, lp1, lp3, lp4
-from .revolute import DOMAIN_TOL, in_domain, sp1, sp1_cs, sp2, sp2_cs, sp3, sp3_cs, sp4, sp4_cs, sp5, sp6
-from .trig import trig2_roots
+from sweepik.subproblems.prismatic import lines2, lines3, lp1, lp3, lp4
+from sweepik.subproblems.revolute import (
+    DOMAIN_TOL,
+    in_domain,
+    sp1,
+    sp1_cs,
+    sp2,
+    sp2_cs,
+    sp3,
+    sp3_cs,
+    sp4,
+    sp4_cs,
+    sp5,
+    sp6,
+)
+from sweepik.subproblems.trig import trig2_roots
 
 __all__ = [
     "sp1",

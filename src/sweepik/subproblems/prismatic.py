@@ -18,8 +18,8 @@ import math
 
 from numba import njit
 
-from .._jit import ERROR_MODEL
-from .vec import add, cross, dot, norm, perp, scale, sub
+from sweepik._jit import ERROR_MODEL
+from sweepik.subproblems.vec import add, cross, dot, norm, perp, scale, sub
 
 __all__ = ["lp1", "lp3", "lp4", "lines2", "lines3", "PARALLEL_DET"]
 

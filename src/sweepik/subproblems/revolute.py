@@ -31,9 +31,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .._jit import ERROR_MODEL, inlined
-from .trig import trig2_roots
-from .vec import cross, dot, norm, perp, rot, rot_cs, sub
+from sweepik._jit import ERROR_MODEL, inlined
+from sweepik.subproblems.trig import trig2_roots
+from sweepik.subproblems.vec import cross, dot, norm, perp, rot, rot_cs, sub
 
 __all__ = [
     "sp1",

@@ -1,4 +1,4 @@
-"""Roots of a trigonometric polynomial of degree 2 in one angle: what SP5 and SP6 reduce to.
+"""Roots of a trigonometric polynomial of degree 2 in one angle (what SP5 and SP6 reduce to), and angle wrapping.
 
 ``f(theta) = a0 + a1 cos(theta) + b1 sin(theta) + a2 cos(2 theta) + b2 sin(2 theta)`` has at most 4 roots on the
 circle. With ``z = exp(i theta)``, ``z^2 f`` is a polynomial of degree 4 in ``z`` whose roots on the unit circle are
@@ -20,9 +20,9 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from .._jit import ERROR_MODEL, internal
+from sweepik._jit import ERROR_MODEL, inlined, internal
 
-__all__ = ["trig2_roots", "trig2"]
+__all__ = ["trig2_roots", "trig2", "wrap_pi"]
 
 #: Roots of ``z^2 f`` this far from the unit circle (in ``| |z| - 1 |``) are candidates: a double root (f tangent
 #: to zero) splits into two roots ~sqrt(rounding) off the circle.
@@ -161,3 +161,21 @@ def trig2_roots(a0, a1, b1, a2, b2):
             j -= 1
         out[j + 1] = t
     return out, n
+
+
+@inlined
+def wrap_pi(x: float) -> float:
+    """``pi - ((pi - x) % 2 pi)``, the angle ``x`` wrapped into ``(-pi, pi]``, bit for bit as that expression gives it
+    (Python's and NumPy's float modulo, as ``Robot.wrap``), without the modulo's library call when ``|pi - x| < 2 pi``:
+    there ``fmod`` returns ``pi - x`` exactly and the modulo adds ``2 pi`` to a negative one (and gives +0 for 0, which
+    ``pi -`` does not tell from -0). NaN (a branch that does not exist) is returned as it is: the modulo's call is
+    slowest on it (~150 ns)."""
+    y = math.pi - x
+    two_pi = 2.0 * math.pi
+    if 0.0 <= y < two_pi:
+        return math.pi - y
+    if -two_pi < y < 0.0:
+        return math.pi - (y + two_pi)
+    if y != y:
+        return x
+    return math.pi - (y % two_pi)

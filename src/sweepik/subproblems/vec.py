@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from .._jit import inlined
+from sweepik._jit import inlined
 
 __all__ = ["add", "sub", "scale", "dot", "cross", "norm", "unit", "rot", "rot_cs", "perp", "along", "orthogonal"]
 

@@ -1,0 +1,816 @@
+"""The one-joint sweep engine, precise strategy: every zero of a reduction's residual along theta*.
+
+For N poses at once: sample theta* (uniform grid plus the reduction's hints) and evaluate every branch,
+giving one residual sequence per (pose, branch). On each sequence:
+
+* sign changes between consecutive valid samples -> bracketed roots (Chandrupatla, to full precision);
+* local extrema of |residual| that do not cross zero at the samples -> the extremum is located precisely
+  (as the root of a central difference of the residual); if it crosses zero there are two close roots
+  (bracketed on either side), if it touches zero it is a double root (certified later by forward kinematics);
+* samples at the edge of a branch's domain (next to NaN) and at the ends of the range -> candidates;
+* intervals where the curve bends enough to hide two roots between its samples (judged from second
+  differences), or that touch a domain edge (square-root behaviour), are resampled more finely, recursively,
+  and searched the same way;
+* runs of samples where the residual vanishes identically -> self-motion families;
+* samples within the residual's rounding noise -> candidates (a double root landing on a sample);
+* roots in a stretch where the residual stays at rounding level (roots of high multiplicity) -> moved to the
+  middle of the stretch; a stretch that ends at a domain edge, a jump or the search reach on both sides is a
+  family (an analytic residual vanishing on an interval vanishes up to such an end), one that leaves the noise
+  smoothly is a single root; roots joined by such stretches are merged;
+* each root's multiplicity, from the growth of the residual away from it.
+
+The result is a flat list of candidates ``(pose index, branch, theta*)``; ``solve`` turns them into
+configurations, certifies each by forward kinematics and applies limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sweepik.engine.rootfind import find_roots
+from sweepik.model import kinematics
+from sweepik.model.pose import pose_error_geodesic
+from sweepik.model.units import orientation_weight
+from sweepik.reductions.base import Array, IntArray, Reduction
+
+#: Default number of uniform samples of theta* over its range (hints and refinements come on top).
+#: Checked against an independent polynomial solver (tests/carm_oracle.py) and against dense sampling.
+N_SAMPLES = 64
+#: Samples per refined interval, and the number of refinement levels (resolution: step / SUB**LEVELS).
+SUB_SAMPLES = 8
+MAX_LEVELS = 4
+#: An interval is resampled when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola dips h^2 |f''| / 8
+#: below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step). Next to a domain edge
+#: (square-root behaviour: no curvature estimate in theta) curvature is judged in the coordinate
+#: sqrt(|theta - edge|), in which the residual is smooth (``_edge_coordinate``), and the interval is resampled only
+#: where that test says so; at the first level only where the edge sits at a sample (``EDGE_PROBE_REL``), else
+#: always.
+BEND = 1.0
+#: An interior extremum of |residual| is examined only if its sample is within EXTREMUM_REACH |f''| h^2 of
+#: zero: 8 times the deepest dip a parabola through the three samples can have (|f''| h^2 / 2).
+EXTREMUM_REACH = 4.0
+_U_UNIFORM = np.linspace(0.0, 1.0, SUB_SAMPLES + 2)
+_U_EDGE = 0.5 * (1.0 - np.cos(np.pi * _U_UNIFORM))
+#: |residual| at or below which a sample counts as lying on a self-motion family (residuals are computed to
+#: ~1e-15; an isolated root makes three consecutive samples this small only with probability ~0). No looser: a
+#: pose a hair off a self-motion (theta5 = 1e-9 at theta2 = 90 deg on the C-Arm) has a residual of that hair's
+#: size along the whole former family, with isolated roots in it that a looser threshold would hide, while its
+#: members miss the pose by more than the FK acceptance (about 1e-12 rad of orientation).
+FAMILY_TOL = 1e-12
+#: Roots of one branch joined by a stretch where the residual stays at rounding noise form a cluster; a
+#: cluster longer than this fraction of the theta* range is reported as a family (a numerical continuum:
+#: every point of it solves the pose to rounding precision), a shorter one as its midpoint. A double root
+#: (f ~ c x^2) is flat at noise level over ~2 sqrt(1e-16 / c), about 1e-8 of the range: far shorter.
+CLUSTER_FAMILY_REL = 1e-5
+#: Probe distance (relative to the range) deciding whether a root sits in a flat stretch of the residual,
+#: the largest half-width searched for such a stretch, and bisection steps locating its ends.
+FLAT_PROBE_REL = 1e-9
+FLAT_MAX_REL = 1e-2
+FLAT_BISECT = 30
+#: ... but a stretch too short to be a family (it marks a root of high multiplicity, see ``_center_flat``) only
+#: to this fraction of its half-width: its centre is the root, and rounding leaves the root undetermined across
+#: the whole stretch anyway (2^-12; 30 halvings would pin the ends to 1e-9 of it).
+FLAT_SHORT_TOL = 2.0**-12
+#: Bisection steps locating where a family ends between its last sample and the next one.
+FAMILY_BISECT = 40
+#: Minimum number of consecutive vanishing samples that make a family.
+FAMILY_MIN_RUN = 3
+#: A flat stretch (|residual| within the noise around a root) ends where the residual leaves the noise. It
+#: leaves it *smoothly* next to an isolated root of high multiplicity (just past the end |f| is barely above
+#: the noise) and by a *jump* (a branch swap) or at a domain edge (NaN) where a continuum ends: a residual
+#: analytic along a branch that vanishes on an interval vanishes up to such an end. |f| above JUMP_NOISE x noise
+#: just past the end counts as a jump.
+JUMP_NOISE = 1e3
+#: Multiplicity of a root: from the growth of |f| away from it, measured where |f| first exceeds
+#: MULT_LEVEL x noise (on either side), comparing |f| at distances d and 2 d (ratio 2^m for a root of order m).
+MULT_LEVEL = 1e4
+#: Largest multiplicity reported (rounding decides nothing finer).
+MULT_MAX = 8
+#: A located extremum of |residual| whose |residual| exceeds FAR_NOISE x the residual's noise (on the side of its
+#: samples) is not a candidate: 1e-2 for residuals of O(1) sines and cosines (noise 1e-14; C-Arm: the sine of the
+#: wrist's misalignment), 1e-2 of the arm's size for the pose-error residual; far above what certification
+#: (2e-13 of the arm's size) or the Newton polish (candidates within 1e-6 of it) accept. Extrema found that far
+#: after their first location are not located further. Samples next to a domain edge or at the range's ends
+#: farther from zero are no candidates either; next to a family's samples (masked as NaN) they stay candidates
+#: whatever their residual: their flat-stretch probe can join two pieces of the family.
+FAR_NOISE = 1e12
+#: A domain edge sits at a sample (a generic sweep's margins' zeros are samples) when its branch's residual is not
+#: finite this far past it (relative to the theta* range): the first level then judges the interval beside it in that
+#: edge's coordinate, as the levels below do (``BEND``).
+EDGE_PROBE_REL = 1e-9
+#: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
+XTOL_REL = 1e-16
+#: Half-step of the central difference used to locate extrema, relative to the theta* range.
+#: Balances rounding (1e-16 / h) against truncation (h^2): the extremum lands within ~1e-8 of the range.
+DIFF_STEP_REL = 1e-7
+#: The extremum is then relocated with steps DIFF_SHRINK and DIFF_SHRINK^2 times smaller (DIFF_LEVELS in all).
+DIFF_SHRINK = 16.0
+DIFF_LEVELS = 3
+
+
+@dataclass(frozen=True)
+class Candidates:
+    """Flat candidate list: pose index, branch, theta* value and the root's multiplicity (1 for a simple root,
+    2 where two solutions merge, ...), for ``K`` candidates."""
+
+    pose: IntArray
+    branch: IntArray
+    theta: Array
+    mult: IntArray
+
+
+@dataclass(frozen=True)
+class Spans:
+    """Runs of theta* along which a branch of a pose solves the pose identically (self-motion families): pose
+    index, branch and the run's ends ``[lo, hi]``, for ``K`` runs (arrays: a batch has thousands of them)."""
+
+    pose: IntArray
+    branch: IntArray
+    lo: Array
+    hi: Array
+
+    @staticmethod
+    def empty() -> Spans:
+        """No spans (one shared instance, its arrays read-only: most sweeps find none)."""
+        return _NO_SPANS
+
+    @staticmethod
+    def concat(parts: list[Spans]) -> Spans:
+        if len(parts) == 1:
+            return parts[0]
+        return Spans(
+            np.concatenate([s.pose for s in parts]).astype(np.intp),
+            np.concatenate([s.branch for s in parts]).astype(np.intp),
+            np.concatenate([s.lo for s in parts]).astype(np.float64),
+            np.concatenate([s.hi for s in parts]).astype(np.float64),
+        )
+
+    def __len__(self) -> int:
+        return int(self.pose.size)
+
+
+def _no_spans() -> Spans:
+    arrays = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0), np.zeros(0))
+    for a in arrays:
+        a.flags.writeable = False
+    return Spans(*arrays)
+
+
+_NO_SPANS = _no_spans()
+
+
+@lru_cache(maxsize=8)
+def _unit_grid(n: int) -> Array:
+    return np.linspace(0.0, 1.0, n)
+
+
+def grid_hints(reduction: Reduction, poses: Array) -> Array | None:
+    """The samples ``(N, H)`` that ``sample_grid`` adds to the uniform grid (NaN: none): the reduction's hints and,
+    for a non-periodic theta*, its limits (a solution exactly at a limit, a rail end, is then a sample); for a
+    periodic theta* wrapped into [-pi, pi]."""
+    hints = reduction.sample_hints(poses)
+    if not reduction.periodic:
+        j = reduction.free_joint
+        ends = np.empty((poses.shape[0], 2))
+        ends[:, 0], ends[:, 1] = reduction.robot.lower[j], reduction.robot.upper[j]
+        hints = ends if hints is None else np.concatenate([hints, ends], axis=1)
+    if hints is not None and hints.size and reduction.periodic:
+        hints = np.pi - np.mod(np.pi - hints, 2.0 * np.pi)
+    return hints
+
+
+def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
+    """Sorted theta* samples ``(N, M)``: a uniform grid on [lo, hi] plus the reduction's hints inside it
+    (``grid_hints``; :func:`sweepik.engine.search.sample_grid` is the compiled version)."""
+    return merge_grid(lo, hi, n_samples, grid_hints(reduction, poses))
+
+
+def merge_grid(lo: Array, hi: Array, n_samples: int, hints: Array | None) -> Array:
+    """``sample_grid`` from the hints: the uniform grid, the hints inside [lo, hi], sorted, repeats spread."""
+    s = _unit_grid(n_samples)
+    grid = lo[:, None] + (hi - lo)[:, None] * s[None, :]
+    if hints is not None and hints.size:
+        inside = np.isfinite(hints) & (hints >= lo[:, None]) & (hints <= hi[:, None])
+        # a hint outside the range becomes a midpoint of the uniform grid (a distinct, harmless extra sample)
+        spare = lo[:, None] + (hi - lo)[:, None] * ((np.arange(hints.shape[1]) + 0.5) / (n_samples - 1))[None, :]
+        hints = np.where(inside, hints, spare)
+        grid = np.concatenate([grid, hints], axis=1)
+    grid = np.sort(grid, axis=1)
+    # a sample repeated (a hint on the grid, hints outside the range all set to lo) would leave zero-width
+    # intervals, where the three-sample extremum test cannot work (a double root exactly at that sample would go
+    # unseen): each run of equal samples is spread evenly towards the next distinct sample
+    new_run = np.ones(grid.shape, dtype=bool)
+    new_run[:, 1:] = grid[:, 1:] > grid[:, :-1]
+    if new_run.all():
+        return grid
+    M = grid.shape[1]
+    idx = np.broadcast_to(np.arange(M), grid.shape)
+    start = np.maximum.accumulate(np.where(new_run, idx, 0), axis=1)
+    nxt = np.full(grid.shape, M)
+    nxt[:, :-1] = np.minimum.accumulate(np.where(new_run, idx, M)[:, :0:-1], axis=1)[:, ::-1]
+    r_i, r_j = np.nonzero(~new_run & (nxt < M))
+    if r_i.size:
+        s0, e0 = start[r_i, r_j], nxt[r_i, r_j]
+        base = grid[r_i, s0]
+        grid[r_i, r_j] = base + (grid[r_i, e0] - base) * (r_j - s0) / (e0 - s0)
+    return grid
+
+
+def _edge_coordinate(theta: Array, edge: Array) -> Array:
+    """The coordinate in which an interval's curvature is judged: theta, or ``sqrt(|theta - edge|)`` where
+    ``edge`` (broadcast against ``theta``) is finite. At a branch-domain edge the residual behaves like
+    ``a + b sqrt(|theta - edge|) + ...`` (the square root of the branch's discriminant): analytic in that
+    coordinate, unbounded in curvature in theta. Judged in theta, the intervals next to an edge always look bent
+    and are resampled down to the last level; judged in the square root, only where a root can hide."""
+    return np.where(np.isfinite(edge), np.sqrt(np.abs(theta - edge)), theta)
+
+
+class _Search:
+    """Candidate search over residual sequences ``theta, f (S, M)`` with pose/branch per sequence."""
+
+    def __init__(self, reduction: Reduction, poses: Array, span: Array) -> None:
+        self.red = reduction
+        self.poses = poses
+        self.span = span
+        self.roots_p: list[IntArray] = []
+        self.roots_b: list[IntArray] = []
+        self.roots_t: list[Array] = []
+        self.br: list[tuple[IntArray, IntArray, Array, Array, Array, Array]] = []
+        self.spans = Spans.empty()
+        #: |residual| above which a sample or extremum is no candidate (see ``FAR_NOISE``)
+        self.far = FAR_NOISE * reduction.residual_noise
+        #: a signed residual (analytic along a branch), not the pose error's norm (kinked where it vanishes)
+        self.signed = not isinstance(reduction, PoseErrorResidual)
+
+    def residual(self, pose: IntArray, branch: IntArray, theta: Array) -> Array:
+        """Residual ``(K, M)`` of one branch per row."""
+        r = self.red.residual_rows(self.poses, pose, theta, np.broadcast_to(branch[:, None], theta.shape))
+        assert r is not None
+        return r
+
+    def _root(self, p: IntArray, b: IntArray, t: Array) -> None:
+        self.roots_p.append(p)
+        self.roots_b.append(b)
+        self.roots_t.append(t)
+
+    def scan(
+        self,
+        p: IntArray,
+        b: IntArray,
+        th: Array,
+        f: Array,
+        valid: NDArray[np.bool_],
+        level: int,
+        edge_left: NDArray[np.bool_] | None = None,
+        edge_right: NDArray[np.bool_] | None = None,
+        ctx: tuple[Array, Array, Array, Array] | None = None,
+        edge_x: Array | None = None,
+        family: NDArray[np.bool_] | None = None,
+    ) -> None:
+        """Find candidates on sequences ``th, f (S, M)`` (``valid``: usable samples); recurse into bends.
+
+        ``edge_left``/``edge_right`` ``(S,)``: the sequence's first/last sample borders a domain edge.
+        ``ctx``: (theta, f) of the samples just left and right of a resampled interval (its parent's neighbours,
+        NaN where there is none), so that its end samples get the extremum test with their nearest neighbours:
+        a double root just beside a parent sample lies in the first or last sub-interval at every level.
+        ``edge_x (S,)``: the domain edge whose neighbouring interval this sequence resamples (NaN if none): there
+        curvature is judged in the coordinate sqrt(|theta - edge|) (see ``_edge_coordinate``).
+        ``family (S, M)``: the samples masked as a family's (level 0 only; see ``FAR_NOISE``).
+        """
+        S, M = f.shape
+        if edge_left is None or edge_right is None:
+            edge_left = edge_right = np.zeros(S, dtype=bool)
+        if edge_x is None:
+            edge_x = np.full(S, np.nan)
+        absf = np.abs(f)
+        fin = np.where(valid, f, np.nan)
+        t0, t1 = th[:, :-1], th[:, 1:]
+        v0, v1 = valid[:, :-1], valid[:, 1:]
+        both = v0 & v1 & (t1 > t0)
+        # samples on a root (within the residual's rounding noise): a sample that lands on a double root is
+        # the root, whatever its neighbours do (the end samples of a resampled interval are its parent's)
+        own = valid.copy()
+        if level:
+            own[:, 0] = own[:, -1] = False
+        z_i, z_j = np.nonzero(own & (absf <= self.red.residual_noise))
+        self._root(p[z_i], b[z_i], th[z_i, z_j])
+        # 3) extrema of |f| with no sign change around them (interior samples; with context, the ends too)
+        if ctx is not None:
+            th_x = np.concatenate([ctx[0][:, None], th, ctx[2][:, None]], axis=1)
+            f_x = np.concatenate([ctx[1][:, None], fin, ctx[3][:, None]], axis=1)
+        else:
+            th_x, f_x = th, fin
+        if th_x.shape[1] >= 3:
+            fm, fc, fp = f_x[:, :-2], f_x[:, 1:-1], f_x[:, 2:]
+            hl, hr = th_x[:, 1:-1] - th_x[:, :-2], th_x[:, 2:] - th_x[:, 1:-1]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                dd = 2.0 * ((fp - fc) / hr - (fc - fm) / hl) / (hl + hr)
+                # a parabola through the samples dips at most |f''| h^2 / 2 below the middle one
+                may_touch = np.abs(fc) <= EXTREMUM_REACH * np.abs(dd) * np.maximum(hl, hr) ** 2
+                ext = (
+                    (np.abs(fc) <= np.abs(fm))
+                    & (np.abs(fc) <= np.abs(fp))
+                    & (fm * fc > 0)
+                    & (fc * fp > 0)
+                    & (hl > 0)
+                    & (hr > 0)
+                    & may_touch
+                )
+            e_i, e_j = np.nonzero(ext)
+            if e_i.size:
+                self._extrema(
+                    p[e_i],
+                    b[e_i],
+                    th_x[e_i, e_j],
+                    th_x[e_i, e_j + 1],
+                    th_x[e_i, e_j + 2],
+                    f_x[e_i, e_j + 1],
+                    f_x[e_i, e_j],
+                    f_x[e_i, e_j + 2],
+                )
+        # 4) samples next to a domain edge (NaN) or at the range ends (level 0 only)
+        end = level == 0
+        left_open = np.concatenate([np.full((S, 1), end), ~valid[:, :-1]], axis=1)
+        right_open = np.concatenate([~valid[:, 1:], np.full((S, 1), end)], axis=1)
+        nb_r = np.concatenate([absf[:, 1:], np.full((S, 1), np.inf)], axis=1)
+        nb_l = np.concatenate([np.full((S, 1), np.inf), absf[:, :-1]], axis=1)
+        nb_r = np.where(np.isfinite(nb_r), nb_r, np.inf)
+        nb_l = np.where(np.isfinite(nb_l), nb_l, np.inf)
+        edge_l, edge_r = left_open & (absf <= nb_r), right_open & (absf <= nb_l)
+        near = absf <= self.far
+        if family is not None:  # (next to a family's samples: whatever the residual)
+            no = np.zeros((S, 1), dtype=bool)
+            near |= edge_l & np.concatenate([no, family[:, :-1]], axis=1)
+            near |= edge_r & np.concatenate([family[:, 1:], no], axis=1)
+        edge = valid & (edge_l | edge_r) & near
+        d_i, d_j = np.nonzero(edge)
+        self._root(p[d_i], b[d_i], th[d_i, d_j])
+        # 5) intervals that may hide a pair of roots (besides a sign change they may have) are resampled;
+        #    sign changes of the other intervals are bracketed
+        prod = fin[:, :-1] * fin[:, 1:]
+        if level < MAX_LEVELS:
+            with np.errstate(invalid="ignore", divide="ignore"):
+                # curvature in theta, or in sqrt(|theta - edge|) below an edge's interval
+                x = _edge_coordinate(th, edge_x[:, None])
+                dd = np.full((S, M), np.nan)  # second divided difference at interior samples
+                if M >= 3:
+                    hl, hr = x[:, 1:-1] - x[:, :-2], x[:, 2:] - x[:, 1:-1]
+                    dd[:, 1:-1] = (
+                        2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
+                    )
+                curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
+                lowest = np.minimum(absf[:, :-1], absf[:, 1:])
+                hx = x[:, 1:] - x[:, :-1]
+                bend = lowest <= BEND * curv * hx * hx
+                # sample j borders a domain edge on its left / right
+                open_l = np.concatenate([edge_left[:, None], ~valid[:, :-1]], axis=1)
+                open_r = np.concatenate([~valid[:, 1:], edge_right[:, None]], axis=1)
+                near_edge = open_l[:, :-1] | open_r[:, 1:]
+                # an interval next to an edge is resampled unconditionally, except next to the edge whose
+                # coordinate judges the curvature (there the bend test in that coordinate decides)
+                ex = edge_x[:, None]
+                own_edge = (open_l[:, :-1] & (t0 == ex) & ~open_r[:, 1:]) | (
+                    open_r[:, 1:] & (t1 == ex) & ~open_l[:, :-1]
+                )
+            nonzero = np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0
+            refine = bend | (near_edge & ~own_edge)
+            if level == 0 and self.signed:  # (an edge at a sample: in its coordinate)
+                judged, bent = self._edge_at_sample(p, b, th, fin, both, open_l, open_r, family)
+                refine = np.where(judged, bent, refine)
+            refine &= both & nonzero
+        else:
+            refine = np.zeros_like(both)
+        s_i, s_j = np.nonzero(both & ~refine & (prod < 0))
+        if s_i.size:
+            self.br.append((p[s_i], b[s_i], th[s_i, s_j], th[s_i, s_j + 1], f[s_i, s_j], f[s_i, s_j + 1]))
+        r_i, r_j = np.nonzero(refine)
+        if r_i.size == 0:
+            return
+        # uniform sub-samples; next to a domain edge (square-root behaviour) clustered towards both ends
+        u = np.where(near_edge[r_i, r_j, None], _U_EDGE[None, :], _U_UNIFORM[None, :])
+        sub = th[r_i, r_j, None] + (th[r_i, r_j + 1] - th[r_i, r_j])[:, None] * u
+        pp, bb = p[r_i], b[r_i]
+        fs = self.residual(pp, bb, sub)
+        fs[:, 0], fs[:, -1] = f[r_i, r_j], f[r_i, r_j + 1]
+        vs = np.isfinite(fs)
+        # the parent already handled the interval's end samples as candidates: only interior ones are new;
+        # its neighbours (or, at the sequence's ends, its own context) are the sub-sequence's context
+        nan = np.full(r_i.size, np.nan)
+        left = r_j >= 1
+        right = r_j + 2 <= M - 1
+        jl, jr = np.maximum(r_j - 1, 0), np.minimum(r_j + 2, M - 1)
+        cl_t = np.where(left, th[r_i, jl], nan if ctx is None else ctx[0][r_i])
+        cl_f = np.where(left, fin[r_i, jl], nan if ctx is None else ctx[1][r_i])
+        cr_t = np.where(right, th[r_i, jr], nan if ctx is None else ctx[2][r_i])
+        cr_f = np.where(right, fin[r_i, jr], nan if ctx is None else ctx[3][r_i])
+        # an interval next to one edge: its sub-sequences judge curvature in that edge's coordinate; next to two
+        # edges: in theta; next to none: as their parent
+        el, er = open_l[r_i, r_j], open_r[r_i, r_j + 1]
+        ex = np.where(el & ~er, th[r_i, r_j], np.where(er & ~el, th[r_i, r_j + 1], np.where(el, np.nan, edge_x[r_i])))
+        self.scan(pp, bb, sub, fs, vs, level + 1, el, er, (cl_t, cl_f, cr_t, cr_f), ex)
+
+    def _edge_at_sample(
+        self,
+        p: IntArray,
+        b: IntArray,
+        th: Array,
+        fin: Array,
+        both: NDArray[np.bool_],
+        open_l: NDArray[np.bool_],
+        open_r: NDArray[np.bool_],
+        family: NDArray[np.bool_] | None,
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+        """Level-0 intervals ``(S, M - 1)`` next to one domain edge that sits at their open-side sample (the residual
+        just past it is not finite), and which of them bend in that edge's coordinate (judged from the interval and its
+        other neighbour: the test the interval's sub-intervals get, ``_edge_coordinate``)."""
+        S, M = th.shape
+        judged = np.zeros((S, M - 1), dtype=bool)
+        bent_out = np.zeros((S, M - 1), dtype=bool)
+        if M < 3:
+            return judged, bent_out
+        o_l, o_r = open_l[:, :-1], open_r[:, 1:]
+        if family is not None:  # (a family's masked samples are no domain edge)
+            no = np.zeros((S, 1), dtype=bool)
+            o_l = o_l & ~np.concatenate([no, family[:, :-2]], axis=1)
+            o_r = o_r & ~np.concatenate([family[:, 2:], no], axis=1)
+        right = both & o_r & ~open_l[:, :-1]  # interval j's sample j + 1 borders the edge
+        left = both & o_l & ~open_r[:, 1:]
+        right[:, 0] = False  # (the sample on the other side is needed)
+        left[:, -1] = False
+        i_r, j_r = np.nonzero(right)
+        i_l, j_l = np.nonzero(left)
+        i = np.concatenate([i_r, i_l])
+        e = np.concatenate([j_r + 1, j_l])  # the sample at the edge
+        n1 = np.concatenate([j_r, j_l + 1])  # its neighbour, then the next one
+        n2 = np.concatenate([j_r - 1, j_l + 2])
+        side = np.concatenate([np.ones(j_r.size), -np.ones(j_l.size)])  # the edge's side
+        if i.size == 0:
+            return judged, bent_out
+        ok = np.isfinite(fin[i, n2])
+        te = th[i, e]
+        x1, x2 = np.sqrt(np.abs(th[i, n1] - te)), np.sqrt(np.abs(th[i, n2] - te))
+        f0, f1, f2 = fin[i, e], fin[i, n1], fin[i, n2]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dd = 2.0 * ((f2 - f1) / (x2 - x1) - (f1 - f0) / x1) / x2
+            bent = np.minimum(np.abs(f0), np.abs(f1)) <= BEND * np.abs(dd) * x1 * x1
+        step = EDGE_PROBE_REL * self.span[p[i]]
+        past = self.residual(p[i], b[i], (te + side * step)[:, None])[:, 0]
+        at = ok & np.isfinite(dd) & ~np.isfinite(past)
+        judged[i_r, j_r], judged[i_l, j_l] = at[: j_r.size], at[j_r.size :]
+        bent_out[i_r, j_r], bent_out[i_l, j_l] = bent[: j_r.size], bent[j_r.size :]
+        return judged, bent_out
+
+    def _extrema(
+        self, p: IntArray, b: IntArray, ta: Array, tc: Array, tb: Array, fc: Array, fa: Array, fb: Array
+    ) -> None:
+        """Locate the extremum between ta and tb, then classify (two roots / touching / nothing)."""
+        span = self.span[p]
+        idx = np.arange(p.size)
+
+        def fe(x: Array, sel: IntArray) -> Array:
+            return self.residual(p[sel], b[sel], x[:, None])[:, 0]
+
+        xe = tc.copy()
+        a, c = ta, tb
+        far = np.zeros(p.size, dtype=bool)
+        idx_ok = ~far
+        # root of the central difference g(x) = f(x + h) - f(x - h), then again with h / DIFF_SHRINK around it:
+        # the first step's truncation error (next to a domain edge f''' is large) shrinks by DIFF_SHRINK^2
+        for level in range(DIFF_LEVELS):
+            h = DIFF_STEP_REL * span / DIFF_SHRINK**level
+
+            if level:
+                a, c = xe - 2.0 * DIFF_SHRINK * h, xe + 2.0 * DIFF_SHRINK * h
+            lo_, hi_ = a + h, c - h
+            ga = fe(lo_ + h, idx) - fe(lo_ - h, idx)
+            gc = fe(hi_ + h, idx) - fe(hi_ - h, idx)
+            ok = (ga * gc < 0) & (lo_ < hi_) & idx_ok
+            if not ok.any():
+                break
+            k = np.nonzero(ok)[0]
+            hk = h[k]
+
+            def g(x: Array, s: IntArray, k: IntArray = k, hk: Array = hk) -> Array:
+                return fe(x + hk[s], k[s]) - fe(x - hk[s], k[s])
+
+            xe[k] = find_roots(g, lo_[k], hi_[k], ga[k], gc[k], 1e-3 * float(hk.min()))
+            if level == 0:  # an extremum located this far from zero (on fc's side) is neither root nor touching
+                f0 = fe(xe, idx)
+                far |= np.sign(fc) * f0 > self.far
+                idx_ok = ~far
+        fx = fe(xe, idx)
+        # a dip below zero within the residual's rounding noise is a double root, not two roots: bracketing
+        # it would return arbitrary points of the flat bottom (where |f| < noise) instead of the extremum
+        cross = np.isfinite(fx) & (np.sign(fc) * fx < -self.red.residual_noise)
+        k = np.nonzero(cross)[0]
+        if k.size:
+            self.br.append((p[k], b[k], ta[k], xe[k], fa[k], fx[k]))
+            self.br.append((p[k], b[k], xe[k], tb[k], fx[k], fb[k]))
+        k = np.nonzero(~cross & np.isfinite(fx) & ~far & (np.abs(fx) <= self.far))[0]
+        self._root(p[k], b[k], xe[k])
+
+    def finish(self) -> Candidates:
+        if self.br:
+            p, b, a, c, fa, fc = (np.concatenate(x) for x in zip(*self.br, strict=True))
+            xtol = float(XTOL_REL * self.span.min())
+            x = find_roots(lambda x, s: self.residual(p[s], b[s], x[:, None])[:, 0], a, c, fa, fc, xtol)
+            self._root(p, b, x)
+        p = np.concatenate(self.roots_p).astype(np.intp)
+        b = np.concatenate(self.roots_b).astype(np.intp)
+        t, lo, hi, family = self._center_flat(p, b, np.concatenate(self.roots_t))
+        if family.any():
+            self.spans = Spans(p[family], b[family], lo[family], hi[family])
+        cand = self._merge_clusters(p[~family], b[~family], t[~family])
+        return Candidates(cand.pose, cand.branch, cand.theta, self._multiplicity(cand.pose, cand.branch, cand.theta))
+
+    def _small(self, p: IntArray, b: IntArray, x: Array) -> NDArray[np.bool_]:
+        """|residual| within the noise (NaN, outside the branch's domain, counts as not small)."""
+        return np.abs(self.residual(p, b, x[:, None])[:, 0]) <= self.red.residual_noise
+
+    def _center_flat(self, p: IntArray, b: IntArray, t: Array) -> tuple[Array, Array, Array, NDArray[np.bool_]]:
+        """Move each root to the middle of the stretch around it where |residual| stays within the noise, and
+        tell a self-motion family from a root of high multiplicity.
+
+        A simple root's stretch is ~noise / |f'| wide: nothing moves. At a root of multiplicity k >= 3 (the
+        residual ~ c x^k) the residual crosses zero at places decided by rounding anywhere in a stretch of
+        width ~(noise / c)^(1/k); its middle is the root. Such a stretch ends *smoothly* on both sides (see
+        ``JUMP_NOISE``); a stretch that ends at a domain edge, a jump or the search reach on both sides is a
+        family. Returns the moved roots, the stretches' ends and the family mask."""
+        family = np.zeros(t.size, dtype=bool)
+        if t.size == 0:
+            return t, t, t, family
+        noise = self.red.residual_noise
+        d0 = FLAT_PROBE_REL * self.span[p]
+        flat = np.nonzero(self._small(p, b, t - d0) | self._small(p, b, t + d0))[0]
+        if flat.size == 0:
+            return t, t, t, family
+        pf, bf, tf = p[flat], b[flat], t[flat]
+        reach = np.empty((flat.size, 2))
+        open_end = np.empty((flat.size, 2), dtype=bool)
+        limit = FLAT_MAX_REL * self.span[pf]
+        inners, outers = np.zeros((flat.size, 2)), np.zeros((flat.size, 2))
+        for side, sgn in enumerate((-1.0, 1.0)):
+            inner = np.zeros(flat.size)
+            outer = d0[flat].copy()
+            grow = self._small(pf, bf, tf + sgn * outer)
+            for _ in range(64):  # double until the residual leaves the noise (or the reach limit)
+                if not grow.any():
+                    break
+                inner = np.where(grow, outer, inner)
+                outer = np.where(grow, np.minimum(2.0 * outer, limit), outer)
+                grow = grow & (inner < limit) & self._small(pf, bf, tf + sgn * outer)
+            inners[:, side], outers[:, side] = inner, outer
+        # a stretch that cannot be a family (both sides within half of CLUSTER_FAMILY_REL) only gives the centre
+        # of a multiple root: its ends are bisected to FLAT_SHORT_TOL of their reach
+        short = np.all(outers <= 0.5 * CLUSTER_FAMILY_REL * self.span[pf][:, None], axis=1)
+        for side, sgn in enumerate((-1.0, 1.0)):
+            inner, outer = inners[:, side], outers[:, side]
+            at_limit = inner >= limit
+            for _ in range(FLAT_BISECT):  # boundary between inner (small) and outer (not small)
+                go = ~short | (outer - inner > FLAT_SHORT_TOL * inner)
+                mid = 0.5 * (inner + outer)
+                sm = self._small(pf, bf, tf + sgn * mid)
+                inner = np.where(go & sm, mid, inner)
+                outer = np.where(go & ~sm, mid, outer)
+            past = np.abs(self.residual(pf, bf, (tf + sgn * outer)[:, None])[:, 0])
+            # ... and keeps growing (a rounding blip inside a continuum falls back into the noise)
+            far = np.abs(self.residual(pf, bf, (tf + 2.0 * sgn * outer)[:, None])[:, 0])
+            open_end[:, side] = at_limit | ~(past <= JUMP_NOISE * noise) | (far <= 2.0 * noise)  # NaN: domain edge
+            reach[:, side] = inner
+        lo, hi = t.copy(), t.copy()
+        lo[flat] -= reach[:, 0]
+        hi[flat] += reach[:, 1]
+        wide = hi[flat] - lo[flat] > CLUSTER_FAMILY_REL * self.span[pf]
+        family[flat] = wide & open_end[:, 0] & open_end[:, 1]
+        return 0.5 * (lo + hi), lo, hi, family
+
+    def _merge_clusters(self, p: IntArray, b: IntArray, t: Array) -> Candidates:
+        """Merge neighbouring roots of one branch between which the residual stays within its rounding
+        noise: at a root of high multiplicity the residual is flat at noise level over a short stretch and
+        crosses zero there many times at random. Each such cluster becomes one candidate, its midpoint
+        (families were set apart before, by ``_center_flat``)."""
+        order = np.lexsort((t, b, p))
+        p, b, t = p[order], b[order], t[order]
+        empty = np.zeros(0, dtype=np.intp)
+        if t.size < 2:
+            return Candidates(p, b, t, empty)
+        same = (p[1:] == p[:-1]) & (b[1:] == b[:-1])
+        k = np.nonzero(same & (t[1:] > t[:-1]))[0]
+        joined = np.zeros(t.size - 1, dtype=bool)
+        if k.size:
+            mid = 0.5 * (t[k] + t[k + 1])
+            joined[k] = self._small(p[k], b[k], mid)
+        joined |= same & (t[1:] == t[:-1])
+        first = np.nonzero(np.concatenate([[True], ~joined]))[0]
+        x = 0.5 * (np.minimum.reduceat(t, first) + np.maximum.reduceat(t, first))
+        return Candidates(pose=p[first], branch=b[first], theta=x, mult=empty)
+
+    def _multiplicity(self, p: IntArray, b: IntArray, t: Array) -> IntArray:
+        """Order of each root (1 simple, 2 double, ...), from how fast |f| grows away from it: at the first
+        distance d (doubling from ``FLAT_PROBE_REL``) where |f| exceeds ``MULT_LEVEL`` x noise, |f(2 d)| / |f(d)|
+        is 2^m. Both sides are averaged; a side outside the branch's domain is left out (1 where neither)."""
+        if t.size == 0:
+            return np.zeros(0, dtype=np.intp)
+        level = MULT_LEVEL * self.red.residual_noise
+        limit = FLAT_MAX_REL * self.span[p]
+        total, count = np.zeros(t.size), np.zeros(t.size)
+        for sgn in (-1.0, 1.0):
+            d = FLAT_PROBE_REL * self.span[p]
+            f1 = np.abs(self.residual(p, b, (t + sgn * d)[:, None])[:, 0])
+            for _ in range(64):
+                low = (f1 < level) & (d < limit)
+                if not low.any():
+                    break
+                d = np.where(low, 2.0 * d, d)
+                k = np.nonzero(low)[0]
+                f1[k] = np.abs(self.residual(p[k], b[k], (t[k] + sgn * d[k])[:, None])[:, 0])
+            f2 = np.abs(self.residual(p, b, (t + 2.0 * sgn * d)[:, None])[:, 0])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                m = np.log2(f2 / f1)
+            ok = np.isfinite(m) & (f1 >= level)
+            total += np.where(ok, m, 0.0)
+            count += ok
+        with np.errstate(invalid="ignore"):
+            m = np.where(count > 0, total / np.maximum(count, 1), 1.0)
+        return np.clip(np.rint(m), 1, MULT_MAX).astype(np.intp)
+
+
+def _extend(reduction: Reduction, poses: Array, branch: IntArray, inside: Array, outside: Array) -> Array:
+    """Bisect, for every family end at once, between a sample on the family (``inside``) and the next sample
+    off it (``outside``) for where the family ends. ``poses (K, 4, 4)``, the rest ``(K,)``."""
+    for _ in range(FAMILY_BISECT):
+        mid = 0.5 * (inside + outside)
+        r = reduction.residual(poses, mid[:, None], branch[:, None])
+        on = np.isfinite(r[:, 0]) & (np.abs(r[:, 0]) <= FAMILY_TOL) if r is not None else np.zeros(mid.size, bool)
+        inside = np.where(on, mid, inside)
+        outside = np.where(on, outside, mid)
+    return inside
+
+
+def _families(
+    reduction: Reduction, poses: Array, theta: Array, f: Array, valid: NDArray[np.bool_], span: Array
+) -> tuple[Spans, NDArray[np.bool_]]:
+    """Runs of vanishing samples ``(N, M, B)`` -> family spans (ends located by bisection towards the
+    neighbouring samples), and the mask of samples they cover."""
+    flat = valid & (np.abs(f) <= FAMILY_TOL)
+    in_family = np.zeros_like(flat)
+    if not flat.any():
+        return Spans.empty(), in_family
+    runs = []  # (pose, branch, first sample, last sample)
+    for p, b in zip(*np.nonzero(flat.sum(axis=1) >= FAMILY_MIN_RUN), strict=True):
+        col = flat[p, :, b]
+        edges = np.diff(np.concatenate([[0], col.astype(np.int8), [0]]))
+        for s0, e0 in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0], strict=True):
+            # a run must also be long: coinciding samples (hints at one point) are one root, not a family
+            if e0 - s0 >= FAMILY_MIN_RUN and theta[p, e0 - 1] - theta[p, s0] > CLUSTER_FAMILY_REL * span[p]:
+                runs.append((int(p), int(b), int(s0), int(e0 - 1)))
+                in_family[p, s0:e0, b] = True
+    if not runs:
+        return Spans.empty(), in_family
+    P, Bb, S0, S1 = (np.array(x) for x in zip(*runs, strict=True))
+    M = theta.shape[1]
+    lo, hi = theta[P, S0], theta[P, S1]
+    lo = np.where(S0 > 0, _extend(reduction, poses[P], Bb, lo, theta[P, np.maximum(S0 - 1, 0)]), lo)
+    hi = np.where(S1 < M - 1, _extend(reduction, poses[P], Bb, hi, theta[P, np.minimum(S1 + 1, M - 1)]), hi)
+    return Spans(P.astype(np.intp), Bb.astype(np.intp), lo, hi), in_family
+
+
+class PoseErrorResidual(Reduction):
+    """Wraps a reduction without a residual: its "residual" is the pose error (position + weight x angle,
+    length unit) of each branch's configuration. Non-negative, so roots show up as local minima that touch
+    zero; the engine's extremum search and the FK certification handle them (at some cost in speed).
+    """
+
+    def __init__(self, inner: Reduction, weight: float) -> None:
+        super().__init__(inner.robot, inner.free_joint, inner.n_branches)
+        self.inner = inner
+        self.weight = weight
+        self.name = inner.name
+        self.residual_noise = 1e-14 * inner.robot.length_scale
+        self._inv_base = np.linalg.inv(inner.robot.T_world_base)
+
+    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        return self.inner.solve_rest(poses, theta, branch)
+
+    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
+        q = self.inner.solve_rest(poses, theta, branch)
+        T = self._inv_base @ kinematics.chain_frames(self.robot, q)[..., -1, :, :]
+        target = poses.reshape(poses.shape[0], *((1,) * (q.ndim - 2)), 4, 4)
+        return pose_error_geodesic(T, target, self.weight)
+
+    def sample_hints(self, poses: Array) -> Array | None:
+        return self.inner.sample_hints(poses)
+
+
+def find_candidates(
+    reduction: Reduction,
+    poses: Array,
+    lo: Array,
+    hi: Array,
+    n_samples: int = N_SAMPLES,
+    masked: Spans | None = None,
+) -> tuple[Candidates, Spans]:
+    """Candidates for all N chain poses ``(N, 4, 4)`` with theta* ranges ``lo, hi (N,)``. ``masked``: stretches of
+    theta* (pose, branch, ends) whose samples are left out of the search, as a family's are (a continuum traced
+    already: :mod:`sweepik.engine.rough_continua`)."""
+    theta = sample_grid(reduction, poses, lo, hi, n_samples)
+    f = reduction.residual(poses, theta)
+    if f is None:
+        reduction = PoseErrorResidual(reduction, orientation_weight(reduction.robot.length_unit))
+        f = reduction.residual(poses, theta)
+    N, M, B = f.shape
+    valid = np.isfinite(f)
+    skip = sorted(set(range(B)) - set(reduction.search_branches))
+    if skip:  # e.g. the other branches of a class of twins, which get their roots from its first (solver)
+        valid[:, :, skip] = False
+    spans, in_family = _families(reduction, poses, theta, f, valid, hi - lo)
+    if masked is not None:
+        for p, b, a, c in zip(masked.pose, masked.branch, masked.lo, masked.hi, strict=True):
+            in_family[p, (theta[p] >= a) & (theta[p] <= c), b] = True
+    valid &= ~in_family
+    search = _Search(reduction, poses, hi - lo)
+    p = np.repeat(np.arange(N), B)
+    b = np.tile(np.arange(B), N)
+    fs = f.transpose(0, 2, 1).reshape(N * B, M)
+    vs = valid.transpose(0, 2, 1).reshape(N * B, M)
+    fam = in_family.transpose(0, 2, 1).reshape(N * B, M)
+    search.scan(p, b, theta[p], fs, vs, 0, family=fam if fam.any() else None)
+    cand = search.finish()
+    return cand, Spans.concat([spans, search.spans])
+
+
+def twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candidates, Spans]:
+    """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
+    branches of the class too: their residuals are the same, their configurations differ. A pose's copies follow
+    its own candidates, poses stay in order."""
+    return twin_candidates(red, cand), twin_spans(red, spans)
+
+
+def twin_candidates(red: Reduction, cand: Candidates) -> Candidates:
+    """``twin_copies``' candidates: each pose's own, then their copies (class member by member, in order), poses in
+    order (``fastsweep``'s one-pass search makes the same copies pose by pose)."""
+    if not red.twins:
+        return cand
+    c_rows, c_branch = _twin_rows(red, cand.branch)
+    pose = np.concatenate([cand.pose, cand.pose[c_rows]])
+    # in pose order again, as the search gave them (certification and settling run on parts of whole poses)
+    order = np.argsort(pose, kind="stable") if pose.size > 1 and pose[0] != pose[-1] else slice(None)
+    return Candidates(
+        pose[order],
+        np.concatenate([cand.branch, c_branch])[order],
+        np.concatenate([cand.theta, cand.theta[c_rows]])[order],
+        np.concatenate([cand.mult, cand.mult[c_rows]])[order],
+    )
+
+
+def twin_spans(red: Reduction, spans: Spans) -> Spans:
+    """``twin_copies``' family spans: all of them, then their copies."""
+    if not red.twins or not len(spans):  # (most sweeps find none)
+        return spans
+    s_rows, s_branch = _twin_rows(red, spans.branch)
+    return Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])])
+
+
+def twin_maps(red: Reduction) -> tuple[IntArray, ...]:
+    """``red.twins`` as maps: for the d-th other member of the classes (d = 1, 2, ...), each branch's twin in that
+    place (-1: none); none without twins."""
+    twins = red.twins
+    if not twins:
+        return ()
+    try:  # (as the reductions give them: tuples of ints, the cache's key as it is)
+        return _twin_maps(twins, red.n_branches)
+    except TypeError:  # (unhashable classes: lists, arrays)
+        return _twin_maps(tuple(tuple(int(b) for b in cls) for cls in twins), red.n_branches)
+
+
+def _twin_rows(red: Reduction, branch: IntArray) -> tuple[IntArray, IntArray]:
+    """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
+    that branch: ``(rows, branches)``."""
+    rows, branches = [], []
+    for twin in twin_maps(red):
+        t = twin[branch]
+        k = np.nonzero(t >= 0)[0]
+        rows.append(k)
+        branches.append(t[k])
+    if len(rows) == 1:  # (classes of two: one map)
+        return rows[0], branches[0]
+    return np.concatenate(rows).astype(np.intp), np.concatenate(branches)
+
+
+@lru_cache(maxsize=64)
+def _twin_maps(twins: tuple[tuple[int, ...], ...], n_branches: int) -> tuple[IntArray, ...]:
+    """For the d-th other member of the classes of ``twins`` (d = 1, 2, ...): each branch's twin in that place (-1:
+    none), read only."""
+    maps = []
+    for d in range(1, max(len(cls) for cls in twins)):
+        twin = np.full(n_branches, -1, dtype=np.intp)
+        for cls in twins:
+            if len(cls) > d:
+                twin[cls[0]] = cls[d]
+        twin.flags.writeable = False
+        maps.append(twin)
+    return tuple(maps)

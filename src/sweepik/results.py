@@ -1,0 +1,402 @@
+"""Result types: ``Solutions`` (all IK solutions of one pose), ``Family`` (a self-motion continuum) and
+``SolutionBatch`` (the solutions of many poses, held in columns).
+
+``solve_many`` of a million poses should not build a million Python objects unless asked: the solver keeps each
+chunk's solutions as stacked arrays (``Block``), and a batch is a sequence of blocks. Indexing or iterating a
+batch builds the :class:`~sweepik.results.Solutions` of the poses asked for; the column attributes
+(``offsets``, ``q``, ``error``, ...) give every solution of every pose at once, pose ``i``'s solutions being the
+rows ``offsets[i]:offsets[i + 1]``.
+"""
+
+from __future__ import annotations
+
+import bisect
+import operator
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING, overload
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sweepik.errors import SweepikError
+from sweepik.model.validate import check_configuration
+
+if TYPE_CHECKING:
+    from sweepik.model.origin_axis import HeldJoints
+    from sweepik.model.robot import Robot
+    from sweepik.reductions.base import Reduction
+
+Array = NDArray[np.float64]
+
+#: Tolerance when asking a family for a member just outside its interval (relative to the interval length).
+_FAMILY_EDGE_TOL = 1e-9
+
+
+def joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
+    """Per-joint absolute differences ``(..., n)``: revolute ones wrapped modulo 2 pi (radians)."""
+    d = np.asarray(q, dtype=np.float64) - np.asarray(q_ref, dtype=np.float64)
+    wrapped = np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi))
+    return np.where(robot.is_revolute, wrapped, np.abs(d))
+
+
+def weighted_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
+    """Distance ``(...)`` between configurations ``q (..., n)`` and ``q_ref (n,)``, dimensionless: the one metric
+    of joint space in sweepik (``Solutions.nearest``, ``follow_path``).
+
+    Angles are compared modulo 2 pi (radians); prismatic differences are divided by the paper's weight
+    (100 mm per radian, eq. 6c, in the robot's length unit), then the Euclidean norm is taken.
+    """
+    from sweepik.model.units import orientation_weight  # local import keeps this module's imports light
+
+    d = joint_distance(robot, q, q_ref)
+    scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
+    return np.asarray(np.linalg.norm(d * scale, axis=-1))
+
+
+#: Members sampled along a self-motion family before the nearest one is refined (golden section).
+_FAMILY_SAMPLES = 721
+#: Local minima of the sampled distance refined by ``_nearest_on_family`` (the lowest ones).
+_NEAREST_MINIMA = 4
+_GOLDEN_ITERS = 60
+
+
+def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, float]:
+    """Member of ``fam`` nearest ``ref`` (weighted distance): dense sampling, then a golden-section search around
+    each local minimum of the samples (``_NEAREST_MINIMA`` at most, the lowest first), the best kept. Every local
+    minimum, not only the lowest sample: the nearest member can lie next to another sample of the same distance,
+    e.g. across the seam of a family that turns theta* through a whole circle (both ends are the same member)."""
+    lo, hi = fam.interval
+    grid = np.linspace(lo, hi, _FAMILY_SAMPLES)
+    members = fam.at(grid)
+    d = weighted_joint_distance(robot, members, ref)
+    d = np.where(np.all(np.isfinite(members), axis=-1), d, np.inf)
+    left = np.concatenate([[np.inf], d[:-1]])
+    right = np.concatenate([d[1:], [np.inf]])
+    minima = np.nonzero(np.isfinite(d) & (d <= left) & (d <= right))[0]
+    minima = minima[np.argsort(d[minima], kind="stable")][:_NEAREST_MINIMA]
+    i0 = int(np.argmin(d))
+    best, bd = members[i0], float(d[i0])
+
+    def dist(t: float) -> float:
+        return float(weighted_joint_distance(robot, fam.at(t), ref))
+
+    g = (np.sqrt(5.0) - 1.0) / 2.0
+    for i in minima.tolist():
+        a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+        c, e = b - g * (b - a), a + g * (b - a)
+        fc, fe = dist(c), dist(e)
+        for _ in range(_GOLDEN_ITERS):
+            if fc <= fe:
+                b, e, fe = e, c, fc
+                c = b - g * (b - a)
+                fc = dist(c)
+            else:
+                a, c, fc = c, e, fe
+                e = a + g * (b - a)
+                fe = dist(e)
+        t, dt = (c, fc) if fc <= fe else (e, fe)
+        if dt < bd:
+            best, bd = fam.at(t), dt
+    return np.asarray(best, dtype=np.float64), bd
+
+
+@dataclass(frozen=True, eq=False)
+class Family:
+    """A continuum of solutions (self-motion): every theta* in ``interval`` gives a solution.
+
+    Attributes:
+        free_joint: index of the joint that parametrises the family (theta* of the reduction).
+        interval: ``(lo, hi)`` in that joint's unit (radians or length unit), inside the joint limits
+            when the solve applied limits.
+        held: for an arm solved with locked joints, how members of the smaller arm the reduction solves map
+            back to full length (``free_joint`` is then an index of the full arm).
+    """
+
+    free_joint: int
+    interval: tuple[float, float]
+    reduction: Reduction = field(repr=False)
+    chain_pose: Array = field(repr=False)
+    branch: int = 0
+    held: HeldJoints | None = field(default=None, repr=False)
+
+    def at(self, theta: ArrayLike) -> Array:
+        """Member configuration(s) ``(n,)`` (or ``(..., n)``) at theta* value(s) inside ``interval`` (a revolute
+        joint's angle modulo 2 pi: a configuration's own value of the joint will do, wherever its range puts it).
+        Each is a solution of the pose: at an isolated theta* where the reduction's closed form breaks down (the
+        C-Arm's wrist crossing joint 2's axis), the member ~1e-9 of the interval away is given, the solution there
+        being its limit."""
+        th = np.asarray(theta, dtype=np.float64)
+        lo, hi = self.interval
+        tol = _FAMILY_EDGE_TOL * max(hi - lo, 1.0)
+        if self.reduction.periodic:  # an angle by whole turns onto the interval (a joint's range can pass +-pi)
+            th = lo - tol + np.mod(th - (lo - tol), 2.0 * np.pi)
+        if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
+            raise SweepikError(f"theta* = {th.tolist()} is outside the family's interval [{lo:.12g}, {hi:.12g}]")
+        flat = np.clip(th.reshape(-1), lo, hi)
+        from sweepik.engine.families import certified_members  # local import: families imports this module
+
+        red = self.reduction
+        q = red.robot.wrap(certified_members(red, self.chain_pose, self.branch, flat, lo, hi))
+        if self.held is not None:
+            q = self.held.expand(q)
+        return q.reshape(*th.shape, -1)
+
+    def sample(self, count: int = 50) -> Array:
+        """``(count, n)`` member configurations evenly spaced over the interval."""
+        return self.at(np.linspace(self.interval[0], self.interval[1], count))
+
+
+@dataclass(frozen=True, eq=False)
+class Solutions:
+    """Every IK solution of one pose.
+
+    Attributes:
+        q: ``(k, n)`` configurations (radians / length unit), revolute values wrapped into their limits.
+        error: ``(k,)`` the paper's error J (eq. 6) in the robot's length unit.
+        error_geodesic: ``(k,)`` position error + weight x rotation angle (length unit).
+        within_limits: ``(k,)`` bool; all True when solved with ``limits=True``.
+        multiplicity: ``(k,)`` int, the order of each solution as a root of the sweep's residual: 1 for a
+            regular solution, 2 where two solutions merge (the arm is singular there), 3 or more on
+            intersections of singular sets. A solution of multiplicity m is pinned down by the pose only to
+            about (rounding / c)^(1/m) along theta*: ~1e-8 of the range for m = 2, ~1e-5 for m = 3.
+        families: self-motion continua (empty for almost every pose).
+        reason: why there is no solution, when ``q`` and ``families`` are empty; else ``None``.
+        pose: the target ``(4, 4)``.
+    """
+
+    q: Array
+    error: Array
+    error_geodesic: Array
+    within_limits: NDArray[np.bool_]
+    multiplicity: NDArray[np.intp]
+    families: tuple[Family, ...]
+    reason: str | None
+    pose: Array
+    robot: Robot = field(repr=False)
+
+    def __len__(self) -> int:
+        return int(self.q.shape[0])
+
+    def __iter__(self) -> Iterator[Array]:
+        return iter(self.q)
+
+    def __getitem__(self, i: int) -> Array:
+        return self.q[i]
+
+    def __bool__(self) -> bool:
+        return len(self) > 0 or bool(self.families)
+
+    def distances(self, q_ref: ArrayLike) -> Array:
+        """``(k,)`` distance of each solution to ``q_ref``: :func:`weighted_joint_distance` (angles modulo 2 pi in
+        radians, prismatic joints in units of 100 mm per radian)."""
+        ref = check_configuration(q_ref, self.robot.n_joints, "q_ref")
+        return weighted_joint_distance(self.robot, self.q, ref)
+
+    def nearest(self, q_ref: ArrayLike) -> Array:
+        """The solution ``(n,)`` closest to ``q_ref`` by :func:`weighted_joint_distance` (the metric
+        ``follow_path`` uses too). Family members count: the nearest member is searched along each family.
+        Raises SweepikError when there is no solution."""
+        ref = check_configuration(q_ref, self.robot.n_joints, "q_ref")
+        if ref.ndim != 1:
+            raise SweepikError(f"q_ref must have shape ({self.robot.n_joints},), got {ref.shape}")
+        best: Array | None = None
+        best_d = np.inf
+        if len(self):
+            d = self.distances(ref)
+            i = int(np.argmin(d))
+            best, best_d = self.q[i], float(d[i])
+        for fam in self.families:
+            member, dm = _nearest_on_family(self.robot, fam, ref)
+            if dm < best_d:
+                best, best_d = member, dm
+        if best is None:
+            raise SweepikError(f"no solution to choose from ({self.reason})")
+        return best.copy()
+
+
+UNREACHABLE = "unreachable: no configuration of the arm reaches this pose"
+
+
+def no_solution_reason(n_reachable: int) -> str:
+    """Why a pose has no solution (nor family), given how many solutions it has before the joint limits."""
+    if n_reachable > 0:
+        return f"out of joint limits: {n_reachable} solution(s) reach the pose but violate the limits"
+    return UNREACHABLE
+
+
+@dataclass(frozen=True, eq=False)
+class Block:
+    """The solutions of a chunk of ``n`` poses, rows sorted by pose: pose ``i`` owns rows
+    ``bounds[i]:bounds[i + 1]``. ``families`` maps a pose to its self-motion families (most poses have none);
+    ``n_reachable[i]`` counts its solutions before the joint limits were applied (for the no-solution reason);
+    ``empty_reason``, if set, is the reason given to every pose without solutions (the paper's strategy)."""
+
+    robot: Robot
+    poses: Array
+    bounds: NDArray[np.intp]
+    q: Array
+    error: Array
+    error_geodesic: Array
+    within_limits: NDArray[np.bool_]
+    multiplicity: NDArray[np.intp]
+    families: dict[int, tuple[Family, ...]]
+    n_reachable: NDArray[np.intp]
+    empty_reason: str | None = None
+
+    @property
+    def n(self) -> int:
+        return int(self.poses.shape[0])
+
+    def reason(self, i: int) -> str | None:
+        """Why pose ``i`` has no solution (None when it has some, or a family)."""
+        if self.bounds[i + 1] > self.bounds[i] or self.families.get(i):
+            return None
+        if self.empty_reason is not None:
+            return self.empty_reason
+        return no_solution_reason(int(self.n_reachable[i]))
+
+    def solutions(self, i: int, copy: bool = True) -> Solutions:
+        """The :class:`Solutions` of pose ``i``: arrays copied (the block stays as it is), or views of the block's
+        (``copy=False``, for a block made for this one result)."""
+        s, e = int(self.bounds[i]), int(self.bounds[i + 1])
+        take = np.copy if copy else np.asarray
+        return Solutions(
+            q=take(self.q[s:e]),
+            error=take(self.error[s:e]),
+            error_geodesic=take(self.error_geodesic[s:e]),
+            within_limits=take(self.within_limits[s:e]),
+            multiplicity=take(self.multiplicity[s:e]),
+            families=self.families.get(i, ()),
+            reason=self.reason(i),
+            pose=take(self.poses[i]),
+            robot=self.robot,
+        )
+
+    def __iter__(self) -> Iterator[Solutions]:
+        return (self.solutions(i) for i in range(self.n))
+
+
+class SolutionBatch(Sequence[Solutions]):
+    """The solutions of a batch of ``N`` poses (what ``solve_many`` returns).
+
+    A sequence of :class:`Solutions` (``len``, indexing, slicing, iteration; each built when asked for), and
+    the same data in columns, every pose's solutions stacked (``K`` rows in all):
+
+    * ``offsets (N + 1,)``: pose ``i``'s solutions are rows ``offsets[i]:offsets[i + 1]``; ``counts (N,)``;
+    * ``pose_index (K,)``: the pose of each row;
+    * ``q (K, n)``, ``error (K,)``, ``error_geodesic (K,)``, ``within_limits (K,)``, ``multiplicity (K,)``: as in
+      :class:`Solutions`;
+    * ``n_reachable (N,)``: each pose's solutions before the joint limits were applied;
+    * ``families``: ``{pose index: families}`` for the few poses that have self-motion families;
+    * ``reason(i)``: why pose ``i`` has no solution (None if it has some).
+    """
+
+    def __init__(self, robot: Robot, blocks: Sequence[Block]) -> None:
+        self.robot = robot
+        self._blocks = list(blocks)
+        self._starts = np.concatenate([[0], np.cumsum([b.n for b in self._blocks])]).astype(np.intp)
+
+    def __len__(self) -> int:
+        return int(self._starts[-1])
+
+    @property
+    def blocks(self) -> list[Block]:
+        """The solver's chunks, in order (each a :class:`Block` of consecutive poses)."""
+        return list(self._blocks)
+
+    def _locate(self, i: int) -> tuple[Block, int]:
+        n = len(self)
+        if not -n <= i < n:
+            raise IndexError(f"pose index {i} out of range for a batch of {n} poses")
+        i %= n
+        k = bisect.bisect_right(self._starts, i) - 1
+        return self._blocks[k], i - int(self._starts[k])
+
+    @overload
+    def __getitem__(self, i: int) -> Solutions: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> list[Solutions]: ...
+
+    def __getitem__(self, i: int | slice) -> Solutions | list[Solutions]:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self)))]
+        block, j = self._locate(operator.index(i))
+        return block.solutions(j)
+
+    def __iter__(self) -> Iterator[Solutions]:
+        for block in self._blocks:
+            yield from block
+
+    def __repr__(self) -> str:
+        return f"SolutionBatch({len(self)} poses, {int(self.offsets[-1])} solutions)"
+
+    def __eq__(self, other: object) -> bool:
+        """Element by element with a list or tuple (an empty batch equals ``[]``). :class:`Solutions` compare by
+        identity and a batch builds them anew on each access, so a non-empty batch equals no list, and two batches
+        are equal only if they are the same object."""
+        if isinstance(other, SolutionBatch):
+            return other is self
+        if isinstance(other, list | tuple):
+            return len(other) == len(self) and all(a == b for a, b in zip(self, other, strict=True))
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]  # mutable-sequence semantics, as a list
+
+    def reason(self, i: int) -> str | None:
+        """Why pose ``i`` has no solution (None when it has some, or a family)."""
+        block, j = self._locate(operator.index(i))
+        return block.reason(j)
+
+    def _stack(self, name: str, shape: tuple[int, ...], dtype: type) -> NDArray:
+        parts = [getattr(b, name) for b in self._blocks]
+        return np.concatenate(parts) if parts else np.zeros(shape, dtype=dtype)
+
+    @cached_property
+    def offsets(self) -> NDArray[np.intp]:
+        counts = self.counts
+        return np.concatenate([[0], np.cumsum(counts)]).astype(np.intp)
+
+    @cached_property
+    def counts(self) -> NDArray[np.intp]:
+        if not self._blocks:
+            return np.zeros(0, dtype=np.intp)
+        return np.concatenate([np.diff(b.bounds) for b in self._blocks]).astype(np.intp)
+
+    @cached_property
+    def pose_index(self) -> NDArray[np.intp]:
+        return np.repeat(np.arange(len(self)), self.counts).astype(np.intp)
+
+    @cached_property
+    def q(self) -> Array:
+        return self._stack("q", (0, self.robot.n_joints), np.float64)
+
+    @cached_property
+    def error(self) -> Array:
+        return self._stack("error", (0,), np.float64)
+
+    @cached_property
+    def error_geodesic(self) -> Array:
+        return self._stack("error_geodesic", (0,), np.float64)
+
+    @cached_property
+    def within_limits(self) -> NDArray[np.bool_]:
+        return self._stack("within_limits", (0,), np.bool_)
+
+    @cached_property
+    def multiplicity(self) -> NDArray[np.intp]:
+        return self._stack("multiplicity", (0,), np.intp)
+
+    @cached_property
+    def n_reachable(self) -> NDArray[np.intp]:
+        """``(N,)`` each pose's solutions before the joint limits were applied (``counts`` is after)."""
+        return self._stack("n_reachable", (0,), np.intp).astype(np.intp)
+
+    @cached_property
+    def families(self) -> dict[int, tuple[Family, ...]]:
+        out: dict[int, tuple[Family, ...]] = {}
+        for start, block in zip(self._starts, self._blocks, strict=False):
+            out.update({int(start) + i: f for i, f in block.families.items() if f})
+        return out
