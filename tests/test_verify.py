@@ -13,6 +13,7 @@ import pytest
 import sweepik.experiments.verify as V
 from sweepik import load_robot
 from sweepik.errors import RobotDefinitionError, UnknownOptionError
+from sweepik.experiments import verify_report
 from sweepik.solving import iter_solve, solve_many
 
 CARM = load_robot("carm")
@@ -242,12 +243,12 @@ def test_run_verify_both_and_the_table(small_grid, tmp_path) -> None:
     assert paper_grid["J_max"] <= 1e-9  # grid-exact d1: the paper's strategy hits the roots exactly
     assert set(paper_grid["missed_by_class"]) <= {"self-motion", "branch-crossing"}
     json.dumps(res, allow_nan=False)
-    table = V.format_table(res)
+    table = verify_report.format_table(res)
     head = table.splitlines()[0]
     assert "paper" in head and "sweepik paper-strategy" in head and "sweepik precise" in head
     assert "3.49e-06" in table and "1.27e-13" in table and "15,900" in table
     assert len(table.splitlines()[2].split()) > 0
-    report = V.write_report(res, tmp_path / "out")
+    report = verify_report.write_report(res, tmp_path / "out")
     text = report.read_text()
     assert "Grid-exact d1 flatters" in text and "| J_max (mm) | 3.49e-06 |" in text
     for name in ("figure4_precise.png", "figure4_paper.png", "trajectory_3d.png", "trajectory_joints.png"):
@@ -258,7 +259,7 @@ def test_run_verify_both_and_the_table(small_grid, tmp_path) -> None:
 def test_format_table_for_one_strategy_marks_the_other_column_missing(small_grid) -> None:
     res = V.run_verify(CARM, "precise", offgrid=0)
     assert res["offgrid"]["points"] == 0 and res["offgrid"]["recall"] is None
-    rows = {ln.split("  ")[0].strip(): ln for ln in V.format_table(res).splitlines()}
+    rows = {ln.split("  ")[0].strip(): ln for ln in verify_report.format_table(res).splitlines()}
     assert rows["J_max (mm)"].split()[-2] == "-"  # no paper-strategy run
 
 

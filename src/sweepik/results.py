@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import bisect
 import operator
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, overload
@@ -29,6 +29,8 @@ if TYPE_CHECKING:
     from sweepik.reductions.base import Reduction
 
 Array = NDArray[np.float64]
+#: How a :class:`Family` computes its members: ``(reduction, chain_pose, branch, theta, lo, hi) -> q``.
+MemberFunction = Callable[["Reduction", Array, int, Array, float, float], Array]
 
 #: Tolerance when asking a family for a member just outside its interval (relative to the interval length).
 _FAMILY_EDGE_TOL = 1e-9
@@ -120,6 +122,9 @@ class Family:
     chain_pose: Array = field(repr=False)
     branch: int = 0
     held: HeldJoints | None = field(default=None, repr=False)
+    #: ``members(reduction, chain_pose, branch, theta (K,), lo, hi) -> (K, n)``: the members, each certified by FK
+    #: (the engine's ``families.certified_members``, given by whoever builds the family: results need no engine).
+    members: MemberFunction = field(kw_only=True, repr=False)
 
     def at(self, theta: ArrayLike) -> Array:
         """Member configuration(s) ``(n,)`` (or ``(..., n)``) at theta* value(s) inside ``interval`` (a revolute
@@ -135,10 +140,8 @@ class Family:
         if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
             raise SweepikError(f"theta* = {th.tolist()} is outside the family's interval [{lo:.12g}, {hi:.12g}]")
         flat = np.clip(th.reshape(-1), lo, hi)
-        from sweepik.engine.families import certified_members  # local import: families imports this module
-
         red = self.reduction
-        q = red.robot.wrap(certified_members(red, self.chain_pose, self.branch, flat, lo, hi))
+        q = red.robot.wrap(self.members(red, self.chain_pose, self.branch, flat, lo, hi))
         if self.held is not None:
             q = self.held.expand(q)
         return q.reshape(*th.shape, -1)

@@ -32,6 +32,7 @@ from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM, paper_ca
 from sweepik.engine.partners import close_partners, nearly_singular, valley_bottoms
 from sweepik.engine.polish import geodesic_errors, polish
 from sweepik.engine.rough_continua import RoughRedo
+from sweepik.engine.settings import ACCEPT_TOL_REL
 from sweepik.engine.sweep import N_SAMPLES, Candidates, Spans, find_candidates, twin_copies
 from sweepik.errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from sweepik.model.origin_axis import HeldJoints, hold_joints
@@ -53,10 +54,6 @@ Array = NDArray[np.float64]
 Strategy = Literal["precise", "paper"]
 STRATEGIES = ("precise", "paper")
 
-#: Precise strategy: a candidate is a solution when position error + weight x angle is below this times the
-#: arm's length scale (C-Arm: 2e-13 x 2752 mm = 5.5e-10 mm). Simple roots refine to ~1e-13 mm, double
-#: roots to ~1e-14 mm; a near miss of the residual above this is not a solution.
-ACCEPT_TOL_REL = 2e-13
 #: Candidates with a pose error below this times the length scale get a Newton polish on the full pose
 #: (removes the ill-conditioning of a reduction; spurious candidates are far above it).
 POLISH_BELOW_REL = 1e-6
@@ -227,6 +224,33 @@ def _solve_chunk(
     return joined(block, _solve_chunk_by(robot, comp, poses, strategy, limits, n_samples, use_fallback, False))
 
 
+@dataclasses.dataclass
+class _Found:
+    """A chunk's candidate solutions before settling: row ``i`` is configuration ``q[i]`` (multiplicity ``mult[i]``)
+    of pose ``pose[i]``; the pose errors where the compiled certification gave them already (else None); the
+    self-motion families found so far, by pose."""
+
+    pose: NDArray[np.intp]
+    q: Array
+    mult: NDArray[np.intp]
+    err_geo: Array | None
+    err_paper: Array | None
+    families: dict[int, list[Family]]
+
+    def add(self, robot: Robot, poses: Array, pose: NDArray[np.intp], q: Array, mult: NDArray[np.intp]) -> None:
+        """Rows appended (their errors worked out when the others' are known)."""
+        if self.err_geo is not None and self.err_paper is not None:
+            eg, ep = _errors(robot, q, poses[pose], orientation_weight(robot.length_unit))
+            self.err_geo, self.err_paper = np.concatenate([self.err_geo, eg]), np.concatenate([self.err_paper, ep])
+        self.q = np.concatenate([self.q, q])
+        self.pose = np.concatenate([self.pose, pose])
+        self.mult = np.concatenate([self.mult, mult])
+
+
+#: A chunk's settled rows: ``(pose, q, err_paper, err_geo, mult, inside, keep)`` (``_settle_stepwise``'s).
+_Rows = tuple[NDArray[np.intp], Array, Array, Array, NDArray[np.intp], NDArray[np.bool_], NDArray[np.bool_]]
+
+
 def _solve_chunk_by(
     robot: Robot,
     red: Reduction,
@@ -237,140 +261,24 @@ def _solve_chunk_by(
     use_fallback: bool = True,
     one_call: bool = True,
 ) -> Block:
-    """:func:`_solve_chunk` with ``red`` alone."""
+    """:func:`_solve_chunk` with ``red`` alone: the candidates, settled (certified, deduplicated, limits), the meeting
+    branches of a closed form merged, the fallback reduction where this one cannot answer, the families."""
     chain = _chain_poses(robot, poses)  # (one array: the reduction keeps its parameters for it)
     if len(poses) == 1 and strategy == "precise" and use_fallback and one_call and red.uses_kernel:
         block = _settled_single(robot, red, poses, chain, limits, n_samples)
         if block is not None:
             return block
-    closed = red.closed_form
-    if not closed:  # (a closed form sweeps nothing)
-        lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
-    weight = orientation_weight(robot.length_unit)
-    spans = Spans.empty()
-    fams: dict[int, list[Family]] = {}  # (poses with self-motion families: few)
-    compiled = red.uses_kernel and search.AVAILABLE
-    err_geo = err_paper = None
-    redo: RoughRedo | None = None
-    if strategy == "precise" or closed:
-        if closed:  # no sweep: every branch of the closed form is a candidate
-            params = red.kernel_params(chain) if compiled else None
-            cand = _every_branch(chain.shape[0], red.n_branches)
-            if compiled and owned_kernel(red, "kernel_configurations") is not None:
-                q, err_geo, err_paper = certify.certify_every_branch(robot, red, chain, poses, params)
-            elif compiled:
-                q, err_geo, err_paper = certify.certify(
-                    robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
-                )
-            else:  # (writable copies of the cached candidates: a reduction's code may want to write them)
-                q = red.solve_rest(chain[cand.pose], np.array(cand.theta)[:, None], np.array(cand.branch)[:, None])
-                q = q[:, 0]
-        elif compiled:
-            params = red.kernel_params(chain)
-            if strategy == "precise":
-                scale = robot.length_scale
-                redo = RoughRedo(
-                    robot,
-                    red,
-                    chain,
-                    poses,
-                    lo,
-                    hi,
-                    n_samples,
-                    limits,
-                    POLISH_BELOW_REL * scale,
-                    ACCEPT_TOL_REL * scale,
-                )
-            # (twins' copies included)
-            cand, spans = search.search(red, chain, lo, hi, n_samples, params, before_redo=redo)
-            cand = _limit_copies(robot, red, cand, hi - lo)
-            q, err_geo, err_paper = certify.certify(
-                robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
-            )
-        else:
-            cand, spans = twin_copies(red, *find_candidates(red, chain, lo, hi, n_samples))
-            cand = _limit_copies(robot, red, cand, hi - lo)
-            q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
-        pose_idx, mult = cand.pose, cand.mult
-        special = red.special_solutions(chain)
-        sp_mult = None
-        if isinstance(special, tuple):
-            special, sp_mult = special
-        if special is not None:
-            sp_p, sp_k = np.nonzero(np.all(np.isfinite(special), axis=-1))
-            q_sp = special[sp_p, sp_k]
-            if err_geo is not None and err_paper is not None:
-                eg_sp, ep_sp = _errors(robot, q_sp, poses[sp_p], weight)
-                err_geo, err_paper = np.concatenate([err_geo, eg_sp]), np.concatenate([err_paper, ep_sp])
-            q = np.concatenate([q, q_sp])
-            pose_idx = np.concatenate([pose_idx, sp_p])
-            mult = np.concatenate([mult, np.ones(sp_p.size, dtype=np.intp) if sp_mult is None else sp_mult[sp_p, sp_k]])
-        tol = ACCEPT_TOL_REL * robot.length_scale
-        members: list[tuple[NDArray[np.intp], Array]] = []  # (isolated members of families: pose index, q)
-        if len(spans):  # (most sweeps find none)
-            # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
-            s_lo, s_hi = np.maximum(spans.lo, lo[spans.pose]), np.minimum(spans.hi, hi[spans.pose])
-            keep_span = s_hi > s_lo
-            spans = Spans(spans.pose[keep_span], spans.branch[keep_span], s_lo[keep_span], s_hi[keep_span])
-            fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, tol)
-            members.append((fam_p, fam_q))
-        # a continuum along a joint other than theta*: its candidates (certified ones, when their errors are known
-        # already: fewer to look at) where the reduction leaves such a joint free are traced (few poses)
-        free = None
-        if use_fallback and type(red).continuum_joints is not Reduction.continuum_joints:  # (else: None)
-            n, seed_tol = cand.pose.size, SEED_TOL_REL * robot.length_scale
-            e = None if err_geo is None else err_geo[:n]
-            free = red.continuum_joints(chain, cand.pose, cand.theta, cand.branch, e, seed_tol)
-        if redo is not None and redo.families:
-            for i, f in redo.families.items():
-                fams.setdefault(i, []).extend(f)
-            members.append((redo.pose, redo.q))
-        if free is not None:
-            seeds = np.nonzero(free >= 0)[0]
-            seed_p, seed_q, free = cand.pose[seeds], q[seeds], free[seeds]
-            traced, fam_p, fam_q = continuum_families(robot, chain, poses, seed_p, seed_q, free, limits, tol)
-            for i, f in traced.items():
-                fams.setdefault(i, []).extend(f)
-            members.append((fam_p, fam_q))
-        for fam_p, fam_q in members:
-            if fam_p.size:
-                if err_geo is not None and err_paper is not None:
-                    eg_f, ep_f = _errors(robot, fam_q, poses[fam_p], weight)
-                    err_geo, err_paper = np.concatenate([err_geo, eg_f]), np.concatenate([err_paper, ep_f])
-                q = np.concatenate([q, fam_q])
-                pose_idx = np.concatenate([pose_idx, fam_p])
-                mult = np.concatenate([mult, np.ones(fam_p.size, dtype=np.intp)])
-    else:
+    if strategy == "precise" or red.closed_form:
+        found = _precise_candidates(robot, red, poses, chain, strategy, limits, n_samples, use_fallback)
+    else:  # the paper's strategy, swept
+        lo, hi = _theta_range(robot, red, chain, paper_limits=limits)
         pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
-        mult = np.ones(pose_idx.size, dtype=np.intp)
-    settled = None
-    if strategy == "precise" and err_geo is not None and err_paper is not None:
-        # in one compiled pass, but for the poses due a polish, the fallback or a limit snap (few)
-        bounds = _settle_bounds(robot)
-        settled = settle(robot, q, err_geo, err_paper, pose_idx, len(poses), bounds, _snap_reach(robot))
-    if settled is None:
-        pose_idx, q, err_paper, err_geo, mult, inside, keep = _settle_stepwise(
-            robot, red, poses, strategy, limits, n_samples, use_fallback, pose_idx, q, mult, err_geo, err_paper
-        )
-    else:
-        assert err_geo is not None and err_paper is not None
-        due, rows, w, inside, keep = settled
-        parts = [(pose_idx[rows], w, err_paper[rows], err_geo[rows], mult[rows], inside, keep)]
-        if due.any():  # (these poses' rows, by the steps; the rows of a pose stay in order, and together)
-            sub = np.nonzero(due[pose_idx])[0]
-            rest = (pose_idx[sub], q[sub], mult[sub], err_geo[sub], err_paper[sub])
-            parts.append(_settle_stepwise(robot, red, poses, strategy, limits, n_samples, use_fallback, *rest))
-        pose_idx, q, err_paper, err_geo, mult, inside, keep = (
-            parts[0] if len(parts) == 1 else [np.concatenate(c) for c in zip(*parts, strict=True)]
-        )
-    assert err_geo is not None and err_paper is not None  # (both paths set them)
-    if closed and not keep.all():  # branches of the closed form that meet: one solution, a multiple root
-        mult = merged_multiplicity(robot, pose_idx, q, keep, mult)
-    if closed:  # ... and those whose meeting the closed form's rounding split in two
-        pair = _meeting_pairs(robot, pose_idx, q, keep)
-        if pair.size:
-            q, mult = q.copy(), mult.copy()
-            _merge_meeting(robot, poses, pair, q, err_geo, err_paper, inside, keep, mult, pose_idx)
+        found = _Found(pose_idx, q, np.ones(pose_idx.size, dtype=np.intp), None, None, {})
+    pose_idx, q, err_paper, err_geo, mult, inside, keep = _settled_rows(
+        robot, red, poses, strategy, limits, n_samples, use_fallback, found
+    )
+    if red.closed_form:
+        q, mult = _closed_form_meetings(robot, poses, pose_idx, q, err_geo, err_paper, inside, keep, mult)
     if strategy == "precise" and pose_idx.size > MAX_ISOLATED_SOLUTIONS:  # (fewer: no pose can hold a continuum)
         # a numerical continuum of certified solutions is reported once
         keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
@@ -380,17 +288,8 @@ def _solve_chunk_by(
     if not keep.all():  # (often all of them: a single pose's candidates are then used as they are)
         pose_idx, q, err_paper, err_geo, inside = pose_idx[keep], q[keep], err_paper[keep], err_geo[keep], inside[keep]
         mult = mult[keep]
-    fallback: dict[int, Solutions] = {}
-    if strategy == "precise" and use_fallback and red.fallback is not None:
-        for by, deg in red.degenerate_fallbacks(chain):
-            idx = np.nonzero(deg)[0]
-            alt_red = get_reduction(robot, by)
-            alt = _solve_chunk(robot, alt_red, poses[idx], strategy, limits, n_samples, False)
-            if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
-                fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx)})
-                _trace_cut_continua(robot, alt_red, chain, poses, idx, alt, limits, fams, fallback)
-            else:  # the reduction's blind spot: the fallback's families
-                fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)})
+    fams = found.families
+    fallback = _fallback_solutions(robot, red, poses, chain, strategy, limits, n_samples, use_fallback, fams)
     # poses with families (few): their isolated solutions lying on a family are reported by the family; the
     # reduction's blind spot: the fallback reduction's families are added, and its isolated solutions when this
     # reduction has none (a closed form: always)
@@ -401,10 +300,6 @@ def _solve_chunk_by(
         families, pose_idx, q, err_paper, err_geo, inside, mult = _with_families(
             robot, red, fams, fallback, pose_idx, q, err_paper, err_geo, inside, mult
         )
-    # (mostly in pose order already, as a closed form's candidates and most sweeps' are, unless some poses went
-    # through the stepwise path: their rows come last; one pose's always: no reordering copies)
-    in_order = len(poses) == 1 or bool(np.all(pose_idx[1:] >= pose_idx[:-1]))
-    order = slice(None) if in_order else np.argsort(pose_idx, kind="stable")
     empty_reason = None
     if strategy == "paper" and not red.closed_form:  # its final resolution decides nothing about reachability
         step = "0.0001 deg" if red.periodic else f"0.001 mm ({robot.joint_names[red.free_joint]})"
@@ -412,6 +307,199 @@ def _solve_chunk_by(
             f"no solution with J < 1e-5 mm found by the paper's strategy (its final {step} step "
             "misses roots off its grid); strategy='precise' finds every solution"
         )
+    rows = (pose_idx, q, err_paper, err_geo, mult, inside, keep)
+    return _block(robot, poses, rows, families, n_reachable, empty_reason)
+
+
+def _precise_candidates(
+    robot: Robot,
+    red: Reduction,
+    poses: Array,
+    chain: Array,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    use_fallback: bool,
+) -> _Found:
+    """The candidates of the precise strategy (or of a closed form's): every branch of a closed form, or the sweep's
+    roots (compiled: certified already), the reduction's special solutions, and the isolated members of the
+    families found along theta*, along another joint (traced) or from a rough sweep."""
+    closed = red.closed_form
+    if not closed:  # (a closed form sweeps nothing)
+        lo, hi = _theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
+    spans = Spans.empty()
+    compiled = red.uses_kernel and search.AVAILABLE
+    err_geo = err_paper = None
+    redo: RoughRedo | None = None
+    if closed:  # no sweep: every branch of the closed form is a candidate
+        params = red.kernel_params(chain) if compiled else None
+        cand = _every_branch(chain.shape[0], red.n_branches)
+        if compiled and owned_kernel(red, "kernel_configurations") is not None:
+            q, err_geo, err_paper = certify.certify_every_branch(robot, red, chain, poses, params)
+        elif compiled:
+            q, err_geo, err_paper = certify.certify(
+                robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params
+            )
+        else:  # (writable copies of the cached candidates: a reduction's code may want to write them)
+            q = red.solve_rest(chain[cand.pose], np.array(cand.theta)[:, None], np.array(cand.branch)[:, None])
+            q = q[:, 0]
+    elif compiled:
+        params = red.kernel_params(chain)
+        if strategy == "precise":
+            scale = robot.length_scale
+            tols = (POLISH_BELOW_REL * scale, ACCEPT_TOL_REL * scale)
+            redo = RoughRedo(robot, red, chain, poses, lo, hi, n_samples, limits, *tols)
+        # (twins' copies included)
+        cand, spans = search.search(red, chain, lo, hi, n_samples, params, before_redo=redo)
+        cand = _limit_copies(robot, red, cand, hi - lo)
+        q, err_geo, err_paper = certify.certify(robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params)
+    else:
+        cand, spans = twin_copies(red, *find_candidates(red, chain, lo, hi, n_samples))
+        cand = _limit_copies(robot, red, cand, hi - lo)
+        q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+    found = _Found(cand.pose, q, cand.mult, err_geo, err_paper, {})
+    special = red.special_solutions(chain)
+    sp_mult = None
+    if isinstance(special, tuple):
+        special, sp_mult = special
+    if special is not None:
+        sp_p, sp_k = np.nonzero(np.all(np.isfinite(special), axis=-1))
+        ones = np.ones(sp_p.size, dtype=np.intp)
+        found.add(robot, poses, sp_p, special[sp_p, sp_k], ones if sp_mult is None else sp_mult[sp_p, sp_k])
+    tol = ACCEPT_TOL_REL * robot.length_scale
+    members: list[tuple[NDArray[np.intp], Array]] = []  # (isolated members of families: pose index, q)
+    if len(spans):  # (most sweeps find none)
+        # a flat stretch followed past the sweep's range (past +-pi for a revolute theta*) is cut to the range
+        s_lo, s_hi = np.maximum(spans.lo, lo[spans.pose]), np.minimum(spans.hi, hi[spans.pose])
+        keep_span = s_hi > s_lo
+        spans = Spans(spans.pose[keep_span], spans.branch[keep_span], s_lo[keep_span], s_hi[keep_span])
+        fams, fam_p, fam_q = families_of(robot, red, chain, poses, spans, limits, tol)
+        found.families = fams
+        members.append((fam_p, fam_q))
+    # a continuum along a joint other than theta*: its candidates (certified ones, when their errors are known
+    # already: fewer to look at) where the reduction leaves such a joint free are traced (few poses)
+    free = None
+    if use_fallback and type(red).continuum_joints is not Reduction.continuum_joints:  # (else: None)
+        n, seed_tol = cand.pose.size, SEED_TOL_REL * robot.length_scale
+        e = None if err_geo is None else err_geo[:n]
+        free = red.continuum_joints(chain, cand.pose, cand.theta, cand.branch, e, seed_tol)
+    if redo is not None and redo.families:
+        for i, f in redo.families.items():
+            found.families.setdefault(i, []).extend(f)
+        members.append((redo.pose, redo.q))
+    if free is not None:
+        seeds = np.nonzero(free >= 0)[0]
+        seed_p, seed_q, free = cand.pose[seeds], q[seeds], free[seeds]
+        traced, fam_p, fam_q = continuum_families(robot, chain, poses, seed_p, seed_q, free, limits, tol)
+        for i, f in traced.items():
+            found.families.setdefault(i, []).extend(f)
+        members.append((fam_p, fam_q))
+    for fam_p, fam_q in members:
+        if fam_p.size:
+            found.add(robot, poses, fam_p, fam_q, np.ones(fam_p.size, dtype=np.intp))
+    return found
+
+
+def _settled_rows(
+    robot: Robot,
+    red: Reduction,
+    poses: Array,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    use_fallback: bool,
+    found: _Found,
+) -> _Rows:
+    """The candidates settled: in one compiled pass (``dedupe.settle``) but for the poses due a polish, the fallback
+    or a limit snap (few), which go step by step (``_settle_stepwise``: all of them without the compiled errors)."""
+    pose_idx, q, mult, err_geo, err_paper = found.pose, found.q, found.mult, found.err_geo, found.err_paper
+    settled = None
+    if strategy == "precise" and err_geo is not None and err_paper is not None:
+        bounds = _settle_bounds(robot)
+        settled = settle(robot, q, err_geo, err_paper, pose_idx, len(poses), bounds, _snap_reach(robot))
+    if settled is None:
+        return _settle_stepwise(
+            robot, red, poses, strategy, limits, n_samples, use_fallback, pose_idx, q, mult, err_geo, err_paper
+        )
+    assert err_geo is not None and err_paper is not None
+    due, rows, w, inside, keep = settled
+    parts = [(pose_idx[rows], w, err_paper[rows], err_geo[rows], mult[rows], inside, keep)]
+    if due.any():  # (these poses' rows, by the steps; the rows of a pose stay in order, and together)
+        sub = np.nonzero(due[pose_idx])[0]
+        rest = (pose_idx[sub], q[sub], mult[sub], err_geo[sub], err_paper[sub])
+        parts.append(_settle_stepwise(robot, red, poses, strategy, limits, n_samples, use_fallback, *rest))
+    if len(parts) == 1:
+        return parts[0]
+    pose_idx, q, err_paper, err_geo, mult, inside, keep = (np.concatenate(c) for c in zip(*parts, strict=True))
+    return pose_idx, q, err_paper, err_geo, mult, inside, keep
+
+
+def _closed_form_meetings(
+    robot: Robot,
+    poses: Array,
+    pose_idx: NDArray[np.intp],
+    q: Array,
+    err_geo: Array,
+    err_paper: Array,
+    inside: NDArray[np.bool_],
+    keep: NDArray[np.bool_],
+    mult: NDArray[np.intp],
+) -> tuple[Array, NDArray[np.intp]]:
+    """A closed form's branches that meet: one solution, a multiple root, whether the deduplication found them one
+    (``keep``) or the closed form's rounding split them in two (merged here, in place of ``err_*``, ``inside`` and
+    ``keep``). Returns ``(q, mult)`` (copies where changed)."""
+    if not keep.all():
+        mult = merged_multiplicity(robot, pose_idx, q, keep, mult)
+    pair = _meeting_pairs(robot, pose_idx, q, keep)
+    if pair.size:
+        q, mult = q.copy(), mult.copy()
+        _merge_meeting(robot, poses, pair, q, err_geo, err_paper, inside, keep, mult, pose_idx)
+    return q, mult
+
+
+def _fallback_solutions(
+    robot: Robot,
+    red: Reduction,
+    poses: Array,
+    chain: Array,
+    strategy: str,
+    limits: bool,
+    n_samples: int,
+    use_fallback: bool,
+    fams: dict[int, list[Family]],
+) -> dict[int, Solutions]:
+    """The fallback reduction's solutions of the poses where ``red`` cannot answer (``degenerate_fallbacks``): all of
+    them near a closed form's singular set (and the continua it cut, traced whole into ``fams``), the families at a
+    sweep's blind spot."""
+    fallback: dict[int, Solutions] = {}
+    if strategy != "precise" or not use_fallback or red.fallback is None:
+        return fallback
+    for by, deg in red.degenerate_fallbacks(chain):
+        idx = np.nonzero(deg)[0]
+        alt_red = get_reduction(robot, by)
+        alt = _solve_chunk(robot, alt_red, poses[idx], strategy, limits, n_samples, False)
+        if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
+            fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx)})
+            _trace_cut_continua(robot, alt_red, chain, poses, idx, alt, limits, fams, fallback)
+        else:  # the reduction's blind spot: the fallback's families
+            fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)})
+    return fallback
+
+
+def _block(
+    robot: Robot,
+    poses: Array,
+    rows: _Rows,
+    families: dict[int, tuple[Family, ...]],
+    n_reachable: NDArray[np.intp],
+    empty_reason: str | None,
+) -> Block:
+    """The chunk's block, its rows in pose order (mostly they are already, as a closed form's candidates and most
+    sweeps' are, unless some poses went through the stepwise path: their rows come last; one pose's always: no
+    reordering copies)."""
+    pose_idx, q, err_paper, err_geo, mult, inside, _ = rows
+    in_order = len(poses) == 1 or bool(np.all(pose_idx[1:] >= pose_idx[:-1]))
+    order = slice(None) if in_order else np.argsort(pose_idx, kind="stable")
     return Block(
         robot=robot,
         poses=poses.copy(),

@@ -56,7 +56,8 @@ def add_verify_parser(sub: _SubParsers) -> None:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    from sweepik.experiments.verify import format_table, run_verify, write_report
+    from sweepik.experiments.verify import run_verify
+    from sweepik.experiments.verify_report import format_table, write_report
 
     _check_report_and_json(args)
     robot = _load_robot(args.robot, args)

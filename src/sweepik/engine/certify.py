@@ -18,8 +18,8 @@ from numpy.typing import NDArray
 from sweepik._jit import alive, inlined, unowned
 from sweepik.engine import parallel
 from sweepik.engine.dedupe import limit_args
-from sweepik.engine.polish import PINV_WIDEN
 from sweepik.engine.search import AVAILABLE, PARALLEL_MIN, writable
+from sweepik.engine.settings import PINV_WIDEN
 from sweepik.model.pose import GIMBAL_TOL
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.kernels import address_of, lazy_njit, owned_kernel

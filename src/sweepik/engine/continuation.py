@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from sweepik.engine.families import certified_members, families_of, off_families
 from sweepik.engine.polish import polished, pose_and_jacobian
 from sweepik.engine.sweep import Spans
 from sweepik.model.robot import Robot
@@ -244,8 +245,6 @@ def continuum_families(
     them (pieces that shrink to a point, at the limits, as isolated members). A configuration on a family already
     traced from another of its pose is not traced again; one that cannot be followed (an isolated solution) gives
     nothing."""
-    from sweepik.engine.families import families_of, off_families  # local: families imports the solver's modules
-
     out: dict[int, list[Family]] = {}
     iso_p: list[IntArray] = [np.zeros(0, dtype=np.intp)]
     iso_q: list[Array] = [np.zeros((0, robot.n_joints))]
@@ -272,7 +271,11 @@ def continuum_families(
                 th, Q, closed = stretch
                 spans += _pieces(i, traced.add(th, Q), th, closed, traced.periodic)
                 if left.shape[0]:  # the other seeds on it are not traced again
-                    mine = tuple(Family(j, (lo, hi), traced, chain[i], b) for p, b, lo, hi in spans if p == i)
+                    mine = tuple(
+                        Family(j, (lo, hi), traced, chain[i], b, members=certified_members)
+                        for p, b, lo, hi in spans
+                        if p == i
+                    )
                     left = left[off_families(robot, [(left, mine)])[0]]
         if not spans:
             continue

@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import certify, search
+from sweepik.engine.settings import ACCEPT_TOL_REL
 from sweepik.engine.sweep import CLUSTER_FAMILY_REL, Spans
 from sweepik.model.pose import pose_error_geodesic
 from sweepik.model.robot import Robot
@@ -42,7 +43,6 @@ def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Arr
     """Members ``(K, n)`` at ``theta (K,)`` (inside ``[lo, hi]``) of one family (chain pose ``(4, 4)``, branch),
     each certified by FK: one that is not is replaced by the member ``_NUDGE_REL (hi - lo)`` further in, or back
     (if neither is a solution, it is left as it is)."""
-    from sweepik.solving import ACCEPT_TOL_REL  # local: the solver imports this module
 
     robot = red.robot
     tol = ACCEPT_TOL_REL * robot.length_scale  # (the solver's own acceptance of a solution)
@@ -451,7 +451,14 @@ def families_of(
     f_pose, f_branch = spans.pose[K].tolist(), spans.branch[K].tolist()
     for j in np.nonzero(~point & ~duplicate)[0].tolist():
         out.setdefault(f_pose[j], []).append(
-            Family(red.free_joint, (float(lo[j]), float(hi[j])), red, chain_all[f_pose[j]], f_branch[j])
+            Family(
+                red.free_joint,
+                (float(lo[j]), float(hi[j])),
+                red,
+                chain_all[f_pose[j]],
+                f_branch[j],
+                members=certified_members,
+            )
         )
     pk = K[point]
     # its member: of the piece's ends and middle, the one deepest inside the limits

@@ -15,20 +15,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from sweepik.engine.settings import PINV_RCOND, PINV_WIDEN
 from sweepik.model import kinematics
 from sweepik.model.pose import pose_error_geodesic
 from sweepik.model.robot import Robot
 
 Array = NDArray[np.float64]
-
-#: Singular values below this fraction of the largest are dropped from the Newton step (pseudo-inverse):
-#: keeps the step bounded at singular configurations, without effect at regular ones.
-PINV_RCOND = 1e-10
-#: A step that no halving makes lower the error is tried again with the singular values below ``PINV_RCOND`` times
-#: these dropped: where the arm loses two ranks (a KR 6 with its wrist centre on axis 1 and its elbow straight, a
-#: member of its joint-1 continuum corrected with joint 1 held) the step along the nearly null directions is all
-#: overshoot, and without them the error went from 2e-4 of the arm's size to 5e-12 (1e-6) and rounding.
-PINV_WIDEN = (1.0, 1e4, 1e7)
 
 
 def pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:

@@ -22,6 +22,7 @@ import math
 import os
 import weakref
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -345,6 +346,52 @@ if AVAILABLE:
                 return True
         return False
 
+    @inlined
+    def _extrema(res, p, b, th, f, level, ctx, span, noise, xtol, out_t, out_b, cnt):
+        """``_scan``'s local minima of ``|f|`` without a sign change (the ends with their context ``ctx``), each
+        looked at (``_extremum``) where it may touch zero."""
+        M = th.shape[0]
+        j0, j1 = (0, M) if level > 0 else (1, M - 1)
+        for j in range(j0, j1):
+            tm, fm = (th[j - 1], f[j - 1]) if j > 0 else (ctx[0], ctx[1])
+            tp, fp = (th[j + 1], f[j + 1]) if j < M - 1 else (ctx[2], ctx[3])
+            fc = f[j]
+            # (the cheap tests first: a local minimum of |f| without a sign change is rare, its curvature dearer; a
+            # NaN among the three fails them)
+            if not (abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0):
+                continue
+            hl, hr = th[j] - tm, tp - th[j]
+            if not (hl > 0 and hr > 0):
+                continue
+            ddj = _dd(fm, fc, fp, hl, hr)
+            if abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2:  # (it may touch zero)
+                _extremum(res, p, b, tm, th[j], tp, fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
+
+    @inlined
+    def _edge_samples(b, th, f, valid, level, fmask, noise, out_t, out_b, cnt):
+        """``_scan``'s samples next to a domain edge (or at the range ends, level 0) that are candidates: near zero,
+        or next to a family's samples (``fmask``: ``sweep.FAR_NOISE``)."""
+        M = th.shape[0]
+        for j in range(M):
+            if not valid[j]:
+                continue
+            lo_open = (j == 0 and level == 0) or (j > 0 and not valid[j - 1])
+            hi_open = (j == M - 1 and level == 0) or (j < M - 1 and not valid[j + 1])
+            if not (lo_open or hi_open):
+                continue
+            nr = abs(f[j + 1]) if (j < M - 1 and valid[j + 1]) else np.inf
+            nl = abs(f[j - 1]) if (j > 0 and valid[j - 1]) else np.inf
+            at_l = lo_open and abs(f[j]) <= nr
+            at_r = hi_open and abs(f[j]) <= nl
+            if not (at_l or at_r):
+                continue
+            if (
+                abs(f[j]) <= FAR_NOISE * noise
+                or (at_l and level == 0 and j > 0 and fmask[j - 1])
+                or (at_r and level == 0 and j < M - 1 and fmask[j + 1])
+            ):
+                _push(out_t, out_b, cnt, th[j], b)
+
     @internal
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
@@ -363,41 +410,8 @@ if AVAILABLE:
             valid[j] = v
             if v and abs(f[j]) <= noise and (level == 0 or 0 < j < M - 1):
                 _push(out_t, out_b, cnt, th[j], b)
-        j0, j1 = (0, M) if level > 0 else (1, M - 1)
-        for j in range(j0, j1):  # extrema of |f| without a sign change (the ends with their context)
-            tm, fm = (th[j - 1], f[j - 1]) if j > 0 else (ctx[0], ctx[1])
-            tp, fp = (th[j + 1], f[j + 1]) if j < M - 1 else (ctx[2], ctx[3])
-            fc = f[j]
-            # (the cheap tests first: a local minimum of |f| without a sign change is rare, its curvature dearer; a
-            # NaN among the three fails them)
-            if not (abs(fc) <= abs(fm) and abs(fc) <= abs(fp) and fm * fc > 0 and fc * fp > 0):
-                continue
-            hl, hr = th[j] - tm, tp - th[j]
-            if not (hl > 0 and hr > 0):
-                continue
-            ddj = _dd(fm, fc, fp, hl, hr)
-            if abs(fc) <= EXTREMUM_REACH * abs(ddj) * max(hl, hr) ** 2:  # (it may touch zero)
-                _extremum(res, p, b, tm, th[j], tp, fm, fc, fp, span, noise, xtol, out_t, out_b, cnt)
-        for j in range(M):  # samples next to a domain edge (or at the range ends, level 0)
-            if not valid[j]:
-                continue
-            lo_open = (j == 0 and level == 0) or (j > 0 and not valid[j - 1])
-            hi_open = (j == M - 1 and level == 0) or (j < M - 1 and not valid[j + 1])
-            if not (lo_open or hi_open):
-                continue
-            nr = abs(f[j + 1]) if (j < M - 1 and valid[j + 1]) else np.inf
-            nl = abs(f[j - 1]) if (j > 0 and valid[j - 1]) else np.inf
-            at_l = lo_open and abs(f[j]) <= nr
-            at_r = hi_open and abs(f[j]) <= nl
-            if not (at_l or at_r):
-                continue
-            # (far from zero: no candidate, but next to a family's samples: sweep.FAR_NOISE)
-            if (
-                abs(f[j]) <= FAR_NOISE * noise
-                or (at_l and level == 0 and j > 0 and fmask[j - 1])
-                or (at_r and level == 0 and j < M - 1 and fmask[j + 1])
-            ):
-                _push(out_t, out_b, cnt, th[j], b)
+        _extrema(res, p, b, th, f, level, ctx, span, noise, xtol, out_t, out_b, cnt)
+        _edge_samples(b, th, f, valid, level, fmask, noise, out_t, out_b, cnt)
         # second divided differences (dd), in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate), worked out
         # as the intervals are walked: c1, c2 at the interval's samples (NaN at the ends and next to a NaN sample)
         x = th if math.isnan(xe) else wx[:M]
@@ -497,6 +511,122 @@ if AVAILABLE:
             carried[m + 1, 0] = c0
             carried[m + 1, 1] = c1
 
+    @inlined
+    def _all_branch_samples(res_all, p, th, n_all, known, known_at, row, f_all):
+        """Every branch's residual ``f_all[j]`` at the samples ``th`` of a pose (row ``row`` of the part), from
+        ``known`` where the caller has it (``_search``)."""
+        for j in range(th.shape[0]):
+            k = known_at[row, j] if known.shape[0] > 0 else -1
+            if k >= 0:
+                for b in range(n_all):
+                    f_all[j, b] = known[row, k, b]
+            else:
+                res_all(p, th[j], f_all[j])
+
+    @inlined
+    def _family_runs(res, p, b, th, f, fm, span, fam, fcnt, i):
+        """Runs of vanishing samples ``f`` of branch ``b``: family spans of pose ``i`` (``fam[i]``, counted in
+        ``fcnt[i]``, past the buffer's size too: an overflow), their samples made NaN in ``f`` and marked in ``fm``
+        (a short run of coinciding samples is left to the scan: one root)."""
+        M = th.shape[0]
+        j = 0
+        while j < M:
+            if not math.isnan(f[j]) and abs(f[j]) <= FAMILY_TOL:
+                k = j
+                while k + 1 < M and not math.isnan(f[k + 1]) and abs(f[k + 1]) <= FAMILY_TOL:
+                    k += 1
+                if k - j + 1 >= FAMILY_MIN_RUN and th[k] - th[j] > CLUSTER_FAMILY_REL * span:
+                    if fcnt[i] < fam.shape[1]:
+                        lo, hi = th[j], th[k]
+                        if j > 0:
+                            lo = _extend(res, p, b, lo, th[j - 1])
+                        if k + 1 < M:
+                            hi = _extend(res, p, b, hi, th[k + 1])
+                        fam[i, fcnt[i], 0] = lo
+                        fam[i, fcnt[i], 1] = hi
+                        fam[i, fcnt[i], 2] = b
+                    fcnt[i] += 1
+                    for m in range(j, k + 1):
+                        f[m] = np.nan
+                        fm[m] = True
+                j = k + 1
+            else:
+                j += 1
+
+    @inlined
+    def _centred(res, p, ts, bs, n0, noise, span, probes, fam, fcnt, i):
+        """The first ``n0`` candidates ``(ts, bs)`` of pose ``i`` centred on their flat stretch (``_center_flat``), or
+        set apart as a family (``fam[i]``, ``fcnt[i]``); the others moved down. Returns how many stay (``probes[w]``:
+        candidate w's probes, written whether or not it is kept)."""
+        w0 = 0
+        for k in range(n0):
+            x, lo, hi, family = _center_flat(res, p, ts[k], bs[k], noise, span, probes[w0])
+            if family:
+                if fcnt[i] < fam.shape[1]:
+                    fam[i, fcnt[i], 0] = lo
+                    fam[i, fcnt[i], 1] = hi
+                    fam[i, fcnt[i], 2] = bs[k]
+                fcnt[i] += 1
+            else:
+                ts[w0] = x
+                bs[w0] = bs[k]
+                w0 += 1
+        return w0
+
+    @inlined
+    def _merged_clusters(res, p, ts, bs, n, noise, probes):
+        """The first ``n`` candidates ``(ts, bs)`` sorted by branch, then theta, and each noise-level cluster of a
+        branch merged into its centre (families were set apart: a cluster is one root), in place. Returns how many
+        stay."""
+        _sort_pairs(bs, ts, probes, n)
+        w = 0  # (written in place: w <= s, and only entries from s on are read after a write)
+        s = 0
+        while s < n:
+            e = s
+            while (
+                e + 1 < n
+                and bs[e + 1] == bs[s]
+                and (ts[e + 1] == ts[e] or abs(res(p, 0.5 * (ts[e] + ts[e + 1]), bs[s])) <= noise)
+            ):
+                e += 1
+            ts[w] = 0.5 * (ts[s] + ts[e])
+            bs[w] = bs[s]
+            # (a cluster's centre is a new point: its probes are not known)
+            probes[w, 0] = probes[s, 0] if e == s else np.nan
+            probes[w, 1] = probes[s, 1] if e == s else np.nan
+            w += 1
+            s = e + 1
+        return w
+
+    @inlined
+    def _scan_arrays(M):
+        """``_search``'s work arrays for ``_scan`` (the most samples of a pose: ``M``): the candidate count, the
+        stack of intervals to resample (theta, f, level and open ends, context), an empty context, the validity and
+        edge coordinates of a sequence. Explicit loops rather than np.zeros, np.full, slice copies or np.argsort:
+        each of those adds to the first compilation (docs/performance.md)."""
+        c = np.empty(1, dtype=np.int64)
+        stk_t = np.empty((STACK, SUB + 2))
+        stk_f = np.empty((STACK, SUB + 2))
+        stk_i = np.empty((STACK, 3), dtype=np.int64)
+        stk_c = np.empty((STACK, 5))
+        no_ctx = np.empty(4)
+        for k in range(4):
+            no_ctx[k] = np.nan
+        W = M if M > SUB + 2 else SUB + 2
+        return c, stk_t, stk_f, stk_i, stk_c, no_ctx, np.empty(W, dtype=np.bool_), np.empty(W)
+
+    @inlined
+    def _pose_arrays(M, n_all, K):
+        """``_search``'s work arrays for a pose (``M`` samples at most, ``n_all`` branches in the all-branch residual,
+        ``K`` candidates): an interval popped from the stack (theta, f, context), the all-branch residuals of the
+        samples and of the sub-samples of level-0 intervals (``_scan``) with which of those are known, one branch's
+        residuals, the stack's top, the candidates' probes, the samples masked as a family's."""
+        nb_all = n_all if n_all > 1 else 1
+        buf_t, buf_f, buf_c = np.empty(SUB + 2), np.empty(SUB + 2), np.empty(4)
+        f_all, edge_f = np.empty((M, nb_all)), np.empty((2, M, SUB + 1, nb_all))
+        edge_ok, f, top = np.empty((2, M), dtype=np.bool_), np.empty(M), np.empty(1, dtype=np.int64)
+        return buf_t, buf_f, buf_c, f_all, edge_f, edge_ok, f, top, np.empty((K, 2)), np.empty(M, dtype=np.bool_)
+
     _U_UNIFORM_ARR = _U_UNIFORM.copy()
     _U_EDGE_ARR = _U_EDGE.copy()
 
@@ -555,31 +685,11 @@ if AVAILABLE:
             unowned(out_m),
         )
         cnt, fam, fcnt, span = unowned(cnt), unowned(fam), unowned(fcnt), unowned(span)
-        M = grid.shape[1]  # (the most samples of a pose)
-        # work arrays, shared by the poses (each pose sets what it reads). Explicit loops rather than np.zeros,
-        # np.full, slice copies or np.argsort: each of those adds to the first compilation (docs/performance.md)
-        own_c = np.empty(1, dtype=np.int64)
-        own_stk_t = np.empty((STACK, SUB + 2))
-        own_stk_f = np.empty((STACK, SUB + 2))
-        own_stk_i = np.empty((STACK, 3), dtype=np.int64)
-        own_stk_c = np.empty((STACK, 5))
-        own_no_ctx = np.empty(4)
-        for k in range(4):
-            own_no_ctx[k] = np.nan
-        W = M if M > SUB + 2 else SUB + 2
-        own_wv = np.empty(W, dtype=np.bool_)
-        own_wx = np.empty(W)
-        own_buf_t = np.empty(SUB + 2)
-        own_buf_f = np.empty(SUB + 2)
-        own_buf_c = np.empty(4)
-        nb_all = n_all if n_all > 1 else 1
-        own_f_all = np.empty((M, nb_all))
-        own_edge_f = np.empty((2, M, SUB + 1, nb_all))  # all-branch sub-samples of level-0 intervals (_scan)
-        own_edge_ok = np.empty((2, M), dtype=np.bool_)
-        own_f = np.empty(M)
-        own_fm = np.empty(M, dtype=np.bool_)
-        own_top = np.empty(1, dtype=np.int64)
-        own_probes = np.empty((out_t.shape[1], 2))
+        # work arrays, shared by the poses (each pose sets what it reads)
+        own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx = _scan_arrays(grid.shape[1])
+        own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top, own_probes, own_fm = (
+            _pose_arrays(grid.shape[1], n_all, out_t.shape[1])
+        )
         # ... and the work arrays too (their owners are used at the end, ``alive``: they outlive the views)
         c, stk_t, stk_f, stk_i = unowned(own_c), unowned(own_stk_t), unowned(own_stk_f), unowned(own_stk_i)
         stk_c, no_ctx, wv, wx = unowned(own_stk_c), unowned(own_no_ctx), unowned(own_wv), unowned(own_wx)
@@ -596,13 +706,7 @@ if AVAILABLE:
                 edge_ok[0, j] = False
                 edge_ok[1, j] = False
             if n_all > 0:
-                for j in range(M):
-                    k = known_at[i - start, j] if known.shape[0] > 0 else -1
-                    if k >= 0:
-                        for b in range(n_all):
-                            f_all[j, b] = known[i - start, k, b]
-                    else:
-                        res_all(p, th[j], f_all[j])
+                _all_branch_samples(res_all, p, th, n_all, known, known_at, i - start, f_all)
             for bi in range(branches.shape[0]):
                 if c[0] > out_t.shape[1] or fcnt[i] > fam.shape[1]:  # (overflowed: redone by the NumPy engine)
                     break
@@ -610,31 +714,7 @@ if AVAILABLE:
                 for j in range(M):
                     f[j] = f_all[j, b] if n_all > 0 else res(p, th[j], b)
                     fm[j] = False
-                # families: runs of vanishing samples
-                j = 0
-                while j < M:
-                    if not math.isnan(f[j]) and abs(f[j]) <= FAMILY_TOL:
-                        k = j
-                        while k + 1 < M and not math.isnan(f[k + 1]) and abs(f[k + 1]) <= FAMILY_TOL:
-                            k += 1
-                        if k - j + 1 >= FAMILY_MIN_RUN and th[k] - th[j] > CLUSTER_FAMILY_REL * span[i]:
-                            if fcnt[i] < fam.shape[1]:
-                                lo, hi = th[j], th[k]
-                                if j > 0:
-                                    lo = _extend(res, p, b, lo, th[j - 1])
-                                if k + 1 < M:
-                                    hi = _extend(res, p, b, hi, th[k + 1])
-                                fam[i, fcnt[i], 0] = lo
-                                fam[i, fcnt[i], 1] = hi
-                                fam[i, fcnt[i], 2] = b
-                            fcnt[i] += 1
-                            for m in range(j, k + 1):
-                                f[m] = np.nan
-                                fm[m] = True
-                        # (a short run of coinciding samples is left to the scan: one root)
-                        j = k + 1
-                    else:
-                        j += 1
+                _family_runs(res, p, b, th, f, fm, span[i], fam, fcnt, i)
                 top[0] = 0
                 # the sequence itself, then the resampled intervals it (and they) push on the stack
                 # level 0, not open at either end: read from ``top`` rather than written as constants (Numba would
@@ -660,46 +740,14 @@ if AVAILABLE:
             cnt[i] = c[0]
             if c[0] > out_t.shape[1] or fcnt[i] > fam.shape[1]:
                 continue
-            n0 = min(c[0], out_t.shape[1])
-            w0 = 0
-            for k in range(n0):  # (probes[w0]: candidate w0's probes, written whether or not it is kept)
-                x, lo, hi, family = _center_flat(res, p, out_t[i, k], out_b[i, k], noise, span[i], probes[w0])
-                if family:
-                    if fcnt[i] < fam.shape[1]:
-                        fam[i, fcnt[i], 0] = lo
-                        fam[i, fcnt[i], 1] = hi
-                        fam[i, fcnt[i], 2] = out_b[i, k]
-                    fcnt[i] += 1
-                else:
-                    out_t[i, w0] = x
-                    out_b[i, w0] = out_b[i, k]
-                    w0 += 1
+            w0 = _centred(res, p, out_t[i], out_b[i], min(c[0], out_t.shape[1]), noise, span[i], probes, fam, fcnt, i)
             if c[0] <= out_t.shape[1]:
                 c[0] = w0
             cnt[i] = c[0]
             # merge noise-level clusters per branch (candidates sorted by branch, then theta)
             n = min(c[0], out_t.shape[1])
             if n > 1:
-                ts = out_t[i]
-                bs = out_b[i]
-                _sort_pairs(bs, ts, probes, n)
-                w = 0  # (written in place: w <= s, and only entries from s on are read after a write)
-                s = 0
-                while s < n:
-                    e = s
-                    while (
-                        e + 1 < n
-                        and bs[e + 1] == bs[s]
-                        and (ts[e + 1] == ts[e] or abs(res(p, 0.5 * (ts[e] + ts[e + 1]), bs[s])) <= noise)
-                    ):
-                        e += 1
-                    out_t[i, w] = 0.5 * (ts[s] + ts[e])  # a cluster is one root (families were set apart)
-                    out_b[i, w] = bs[s]
-                    # (a cluster's centre is a new point: its probes are not known)
-                    probes[w, 0] = probes[s, 0] if e == s else np.nan
-                    probes[w, 1] = probes[s, 1] if e == s else np.nan
-                    w += 1
-                    s = e + 1
+                w = _merged_clusters(res, p, out_t[i], out_b[i], n, noise, probes)
                 cnt[i] = w if c[0] <= out_t.shape[1] else c[0]
             for k in range(min(cnt[i], out_t.shape[1])):
                 if multiplicity:
@@ -1234,74 +1282,19 @@ def search(
     gives the samples of every pose first (the same samples: the tests compare the two)."""
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
     N = poses.shape[0]
-    out_t = np.empty((N, MAX_CAND))
-    out_b = np.empty((N, MAX_CAND), dtype=np.int64)
-    out_m = np.empty((N, MAX_CAND), dtype=np.int64)  # (every slot below a pose's count is written)
-    cnt = np.zeros(N, dtype=np.int64)
-    fam = np.empty((N, MAX_FAM, 3))
-    fcnt = np.zeros(N, dtype=np.int64)
+    out = _Out.empty(N)
     plan = _plan(reduction)
     one = plan.one_pass if one_pass else None
     if one is not None and one.n_samples is not None and one.n_samples != n_samples:
         one = None
     redo = None
-    # threads pay off only for batches; a single pose would wait for a worker thread to be scheduled
     if one is not None:  # each pose's samples, then its candidates
-        redo = np.empty(N, dtype=np.bool_)
         lo, hi = writable(lo), writable(hi)
-        hlo, hhi = lo, hi
-        if one.hint_range is not None:
-            hlo, hhi = (writable(a) for a in one.hint_range(reduction, poses))
-        parallel.run(
-            one.kernel,
-            N,
-            PARALLEL_MIN,
-            one.ints[bool(multiplicity)],
-            plan.branches,
-            one.margin_branches,
-            one.steps,
-            one.noise,
-            params,
-            hlo,
-            hhi,
-            lo,
-            hi,
-            _ref._unit_grid(n_samples),
-            plan.ends,
-            one.twins,
-            out_t,
-            out_b,
-            out_m,
-            cnt,
-            fam,
-            fcnt,
-            redo,
-        )
+        redo = _run_one_pass(reduction, plan, one, poses, params, lo, hi, n_samples, multiplicity, out)
     else:
         theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
-        parallel.run(
-            _search,
-            N,
-            PARALLEL_MIN,
-            plan.residual,
-            plan.residuals,
-            plan.n_all,
-            params,
-            np.ascontiguousarray(theta),
-            n_theta,
-            plan.branches,
-            np.ascontiguousarray(hi - lo, dtype=np.float64),
-            float(reduction.residual_noise),
-            out_t,
-            out_b,
-            out_m,
-            cnt,
-            fam,
-            fcnt,
-            multiplicity,
-            np.empty((0, 0, 1)),
-            np.empty((0, 0), dtype=np.int64),
-        )
+        _run_search(reduction, plan, params, theta, n_theta, lo, hi, multiplicity, out)
+    out_t, out_b, out_m, cnt, fcnt = out.t, out.b, out.m, out.cnt, out.fcnt
     if N == 1 and cnt[0] <= MAX_CAND and fcnt[0] == 0 and (redo is None or not redo[0]):
         # (a single pose: the general bookkeeping costs ~40 us)
         k0 = int(cnt[0])
@@ -1315,15 +1308,7 @@ def search(
     over = (cnt > MAX_CAND) | (fcnt > MAX_FAM)
     if redo is not None:
         over |= redo
-    counts = np.where(over, 0, cnt)
-    pose_idx = np.repeat(np.arange(N), counts)
-    slot = np.arange(pose_idx.size) - np.repeat(np.cumsum(counts) - counts, counts)
-    cand_p, cand_b, cand_t = [pose_idx], [out_b[pose_idx, slot]], [out_t[pose_idx, slot]]
-    cand_m = [out_m[pose_idx, slot]]
-    spans = [_ref.Spans.empty()]
-    if fcnt.any():
-        fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(fcnt, MAX_FAM)[:, None]) & ~over[:, None])
-        spans.append(_ref.Spans(fp.astype(np.intp), fam[fp, fs, 2].astype(np.intp), fam[fp, fs, 0], fam[fp, fs, 1]))
+    cand, spans = _gathered(out, over)
     redone = bool(over.any())
     if redone:
         idx = np.nonzero(over)[0]
@@ -1331,23 +1316,128 @@ def search(
         c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples, masked)
         if one is not None:  # (the one-pass kernels copied the others' candidates to their twins)
             c2 = _ref.twin_candidates(reduction, c2)
-        cand_p.append(idx[c2.pose])
-        cand_b.append(c2.branch)
-        cand_t.append(c2.theta)
-        cand_m.append(c2.mult)
-        spans.append(_ref.Spans(idx[s2.pose].astype(np.intp), s2.branch, s2.lo, s2.hi))
+        cand = _ref.Candidates(
+            np.concatenate([cand.pose, idx[c2.pose]]),
+            np.concatenate([cand.branch, c2.branch]),
+            np.concatenate([cand.theta, c2.theta]),
+            np.concatenate([cand.mult, c2.mult]),
+        )
+        spans = _ref.Spans.concat([spans, _ref.Spans(idx[s2.pose].astype(np.intp), s2.branch, s2.lo, s2.hi)])
     cand = _ref.Candidates(
-        pose=np.concatenate(cand_p).astype(np.intp),
-        branch=np.concatenate(cand_b).astype(np.intp),
-        theta=np.concatenate(cand_t),
-        mult=np.concatenate(cand_m).astype(np.intp),
+        pose=cand.pose.astype(np.intp),
+        branch=cand.branch.astype(np.intp),
+        theta=cand.theta,
+        mult=cand.mult.astype(np.intp),
     )
     if one is None:
-        return _ref.twin_copies(reduction, cand, _ref.Spans.concat(spans))
+        return _ref.twin_copies(reduction, cand, spans)
     if redone and reduction.twins:  # the redone poses in their place, as ``sweep.twin_candidates`` puts them
         order = np.argsort(cand.pose, kind="stable")
         cand = _ref.Candidates(cand.pose[order], cand.branch[order], cand.theta[order], cand.mult[order])
-    return cand, _ref.twin_spans(reduction, _ref.Spans.concat(spans))
+    return cand, _ref.twin_spans(reduction, spans)
+
+
+@dataclass
+class _Out:
+    """The compiled search's output buffers for ``N`` poses: candidates (theta, branch, multiplicity; every slot
+    below a pose's count is written) and their count, family spans ``(lo, hi, branch)`` and their count (counts past
+    the buffers' sizes: an overflow)."""
+
+    t: Array
+    b: NDArray[np.int64]
+    m: NDArray[np.int64]
+    cnt: NDArray[np.int64]
+    fam: Array
+    fcnt: NDArray[np.int64]
+
+    @classmethod
+    def empty(cls, N: int) -> _Out:
+        return cls(
+            np.empty((N, MAX_CAND)),
+            np.empty((N, MAX_CAND), dtype=np.int64),
+            np.empty((N, MAX_CAND), dtype=np.int64),
+            np.zeros(N, dtype=np.int64),
+            np.empty((N, MAX_FAM, 3)),
+            np.zeros(N, dtype=np.int64),
+        )
+
+
+def _run_one_pass(reduction, plan, one, poses, params, lo, hi, n_samples, multiplicity, out):
+    """The one-pass kernel of ``plan`` (each pose's samples, then its candidates) over the poses, on threads for a
+    batch (a single pose would wait for a worker thread to be scheduled). Returns which poses it leaves to redo."""
+    N = poses.shape[0]
+    redo = np.empty(N, dtype=np.bool_)
+    hlo, hhi = lo, hi
+    if one.hint_range is not None:
+        hlo, hhi = (writable(a) for a in one.hint_range(reduction, poses))
+    parallel.run(
+        one.kernel,
+        N,
+        PARALLEL_MIN,
+        one.ints[bool(multiplicity)],
+        plan.branches,
+        one.margin_branches,
+        one.steps,
+        one.noise,
+        params,
+        hlo,
+        hhi,
+        lo,
+        hi,
+        _ref._unit_grid(n_samples),
+        plan.ends,
+        one.twins,
+        out.t,
+        out.b,
+        out.m,
+        out.cnt,
+        out.fam,
+        out.fcnt,
+        redo,
+    )
+    return redo
+
+
+def _run_search(reduction, plan, params, theta, n_theta, lo, hi, multiplicity, out):
+    """``_search`` over the poses' samples ``theta (N, M)`` (the first ``n_theta[i]`` of row i), on threads for a
+    batch."""
+    parallel.run(
+        _search,
+        theta.shape[0],
+        PARALLEL_MIN,
+        plan.residual,
+        plan.residuals,
+        plan.n_all,
+        params,
+        np.ascontiguousarray(theta),
+        n_theta,
+        plan.branches,
+        np.ascontiguousarray(hi - lo, dtype=np.float64),
+        float(reduction.residual_noise),
+        out.t,
+        out.b,
+        out.m,
+        out.cnt,
+        out.fam,
+        out.fcnt,
+        multiplicity,
+        np.empty((0, 0, 1)),
+        np.empty((0, 0), dtype=np.int64),
+    )
+
+
+def _gathered(out: _Out, over: NDArray[np.bool_]) -> tuple[_ref.Candidates, _ref.Spans]:
+    """The candidates and family spans of the poses that did not overflow (``over``), pose by pose."""
+    counts = np.where(over, 0, out.cnt)
+    pose_idx = np.repeat(np.arange(over.size), counts)
+    slot = np.arange(pose_idx.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    cand = _ref.Candidates(pose_idx, out.b[pose_idx, slot], out.t[pose_idx, slot], out.m[pose_idx, slot])
+    spans = _ref.Spans.empty()
+    if out.fcnt.any():
+        fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(out.fcnt, MAX_FAM)[:, None]) & ~over[:, None])
+        fam = out.fam
+        spans = _ref.Spans(fp.astype(np.intp), fam[fp, fs, 2].astype(np.intp), fam[fp, fs, 0], fam[fp, fs, 1])
+    return cand, spans
 
 
 if AVAILABLE:

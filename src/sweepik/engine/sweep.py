@@ -281,7 +281,7 @@ class _Search:
         curvature is judged in the coordinate sqrt(|theta - edge|) (see ``_edge_coordinate``).
         ``family (S, M)``: the samples masked as a family's (level 0 only; see ``FAR_NOISE``).
         """
-        S, M = f.shape
+        S = f.shape[0]
         if edge_left is None or edge_right is None:
             edge_left = edge_right = np.zeros(S, dtype=bool)
         if edge_x is None:
@@ -298,7 +298,28 @@ class _Search:
             own[:, 0] = own[:, -1] = False
         z_i, z_j = np.nonzero(own & (absf <= self.red.residual_noise))
         self._root(p[z_i], b[z_i], th[z_i, z_j])
-        # 3) extrema of |f| with no sign change around them (interior samples; with context, the ends too)
+        self._extrema_of(p, b, th, fin, ctx)
+        self._edge_roots(p, b, th, absf, valid, level, family)
+        # 5) intervals that may hide a pair of roots (besides a sign change they may have) are resampled;
+        #    sign changes of the other intervals are bracketed
+        prod = fin[:, :-1] * fin[:, 1:]
+        if level < MAX_LEVELS:
+            edges = (edge_left, edge_right, edge_x)
+            refine, near_edge, open_l, open_r = self._to_refine(p, b, th, fin, absf, valid, both, level, *edges, family)
+        else:
+            refine = np.zeros_like(both)
+        s_i, s_j = np.nonzero(both & ~refine & (prod < 0))
+        if s_i.size:
+            self.br.append((p[s_i], b[s_i], th[s_i, s_j], th[s_i, s_j + 1], f[s_i, s_j], f[s_i, s_j + 1]))
+        r_i, r_j = np.nonzero(refine)
+        if r_i.size:
+            self._resample(p, b, th, f, fin, r_i, r_j, level, near_edge, open_l, open_r, ctx, edge_x)
+
+    def _extrema_of(
+        self, p: IntArray, b: IntArray, th: Array, fin: Array, ctx: tuple[Array, Array, Array, Array] | None
+    ) -> None:
+        """``scan``'s step 3: extrema of |f| with no sign change around them (interior samples; with context, the
+        ends too)."""
         if ctx is not None:
             th_x = np.concatenate([ctx[0][:, None], th, ctx[2][:, None]], axis=1)
             f_x = np.concatenate([ctx[1][:, None], fin, ctx[3][:, None]], axis=1)
@@ -332,7 +353,19 @@ class _Search:
                     f_x[e_i, e_j],
                     f_x[e_i, e_j + 2],
                 )
-        # 4) samples next to a domain edge (NaN) or at the range ends (level 0 only)
+
+    def _edge_roots(
+        self,
+        p: IntArray,
+        b: IntArray,
+        th: Array,
+        absf: Array,
+        valid: NDArray[np.bool_],
+        level: int,
+        family: NDArray[np.bool_] | None,
+    ) -> None:
+        """``scan``'s step 4: samples next to a domain edge (NaN) or at the range ends (level 0 only)."""
+        S = th.shape[0]
         end = level == 0
         left_open = np.concatenate([np.full((S, 1), end), ~valid[:, :-1]], axis=1)
         right_open = np.concatenate([~valid[:, 1:], np.full((S, 1), end)], axis=1)
@@ -349,47 +382,71 @@ class _Search:
         edge = valid & (edge_l | edge_r) & near
         d_i, d_j = np.nonzero(edge)
         self._root(p[d_i], b[d_i], th[d_i, d_j])
-        # 5) intervals that may hide a pair of roots (besides a sign change they may have) are resampled;
-        #    sign changes of the other intervals are bracketed
-        prod = fin[:, :-1] * fin[:, 1:]
-        if level < MAX_LEVELS:
-            with np.errstate(invalid="ignore", divide="ignore"):
-                # curvature in theta, or in sqrt(|theta - edge|) below an edge's interval
-                x = _edge_coordinate(th, edge_x[:, None])
-                dd = np.full((S, M), np.nan)  # second divided difference at interior samples
-                if M >= 3:
-                    hl, hr = x[:, 1:-1] - x[:, :-2], x[:, 2:] - x[:, 1:-1]
-                    dd[:, 1:-1] = (
-                        2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
-                    )
-                curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
-                lowest = np.minimum(absf[:, :-1], absf[:, 1:])
-                hx = x[:, 1:] - x[:, :-1]
-                bend = lowest <= BEND * curv * hx * hx
-                # sample j borders a domain edge on its left / right
-                open_l = np.concatenate([edge_left[:, None], ~valid[:, :-1]], axis=1)
-                open_r = np.concatenate([~valid[:, 1:], edge_right[:, None]], axis=1)
-                near_edge = open_l[:, :-1] | open_r[:, 1:]
-                # an interval next to an edge is resampled unconditionally, except next to the edge whose
-                # coordinate judges the curvature (there the bend test in that coordinate decides)
-                ex = edge_x[:, None]
-                own_edge = (open_l[:, :-1] & (t0 == ex) & ~open_r[:, 1:]) | (
-                    open_r[:, 1:] & (t1 == ex) & ~open_l[:, :-1]
-                )
-            nonzero = np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0
-            refine = bend | (near_edge & ~own_edge)
-            if level == 0 and self.signed:  # (an edge at a sample: in its coordinate)
-                judged, bent = self._edge_at_sample(p, b, th, fin, both, open_l, open_r, family)
-                refine = np.where(judged, bent, refine)
-            refine &= both & nonzero
-        else:
-            refine = np.zeros_like(both)
-        s_i, s_j = np.nonzero(both & ~refine & (prod < 0))
-        if s_i.size:
-            self.br.append((p[s_i], b[s_i], th[s_i, s_j], th[s_i, s_j + 1], f[s_i, s_j], f[s_i, s_j + 1]))
-        r_i, r_j = np.nonzero(refine)
-        if r_i.size == 0:
-            return
+
+    def _to_refine(
+        self,
+        p: IntArray,
+        b: IntArray,
+        th: Array,
+        fin: Array,
+        absf: Array,
+        valid: NDArray[np.bool_],
+        both: NDArray[np.bool_],
+        level: int,
+        edge_left: NDArray[np.bool_],
+        edge_right: NDArray[np.bool_],
+        edge_x: Array,
+        family: NDArray[np.bool_] | None,
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.bool_], NDArray[np.bool_]]:
+        """``scan``'s step 5: the intervals to resample (``(S, M - 1)``), whether each is next to a domain edge, and
+        whether each sample borders one on its left / right (``(S, M)``)."""
+        S, M = fin.shape
+        t0, t1 = th[:, :-1], th[:, 1:]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            # curvature in theta, or in sqrt(|theta - edge|) below an edge's interval
+            x = _edge_coordinate(th, edge_x[:, None])
+            dd = np.full((S, M), np.nan)  # second divided difference at interior samples
+            if M >= 3:
+                hl, hr = x[:, 1:-1] - x[:, :-2], x[:, 2:] - x[:, 1:-1]
+                dd[:, 1:-1] = 2.0 * ((fin[:, 2:] - fin[:, 1:-1]) / hr - (fin[:, 1:-1] - fin[:, :-2]) / hl) / (hl + hr)
+            curv = np.fmax(np.abs(dd[:, :-1]), np.abs(dd[:, 1:]))
+            lowest = np.minimum(absf[:, :-1], absf[:, 1:])
+            hx = x[:, 1:] - x[:, :-1]
+            bend = lowest <= BEND * curv * hx * hx
+            # sample j borders a domain edge on its left / right
+            open_l = np.concatenate([edge_left[:, None], ~valid[:, :-1]], axis=1)
+            open_r = np.concatenate([~valid[:, 1:], edge_right[:, None]], axis=1)
+            near_edge = open_l[:, :-1] | open_r[:, 1:]
+            # an interval next to an edge is resampled unconditionally, except next to the edge whose
+            # coordinate judges the curvature (there the bend test in that coordinate decides)
+            ex = edge_x[:, None]
+            own_edge = (open_l[:, :-1] & (t0 == ex) & ~open_r[:, 1:]) | (open_r[:, 1:] & (t1 == ex) & ~open_l[:, :-1])
+        nonzero = np.abs(fin[:, :-1]) + np.abs(fin[:, 1:]) > 0
+        refine = bend | (near_edge & ~own_edge)
+        if level == 0 and self.signed:  # (an edge at a sample: in its coordinate)
+            judged, bent = self._edge_at_sample(p, b, th, fin, both, open_l, open_r, family)
+            refine = np.where(judged, bent, refine)
+        refine &= both & nonzero
+        return refine, near_edge, open_l, open_r
+
+    def _resample(
+        self,
+        p: IntArray,
+        b: IntArray,
+        th: Array,
+        f: Array,
+        fin: Array,
+        r_i: IntArray,
+        r_j: IntArray,
+        level: int,
+        near_edge: NDArray[np.bool_],
+        open_l: NDArray[np.bool_],
+        open_r: NDArray[np.bool_],
+        ctx: tuple[Array, Array, Array, Array] | None,
+        edge_x: Array,
+    ) -> None:
+        """The intervals ``(r_i, r_j)`` resampled and scanned one level down."""
+        M = th.shape[1]
         # uniform sub-samples; next to a domain edge (square-root behaviour) clustered towards both ends
         u = np.where(near_edge[r_i, r_j, None], _U_EDGE[None, :], _U_UNIFORM[None, :])
         sub = th[r_i, r_j, None] + (th[r_i, r_j + 1] - th[r_i, r_j])[:, None] * u

@@ -26,11 +26,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sweepik.errors import UnknownOptionError
-from sweepik.io.robot_file import MAX_LENGTH
 from sweepik.model import kinematics
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit
-from sweepik.model.validate import check_configuration
+from sweepik.model.validate import MAX_LENGTH, check_configuration
 
 __all__ = ["STANDARD_GRAVITY", "gravity_torques", "potential_energy", "torque_units"]
 

@@ -24,8 +24,6 @@ import math
 import time
 from collections import Counter
 from collections.abc import Sequence
-from os import PathLike
-from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
@@ -62,8 +60,6 @@ __all__ = [
     "trajectory_poses",
     "run_trajectory",
     "run_verify",
-    "format_table",
-    "write_report",
 ]
 
 Array = NDArray[np.float64]
@@ -584,18 +580,3 @@ def run_verify(
     out = _run_one(robot, strategy, offgrid, seed, progress)
     out["paper_reference"] = PAPER_TABLES
     return out
-
-
-def format_table(result: dict[str, Any]) -> str:
-    """Console table of a :func:`run_verify` result (see :mod:`sweepik.experiments.verify_report`)."""
-    from sweepik.experiments.verify_report import format_table as _format_table
-
-    return _format_table(result)
-
-
-def write_report(result: dict[str, Any], directory: str | PathLike[str]) -> Path:
-    """Markdown report with PNG figures of a :func:`run_verify` result (see
-    :mod:`sweepik.experiments.verify_report`)."""
-    from sweepik.experiments.verify_report import write_report as _write_report
-
-    return _write_report(result, directory)

@@ -63,7 +63,17 @@ import numpy as np
 from sweepik.errors import RobotFileError, UnknownOptionError, UnknownRobotError
 from sweepik.model.pose import pose_from_xyz_rpy, pose_from_xyz_zyz
 from sweepik.model.robot import Joint, Robot
-from sweepik.model.validate import as_path, decode_text, file_status, read_file_bytes, short_repr
+from sweepik.model.validate import (
+    MAX_ANGLE_DEG,
+    MAX_LENGTH,
+    MAX_LIMIT,
+    MAX_MASS,
+    as_path,
+    decode_text,
+    file_status,
+    read_file_bytes,
+    short_repr,
+)
 
 __all__ = ["load_robot", "bundled_robots", "robot_from_dict", "robot_to_toml"]
 
@@ -93,19 +103,6 @@ def bundled_robots() -> list[str]:
 
 #: Robot files larger than this are refused before they are read (a 6-joint arm takes about 1 KiB).
 MAX_ROBOT_FILE_BYTES = 1 << 20
-#: Lengths (a, d, base/tool offsets) beyond this magnitude are refused: no arm in any unit is that large, and
-#: sums and squares of such numbers overflow.
-MAX_LENGTH = 1e12
-#: Angles (alpha, theta, base/tool Z-Y-Z angles; degrees) beyond this magnitude are refused:
-#: no DH table needs more than a turn, and 1e6 degrees (about 2,800 turns) keeps the rounding of the angle in
-#: radians (ulp 4e-12 rad at 1.7e4 rad) far below the angle tolerances (e.g. ``robot.LIMIT_TOL``, 1e-9 rad).
-MAX_ANGLE_DEG = 1e6
-#: Joint limits (degrees or length unit) beyond this magnitude are refused, so that a range ``upper - lower``
-#: stays finite. Huge limits are allowed on purpose: ``[-1e300, 1e300]`` is a joint without a practical end
-#: (``Robot.length_scale`` caps how much a prismatic range counts).
-MAX_LIMIT = 1e300
-#: Link masses (kg) beyond this are refused (a typo, not a link: the heaviest industrial arms weigh a few tonnes).
-MAX_MASS = 1e6
 
 
 def _number(value: Any, where: str, field: str, bound: float) -> float:

@@ -61,6 +61,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine.continuation import Traced
+from sweepik.engine.families import certified_members
 from sweepik.errors import StoreError, SweepikError
 from sweepik.model.robot import Joint, Robot
 from sweepik.results import Block, Family, SolutionBatch
@@ -244,6 +245,7 @@ class _FamilyBuilder:
             chain_pose=np.array(rec["chain_pose"], dtype=np.float64).reshape(4, 4),
             branch=int(rec["branch"]),
             held=self.held if rec["held"] else None,
+            members=certified_members,
         )
 
 

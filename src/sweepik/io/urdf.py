@@ -39,12 +39,11 @@ from defusedxml.ElementTree import DefusedXMLParser, ParseError
 from numpy.typing import NDArray
 
 from sweepik.errors import RobotDefinitionError, UnknownOptionError, UrdfError
-from sweepik.io.robot_file import MAX_ANGLE_DEG, MAX_LENGTH, MAX_LIMIT, MAX_MASS
 from sweepik.model.origin_axis import joint_origins, link_masses
 from sweepik.model.pose import matrix_from_rpy, rpy_from_matrix
 from sweepik.model.robot import AXIS_MIN_NORM, Joint, Robot
 from sweepik.model.units import mm_per_unit
-from sweepik.model.validate import as_path, read_file_bytes, short_repr
+from sweepik.model.validate import MAX_ANGLE_DEG, MAX_LENGTH, MAX_LIMIT, MAX_MASS, as_path, read_file_bytes, short_repr
 
 __all__ = [
     "read_urdf",

@@ -6,21 +6,51 @@ prismatic ones) and loop only over the joints, never over configurations.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-if TYPE_CHECKING:
-    from sweepik.model.robot import Robot
+from sweepik.model.chain import rotation_about
 
 Array = NDArray[np.float64]
 
 
-def _origin_axis_transforms(robot: Robot, q: Array) -> Array:
-    """``origin_i @ Rot(axis_i, q_i)`` or ``origin_i @ Trans(axis_i q_i)`` for ``dh_convention="none"``."""
-    from sweepik.model.chain import rotation_about
+class _Joint(Protocol):
+    @property
+    def origin(self) -> object: ...
+    @property
+    def axis(self) -> object: ...
 
+
+class Arm(Protocol):
+    """What these functions read of a :class:`sweepik.model.robot.Robot` (which imports this module)."""
+
+    @property
+    def joints(self) -> Sequence[_Joint]: ...
+    @property
+    def n_joints(self) -> int: ...
+    @property
+    def dh_convention(self) -> str: ...
+    @property
+    def dh_a(self) -> Array: ...
+    @property
+    def dh_alpha(self) -> Array: ...
+    @property
+    def dh_theta(self) -> Array: ...
+    @property
+    def dh_d(self) -> Array: ...
+    @property
+    def is_revolute(self) -> NDArray[np.bool_]: ...
+    @property
+    def T_world_base(self) -> Array: ...
+    @property
+    def T_flange_tool(self) -> Array: ...
+
+
+def _origin_axis_transforms(robot: Arm, q: Array) -> Array:
+    """``origin_i @ Rot(axis_i, q_i)`` or ``origin_i @ Trans(axis_i q_i)`` for ``dh_convention="none"``."""
     origins = np.array([j.origin for j in robot.joints], dtype=np.float64)
     axes = np.array([j.axis for j in robot.joints], dtype=np.float64)
     M = np.zeros((*q.shape, 4, 4))
@@ -31,7 +61,7 @@ def _origin_axis_transforms(robot: Robot, q: Array) -> Array:
     return np.asarray(origins @ M, dtype=np.float64)
 
 
-def link_transforms(robot: Robot, q: Array) -> Array:
+def link_transforms(robot: Arm, q: Array) -> Array:
     """Transforms ``(..., n, 4, 4)`` of each link frame relative to the previous one."""
     if robot.dh_convention == "none":
         return _origin_axis_transforms(robot, q)
@@ -73,7 +103,7 @@ def link_transforms(robot: Robot, q: Array) -> Array:
     return T
 
 
-def chain_frames(robot: Robot, q: Array) -> Array:
+def chain_frames(robot: Arm, q: Array) -> Array:
     """World poses ``(..., n + 1, 4, 4)`` of the base (index 0) and of link frames 1..n (tool not applied)."""
     links = link_transforms(robot, q)
     n = robot.n_joints
@@ -84,7 +114,7 @@ def chain_frames(robot: Robot, q: Array) -> Array:
     return out
 
 
-def joint_axes(robot: Robot, frames: Array) -> tuple[Array, Array]:
+def joint_axes(robot: Arm, frames: Array) -> tuple[Array, Array]:
     """Unit axes ``(..., n, 3)`` and points on them ``(..., n, 3)`` of each joint, in world coordinates.
 
     Modified DH: joint i moves along/about z of frame i. Standard DH: about z of frame i - 1. Origin + axis
@@ -98,7 +128,7 @@ def joint_axes(robot: Robot, frames: Array) -> tuple[Array, Array]:
     return sel[..., :3, 2], sel[..., :3, 3]
 
 
-def geometric_jacobian(robot: Robot, q: Array) -> Array:
+def geometric_jacobian(robot: Arm, q: Array) -> Array:
     """Geometric Jacobian ``(..., 6, n)`` in world coordinates at the tool point.
 
     Rows 0-2: linear velocity of the tool origin; rows 3-5: angular velocity (rad per unit of q).

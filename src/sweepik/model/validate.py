@@ -30,6 +30,19 @@ MAX_TRANSLATION = 1e30
 #: Joint values beyond this magnitude (radians or length unit) are refused: their poses would overflow.
 MAX_JOINT_VALUE = 1e30
 
+#: Lengths in robot files (a, d, base/tool offsets; URDF origins) beyond this magnitude are refused: no arm in any
+#: unit is that large, and sums and squares of such numbers overflow.
+MAX_LENGTH = 1e12
+#: Angles (alpha, theta, base/tool Z-Y-Z angles; degrees) beyond this magnitude are refused:
+#: no DH table needs more than a turn, and 1e6 degrees (about 2,800 turns) keeps the rounding of the angle in
+#: radians (ulp 4e-12 rad at 1.7e4 rad) far below the angle tolerances (e.g. ``robot.LIMIT_TOL``, 1e-9 rad).
+MAX_ANGLE_DEG = 1e6
+#: Joint limits (degrees or length unit) beyond this magnitude are refused, so that a range ``upper - lower``
+#: stays finite. Huge limits are allowed on purpose: ``[-1e300, 1e300]`` is a joint without a practical end
+#: (``Robot.length_scale`` caps how much a prismatic range counts).
+MAX_LIMIT = 1e300
+#: Link masses (kg) beyond this are refused (a typo, not a link: the heaviest industrial arms weigh a few tonnes).
+MAX_MASS = 1e6
 #: dtype kinds taken as real numbers: floats, signed and unsigned integers (object arrays: checked per element).
 _REAL_KINDS = "fiu"
 _KIND_NAMES = {

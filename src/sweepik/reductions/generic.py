@@ -7,7 +7,6 @@ arm: :mod:`.decompose` finds the plans of a robot.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
@@ -19,6 +18,7 @@ from sweepik.model.chain import Chain
 from sweepik.model.robot import Robot
 from sweepik.reductions import geometric
 from sweepik.reductions.base import Array, IntArray, Reduction
+from sweepik.reductions.plan import Plan, plans
 from sweepik.reductions.position import CASES, FINAL_JOINTS, STEP_JOINTS
 
 #: A candidate where a step's amplitude (``amplitude`` of ``geometric.case_kernels``) is below this fraction of the
@@ -35,78 +35,6 @@ CONTINUUM_AMPLITUDE = 1e-5
 TWIN_POSES = 12
 TWIN_SAMPLES = 24
 TWIN_TOL = 1e-12
-
-
-@dataclass(frozen=True)
-class Plan:
-    """One way to solve an arm: ``family`` ('pair': sweep theta*; 'wrist', 'parallel': closed forms) on the forward or
-    ``reversed`` chain, with ``free`` (0-3, in the solved chain's order) the fixed joint among the first four
-    and ``case`` the position case placing the wrist centre ``W``; ``meet`` the meeting point of the axes that
-    case uses (world frame, at the zero configuration of the joints other than theta*; for a prismatic theta* at
-    the middle of its sampled range: its position relative to joint a or b does not depend on the slide)."""
-
-    family: str
-    reversed: bool
-    free: int
-    case: str
-    branches: int
-    W: tuple[float, float, float]
-    meet: tuple[float, float, float]
-    #: theta* enters a division (a line-plane or lines step whose direction turns with theta*): the plan has a
-    #: blind spot where that product vanishes and is chosen only on request.
-    conditional: bool = False
-
-    @property
-    def closed_form(self) -> bool:
-        return self.family in ("wrist", "parallel")
-
-    def joint(self, i: int) -> int:
-        """Robot index of joint ``i`` of the solved chain."""
-        return 5 - i if self.reversed else i
-
-    @property
-    def free_joint(self) -> int:
-        """Robot index of theta* (for the closed form: the joint the family fixes, which does not move ``W``)."""
-        return self.joint(self.free)
-
-    def steps(self) -> list[str]:
-        """The subproblem chain, in words (joints numbered from 1 as the robot numbers them)."""
-        if self.family == "parallel":
-            j = [self.joint(i) + 1 for i in range(6)]
-            axes = f"the parallel axes {j[1]}, {j[2]}, {j[3]}"
-            if self.case != "parallel":  # a slide first
-                first = [
-                    f"joint {j[4]}: sp4 on the angle of joint {j[5]}'s axis to {axes}",
-                    f"joint {j[0]}: lp4 on the height of joint {j[5]}'s point along them",
-                ]
-            elif self.W != self.meet:
-                first = [
-                    f"joints {j[0]}, {j[4]}: sp6 on the height of joint {j[5]}'s point along {axes} and the angle "
-                    f"of joint {j[5]}'s axis to them"
-                ]
-            else:
-                first = [
-                    f"joint {j[0]}: sp4 on the height of the wrist centre along {axes}",
-                    f"joint {j[4]}: sp4 on the angle of joint {j[5]}'s axis to them",
-                ]
-            return [
-                *first,
-                f"joint {j[5]} and the sum of joints {j[1]}-{j[3]}: sp1",
-                f"joints {j[2]}, {j[1]}: sp3, sp1; joint {j[3]} from the sum",
-            ]
-        others = [i for i in range(4) if i != self.free]
-        a, b, c = (self.joint(i) + 1 for i in others)
-        place = f"joints {a}, {b}, {c} place the wrist centre ({self.case})"
-        if self.family == "wrist":
-            j4, j5, j6 = (self.joint(i) + 1 for i in (3, 4, 5))
-            return [place, f"joints {j4}, {j5}: sp2 on joint {j6}'s axis", f"joint {j6}: sp1"]
-        j5, j6 = self.joint(4) + 1, self.joint(5) + 1
-        return [
-            f"sweep joint {self.free_joint + 1}",
-            place,
-            f"residual: angle of joint {j5}'s axis to joint {j6}'s in the target",
-            f"joints {j5}, {j6}: sp1",
-        ]
 
 
 def _chain_rows(chain: Chain) -> Array:
@@ -299,8 +227,6 @@ class GeometricReduction(Reduction):
         None when the arm has no such plan (the slide-first parallel arm with an offset wrist)."""
         if not self.plan.closed_form:
             return None
-        from sweepik.reductions.decompose import plans  # local: decompose imports this module
-
         moving = [3, 5] + ([1, 2] if self.plan.family == "parallel" else [])
         pairs = [p for p in plans(self.robot) if p.family == "pair" and not p.conditional]
         for j in moving:
@@ -316,8 +242,6 @@ class GeometricReduction(Reduction):
         and a sweep of joint 4 places that point with joint 1, which it leaves free). None without one."""
         if not self.plan.closed_form or self.plan.family != "parallel":
             return None
-        from sweepik.reductions.decompose import plans  # local: decompose imports this module
-
         pairs = [p for p in plans(self.robot) if p.family == "pair" and not p.conditional]
         for j in (5, 0):
             for p in pairs:

@@ -731,6 +731,190 @@ class CaseKernels(NamedTuple):
 _CASE_KERNELS: dict[tuple[int, int, tuple[bool, ...]], CaseKernels] = {}
 
 
+def _residual_kernels(case: int, free: int, rev: tuple[bool, ...]) -> tuple[Any, ...]:
+    """``case_kernels``' residuals: one branch's, every branch's, and every branch's with the margins."""
+
+    def residual(p, x, branch):
+        arm = _arm(p, x, branch // 2, branch % 2, case, free, rev)
+        m = arm[0] if branch % 2 == 0 else arm[1]
+        return _orientation(p, m, arm[2], arm[3])
+
+    def residuals(p, x, out):
+        """Every branch's ``residual`` at once (``Reduction.kernel_residuals``): the two branches of each first
+        step share its work, and a first step whose branches the search skips (twins, ``LAYOUT['need']``) is
+        not computed (its entries are left as they are)."""
+        nb = int(p[_POS_BRANCHES])
+        need = int(p[_NEED])
+        both = BOTH + 0 * nb  # (a run-time value: see position.place)
+        if nb == 4 and need & 3 == 3:
+            # the usual case written out: both first-step branches in one stretch of code, so that the compiler
+            # shares their common work (theta*'s motion, the reduced chain) and interleaves the rest
+            a0 = _arm(p, x, 0 * nb, both, case, free, rev)
+            a1 = _arm(p, x, 1 + 0 * nb, both, case, free, rev)
+            r0, r1 = _orientations(p, a0[0], a0[1], a0[2], a0[3])
+            r2, r3 = _orientations(p, a1[0], a1[1], a1[2], a1[3])
+            out[0], out[1], out[2], out[3] = r0, r1, r2, r3
+            return
+        for b1 in range((nb + 1) // 2):
+            if need & (1 << b1):
+                arm = _arm(p, x, b1, both, case, free, rev)
+                out[2 * b1] = _orientation(p, arm[0], arm[2], arm[3])
+                if 2 * b1 + 1 < nb:
+                    out[2 * b1 + 1] = _orientation(p, arm[1], arm[2], arm[3])
+
+    def every(p, x, out):
+        """``residuals`` of the four branches and ``margins`` of the three steps at once, into ``out[:4]`` and
+        ``out[4:7]``, bit for bit theirs (the margins' cosines are those the residuals' first four joints come
+        from): the engine's uniform samples (``fastsweep.EdgeSearch.every``) for a plan that searches both
+        first-step branches (``LAYOUT['need']`` 3)."""
+        nb = int(p[_POS_BRANCHES])
+        both = BOTH + 0 * nb  # (a run-time value: see position.place)
+        a0 = _arm(p, x, 0 * nb, both, case, free, rev)
+        a1 = _arm(p, x, 1 + 0 * nb, both, case, free, rev)
+        r0, r1 = _orientations(p, a0[0], a0[1], a0[2], a0[3])
+        r2, r3 = _orientations(p, a1[0], a1[1], a1[2], a1[3])
+        out[0], out[1], out[2], out[3] = r0, r1, r2, r3
+        out[4] = 1.0 - a0[2] * a0[2]
+        out[5] = 1.0 - a0[3] * a0[3]
+        out[6] = 1.0 - a1[3] * a1[3]
+
+    return residual, residuals, every
+
+
+def _step_kernels(case: int, free: int, rev: tuple[bool, ...]) -> tuple[Any, ...]:
+    """``case_kernels``' configuration of a branch, and the steps' margins and amplitudes."""
+
+    def configuration(p, x, branch, out):
+        arm = _arm(p, x, branch // 2, branch % 2, case, free, rev)
+        m0, m1, m2, m3 = arm[0] if branch % 2 == 0 else arm[1]
+        if _missing(m0, m1, m2, m3):
+            for i in range(6):
+                out[i] = math.nan
+            return
+        q4, q5 = _last_two(p, m0, m1, m2, m3, _h(p, 4), _h(p, 5))
+        _write(p, out, m0, m1, m2, m3, q4, q5)
+
+    def margin(p, x, k):
+        """``1 - c^2`` of step k's cosine c: positive inside the branch domains, zero at their edges (found by
+        the same sweep, and sampled as hints)."""
+        if k == 0:  # (the first step's cosine alone: the compiler drops the second step)
+            arm = _arm(p, x, 0 * k, NEITHER + 0 * k, case, free, rev)
+            return 1.0 - arm[2] * arm[2]
+        arm = _arm(p, x, k - 1, NEITHER + 0 * k, case, free, rev)
+        return 1.0 - arm[3] * arm[3]
+
+    def margins(p, x, out):
+        """``margin`` of steps 0 and 1 (one first-step branch) and of step 2 (the other) at once, as they are
+        wanted (``LAYOUT['need_margin']``: bit k for step k)."""
+        need = int(p[_NEED_MARGIN])
+        neither = NEITHER + 0 * need
+        if need & 3:
+            arm = _arm(p, x, 0 * need, neither, case, free, rev)
+            out[0] = 1.0 - arm[2] * arm[2]
+            out[1] = 1.0 - arm[3] * arm[3]
+        if need & 4:
+            arm = _arm(p, x, 1 + 0 * need, neither, case, free, rev)
+            out[2] = 1.0 - arm[3] * arm[3]
+
+    def amplitude(p, x, k):
+        """Amplitude of step k (see ``margin``); for k >= 3 the final step's gap on position branch k - 3
+        (``_final_gap``)."""
+        if k >= 3:
+            pb = k - 3
+            arm = _arm(p, x, pb // 2, pb % 2, case, free, rev)
+            return arm[6] if pb % 2 == 0 else arm[7]
+        if k == 0:  # (the first step alone, as ``margin``)
+            arm = _arm(p, x, 0 * k, NEITHER + 0 * k, case, free, rev)
+            return arm[4]
+        arm = _arm(p, x, k - 1, NEITHER + 0 * k, case, free, rev)
+        return arm[5]
+
+    def amplitudes(p, x, out):
+        """``amplitude`` of the steps wanted (``LAYOUT['need_amplitude']``: bit k for step k) at once."""
+        need = int(p[_NEED_AMPLITUDE])
+        neither = NEITHER + 0 * need
+        if need & 3:
+            arm = _arm(p, x, 0 * need, neither, case, free, rev)
+            out[0] = arm[4]
+            out[1] = arm[5]
+        if need & 4:
+            arm = _arm(p, x, 1 + 0 * need, neither, case, free, rev)
+            out[2] = arm[5]
+
+    return configuration, margin, margins, amplitude, amplitudes
+
+
+def _wrist_kernels(case: int, free: int, rev: tuple[bool, ...]) -> tuple[Any, ...]:
+    """``case_kernels``' wrist family configurations (one branch, every branch) and its singular-wrist test."""
+
+    def wrist(p, x, branch, out):
+        nb = int(p[_POS_BRANCHES])
+        pb = branch // 2  # the position branch
+        arm = _arm(p, 0.0, pb // 2, pb % 2, case, free, rev)
+        m = arm[0] if pb % 2 == 0 else arm[1]
+        if _missing(m[0], m[1], m[2], m[3]) or branch >= 2 * nb:
+            for i in range(6):
+                out[i] = math.nan
+            return
+        v, be, s = _wrist_first(p, m)
+        _wrist_joints(p, m, v, be, s, branch % 2, out)
+
+    def wrists(p, x, out):
+        """Every branch's ``wrist`` configuration at once, ``out (n_branches, 6)`` (``Reduction.
+        kernel_configurations``): the two branches of a first position step share its work (``_arm`` with
+        ``BOTH``), the two wrist branches of a position branch share their ``sp2``."""
+        nb = int(p[_POS_BRANCHES])
+        both = BOTH + 0 * nb  # (a run-time value: see position.place)
+        for b1 in range((nb + 1) // 2):
+            arm = _arm(p, 0.0, b1, both, case, free, rev)
+            for j in range(2):
+                pb = 2 * b1 + j
+                if pb >= nb:
+                    break
+                m = arm[0] if j == 0 else arm[1]
+                if _missing(m[0], m[1], m[2], m[3]):
+                    for i in range(6):
+                        out[2 * pb, i] = math.nan
+                        out[2 * pb + 1, i] = math.nan
+                    continue
+                v, be, s = _wrist_first(p, m)
+                _wrist_joints(p, m, v, be, s, 0, out[2 * pb])
+                _wrist_joints(p, m, v, be, s, 1, out[2 * pb + 1])
+        for r in range(2 * nb, out.shape[0]):
+            for i in range(6):
+                out[r, i] = math.nan
+
+    def singular(params, thr, out, low, start, stop):
+        """``out[i]`` for poses ``start .. stop - 1``: some exact position branch of the wrist family leaves
+        pose i with a singular wrist; ``low[i]``: the amplitude of a step of the position case is below its
+        threshold ``thr[k]`` (``k = 0, 1, 2`` as ``amplitude`` numbers them: a joint left free there)."""
+        h3, h5 = _h(params[0], 3), _h(params[0], 5)
+        for i in range(start, stop):
+            p = params[i]
+            out[i] = False
+            low[i] = False
+            nb = int(p[_POS_BRANCHES])
+            both = BOTH + 0 * nb  # (a run-time value: see position.place)
+            for b1 in range((nb + 1) // 2):
+                # the two branches of a first step share its work (as in ``wrists``, the same values)
+                arm = _arm(p, 0.0, b1, both, case, free, rev)
+                if arm[4] < thr[0] or arm[5] < thr[1 + b1]:
+                    low[i] = True
+                for j in range(2):
+                    if 2 * b1 + j >= nb:
+                        break
+                    if (arm[6] if j == 0 else arm[7]) < thr[3]:
+                        low[i] = True
+                    m0, m1, m2, m3 = arm[0] if j == 0 else arm[1]
+                    if _missing(m0, m1, m2, m3) or not (in_domain(arm[2]) and in_domain(arm[3])):
+                        continue
+                    v = _back(p, m0, m1, m2, m3, _mat(p, h5))
+                    if norm(cross(v, h3)) < WRIST_SINGULAR:
+                        out[i] = True
+
+    return wrist, wrists, singular
+
+
 def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernels:
     """The pair and wrist families' kernels for position case ``case`` (its index in ``position.CASES``; -1: none),
     theta* the joint ``free`` (0-3) of the solved chain's first four, whose types are ``revolute`` (4 booleans).
@@ -747,175 +931,12 @@ def case_kernels(case: int, free: int, revolute: tuple[bool, ...]) -> CaseKernel
     key = (case, free, rev)
     ck = _CASE_KERNELS.get(key)
     if ck is None:
-        # (the kernels' bodies are here, not in functions they call with the case: Numba re-optimises all that
-        # a compiled function calls, and a level more costs ~0.3 s per kernel on a fresh install)
-
-        def residual(p, x, branch):
-            arm = _arm(p, x, branch // 2, branch % 2, case, free, rev)
-            m = arm[0] if branch % 2 == 0 else arm[1]
-            return _orientation(p, m, arm[2], arm[3])
-
-        def residuals(p, x, out):
-            """Every branch's ``residual`` at once (``Reduction.kernel_residuals``): the two branches of each first
-            step share its work, and a first step whose branches the search skips (twins, ``LAYOUT['need']``) is
-            not computed (its entries are left as they are)."""
-            nb = int(p[_POS_BRANCHES])
-            need = int(p[_NEED])
-            both = BOTH + 0 * nb  # (a run-time value: see position.place)
-            if nb == 4 and need & 3 == 3:
-                # the usual case written out: both first-step branches in one stretch of code, so that the compiler
-                # shares their common work (theta*'s motion, the reduced chain) and interleaves the rest
-                a0 = _arm(p, x, 0 * nb, both, case, free, rev)
-                a1 = _arm(p, x, 1 + 0 * nb, both, case, free, rev)
-                r0, r1 = _orientations(p, a0[0], a0[1], a0[2], a0[3])
-                r2, r3 = _orientations(p, a1[0], a1[1], a1[2], a1[3])
-                out[0], out[1], out[2], out[3] = r0, r1, r2, r3
-                return
-            for b1 in range((nb + 1) // 2):
-                if need & (1 << b1):
-                    arm = _arm(p, x, b1, both, case, free, rev)
-                    out[2 * b1] = _orientation(p, arm[0], arm[2], arm[3])
-                    if 2 * b1 + 1 < nb:
-                        out[2 * b1 + 1] = _orientation(p, arm[1], arm[2], arm[3])
-
-        def every(p, x, out):
-            """``residuals`` of the four branches and ``margins`` of the three steps at once, into ``out[:4]`` and
-            ``out[4:7]``, bit for bit theirs (the margins' cosines are those the residuals' first four joints come
-            from): the engine's uniform samples (``fastsweep.EdgeSearch.every``) for a plan that searches both
-            first-step branches (``LAYOUT['need']`` 3)."""
-            nb = int(p[_POS_BRANCHES])
-            both = BOTH + 0 * nb  # (a run-time value: see position.place)
-            a0 = _arm(p, x, 0 * nb, both, case, free, rev)
-            a1 = _arm(p, x, 1 + 0 * nb, both, case, free, rev)
-            r0, r1 = _orientations(p, a0[0], a0[1], a0[2], a0[3])
-            r2, r3 = _orientations(p, a1[0], a1[1], a1[2], a1[3])
-            out[0], out[1], out[2], out[3] = r0, r1, r2, r3
-            out[4] = 1.0 - a0[2] * a0[2]
-            out[5] = 1.0 - a0[3] * a0[3]
-            out[6] = 1.0 - a1[3] * a1[3]
-
-        def configuration(p, x, branch, out):
-            arm = _arm(p, x, branch // 2, branch % 2, case, free, rev)
-            m0, m1, m2, m3 = arm[0] if branch % 2 == 0 else arm[1]
-            if _missing(m0, m1, m2, m3):
-                for i in range(6):
-                    out[i] = math.nan
-                return
-            q4, q5 = _last_two(p, m0, m1, m2, m3, _h(p, 4), _h(p, 5))
-            _write(p, out, m0, m1, m2, m3, q4, q5)
-
-        def margin(p, x, k):
-            """``1 - c^2`` of step k's cosine c: positive inside the branch domains, zero at their edges (found by
-            the same sweep, and sampled as hints)."""
-            if k == 0:  # (the first step's cosine alone: the compiler drops the second step)
-                arm = _arm(p, x, 0 * k, NEITHER + 0 * k, case, free, rev)
-                return 1.0 - arm[2] * arm[2]
-            arm = _arm(p, x, k - 1, NEITHER + 0 * k, case, free, rev)
-            return 1.0 - arm[3] * arm[3]
-
-        def margins(p, x, out):
-            """``margin`` of steps 0 and 1 (one first-step branch) and of step 2 (the other) at once, as they are
-            wanted (``LAYOUT['need_margin']``: bit k for step k)."""
-            need = int(p[_NEED_MARGIN])
-            neither = NEITHER + 0 * need
-            if need & 3:
-                arm = _arm(p, x, 0 * need, neither, case, free, rev)
-                out[0] = 1.0 - arm[2] * arm[2]
-                out[1] = 1.0 - arm[3] * arm[3]
-            if need & 4:
-                arm = _arm(p, x, 1 + 0 * need, neither, case, free, rev)
-                out[2] = 1.0 - arm[3] * arm[3]
-
-        def amplitude(p, x, k):
-            """Amplitude of step k (see ``margin``); for k >= 3 the final step's gap on position branch k - 3
-            (``_final_gap``)."""
-            if k >= 3:
-                pb = k - 3
-                arm = _arm(p, x, pb // 2, pb % 2, case, free, rev)
-                return arm[6] if pb % 2 == 0 else arm[7]
-            if k == 0:  # (the first step alone, as ``margin``)
-                arm = _arm(p, x, 0 * k, NEITHER + 0 * k, case, free, rev)
-                return arm[4]
-            arm = _arm(p, x, k - 1, NEITHER + 0 * k, case, free, rev)
-            return arm[5]
-
-        def amplitudes(p, x, out):
-            """``amplitude`` of the steps wanted (``LAYOUT['need_amplitude']``: bit k for step k) at once."""
-            need = int(p[_NEED_AMPLITUDE])
-            neither = NEITHER + 0 * need
-            if need & 3:
-                arm = _arm(p, x, 0 * need, neither, case, free, rev)
-                out[0] = arm[4]
-                out[1] = arm[5]
-            if need & 4:
-                arm = _arm(p, x, 1 + 0 * need, neither, case, free, rev)
-                out[2] = arm[5]
-
-        def wrist(p, x, branch, out):
-            nb = int(p[_POS_BRANCHES])
-            pb = branch // 2  # the position branch
-            arm = _arm(p, 0.0, pb // 2, pb % 2, case, free, rev)
-            m = arm[0] if pb % 2 == 0 else arm[1]
-            if _missing(m[0], m[1], m[2], m[3]) or branch >= 2 * nb:
-                for i in range(6):
-                    out[i] = math.nan
-                return
-            v, be, s = _wrist_first(p, m)
-            _wrist_joints(p, m, v, be, s, branch % 2, out)
-
-        def wrists(p, x, out):
-            """Every branch's ``wrist`` configuration at once, ``out (n_branches, 6)`` (``Reduction.
-            kernel_configurations``): the two branches of a first position step share its work (``_arm`` with
-            ``BOTH``), the two wrist branches of a position branch share their ``sp2``."""
-            nb = int(p[_POS_BRANCHES])
-            both = BOTH + 0 * nb  # (a run-time value: see position.place)
-            for b1 in range((nb + 1) // 2):
-                arm = _arm(p, 0.0, b1, both, case, free, rev)
-                for j in range(2):
-                    pb = 2 * b1 + j
-                    if pb >= nb:
-                        break
-                    m = arm[0] if j == 0 else arm[1]
-                    if _missing(m[0], m[1], m[2], m[3]):
-                        for i in range(6):
-                            out[2 * pb, i] = math.nan
-                            out[2 * pb + 1, i] = math.nan
-                        continue
-                    v, be, s = _wrist_first(p, m)
-                    _wrist_joints(p, m, v, be, s, 0, out[2 * pb])
-                    _wrist_joints(p, m, v, be, s, 1, out[2 * pb + 1])
-            for r in range(2 * nb, out.shape[0]):
-                for i in range(6):
-                    out[r, i] = math.nan
-
-        def singular(params, thr, out, low, start, stop):
-            """``out[i]`` for poses ``start .. stop - 1``: some exact position branch of the wrist family leaves
-            pose i with a singular wrist; ``low[i]``: the amplitude of a step of the position case is below its
-            threshold ``thr[k]`` (``k = 0, 1, 2`` as ``amplitude`` numbers them: a joint left free there)."""
-            h3, h5 = _h(params[0], 3), _h(params[0], 5)
-            for i in range(start, stop):
-                p = params[i]
-                out[i] = False
-                low[i] = False
-                nb = int(p[_POS_BRANCHES])
-                both = BOTH + 0 * nb  # (a run-time value: see position.place)
-                for b1 in range((nb + 1) // 2):
-                    # the two branches of a first step share its work (as in ``wrists``, the same values)
-                    arm = _arm(p, 0.0, b1, both, case, free, rev)
-                    if arm[4] < thr[0] or arm[5] < thr[1 + b1]:
-                        low[i] = True
-                    for j in range(2):
-                        if 2 * b1 + j >= nb:
-                            break
-                        if (arm[6] if j == 0 else arm[7]) < thr[3]:
-                            low[i] = True
-                        m0, m1, m2, m3 = arm[0] if j == 0 else arm[1]
-                        if _missing(m0, m1, m2, m3) or not (in_domain(arm[2]) and in_domain(arm[3])):
-                            continue
-                        v = _back(p, m0, m1, m2, m3, _mat(p, h5))
-                        if norm(cross(v, h3)) < WRIST_SINGULAR:
-                            out[i] = True
-
+        # (the kernels are closures over the case, each written out in full, not calling functions with the case:
+        # Numba re-optimises all that a compiled function calls, and a level more costs ~0.3 s per kernel on a fresh
+        # install)
+        residual, residuals, every = _residual_kernels(case, free, rev)
+        configuration, margin, margins, amplitude, amplitudes = _step_kernels(case, free, rev)
+        wrist, wrists, singular = _wrist_kernels(case, free, rev)
         ck = _CASE_KERNELS[key] = CaseKernels(
             LazyKernel(residual, RESIDUAL_SIG, cache=True),
             LazyKernel(residuals, RESIDUALS_SIG, cache=True),
