@@ -20,8 +20,7 @@ import numba
 import numpy as np
 
 import sweepik
-from sweepik import solving
-from sweepik.engine import search
+from sweepik.engine import chunk, search
 from sweepik.experiments.bench import grid_configurations
 
 
@@ -47,8 +46,8 @@ def main() -> None:
         robot = sweepik.load_robot(name)
         red = sweepik.reductions.get_reduction(robot, None)
         rng = np.random.default_rng(0)
-        chain = solving._chain_poses(robot, robot.fk(rng.uniform(robot.lower, robot.upper, size=(2000, 6))))
-        lo, hi = solving._theta_range(robot, red, chain)
+        chain = chunk.chain_poses(robot, robot.fk(rng.uniform(robot.lower, robot.upper, size=(2000, 6))))
+        lo, hi = chunk.theta_range(robot, red, chain)
         search.search(red, chain[:10], lo[:10], hi[:10], 64)  # compile or load the kernels
         t = best(lambda: search.search(red, chain, lo, hi, 64), 5)  # noqa: B023 (called right here)
         print(f"  {name}: compiled search {t / len(chain) * 1e6:.1f} us/pose (one thread, {red.name})")

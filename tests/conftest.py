@@ -140,3 +140,16 @@ def random_dh_robot(
         T_flange_tool=random_pose(rng) if tool else np.eye(4),
         length_unit="m",
     )
+
+
+def carm_stress_configurations(n: int, seed: int) -> NDArray[np.float64]:
+    """``(n, 6)`` in-limit C-Arm configurations, with stress subsets: theta5 near 0, theta2 near +-90 deg (1e-4 off),
+    d1 at a rail end."""
+    carm = load_robot("carm")
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(carm.lower, carm.upper, (n, 6))
+    k = n // 5
+    q[:k, 4] = rng.normal(0.0, 1e-3, k)
+    q[k : 2 * k, 1] = np.pi / 2 * rng.choice([-1, 1], k) + rng.normal(0.0, 1e-4, k)
+    q[2 * k : 3 * k, 0] = rng.choice([0.0, 2000.0], k)
+    return q

@@ -42,6 +42,34 @@ def test_import_leaves_the_tools_a_solve_does_not_need_unloaded() -> None:
     assert sweepik.solve_dask.__module__ == "sweepik.distributed"  # and they load on first use
 
 
+def test_dir_is_all_and_dunders() -> None:
+    """``dir(sweepik)`` lists the public names and the module's dunders, nothing of the engine (its subpackages are
+    imported by name: ``sweepik.engine``, ``sweepik.reductions``, ...), and every error lives in ``sweepik.errors``."""
+    extra = [n for n in dir(sweepik) if n not in sweepik.__all__ and not (n.startswith("__") and n.endswith("__"))]
+    assert extra == []
+    assert set(sweepik.__all__) <= set(dir(sweepik))
+    errors = importlib.import_module("sweepik.errors")
+    for name in sweepik.__all__:
+        obj = getattr(sweepik, name)
+        if isinstance(obj, type) and issubclass(obj, Exception):
+            assert issubclass(obj, sweepik.SweepikError) and obj.__module__ == "sweepik.errors", name
+            assert name in errors.__all__
+
+
+@pytest.mark.parametrize(
+    ("name", "home"),
+    [("CArmD1", "sweepik.reductions"), ("get_reduction", "sweepik.reductions"), ("STRATEGIES", "sweepik.solving")],
+)
+def test_engine_names_once_public_still_work_with_a_warning(name: str, home: str) -> None:
+    """Names ``sweepik`` exported before its packages were layered are served from their package, with a
+    DeprecationWarning that says where; an unknown name is an AttributeError."""
+    with pytest.warns(DeprecationWarning, match=home):
+        obj = getattr(sweepik, name)
+    assert obj is getattr(importlib.import_module(home), name)
+    with pytest.raises(AttributeError):
+        sweepik.no_such_name  # noqa: B018
+
+
 def test_version_matches_metadata() -> None:
     assert sweepik.__version__ == version("sweepik")
 

@@ -18,6 +18,7 @@ import pytest
 import sweepik
 from sweepik import solving
 from sweepik.cli.app import main
+from sweepik.engine import chunk
 from sweepik.io.robot_file import MAX_ANGLE_DEG, MAX_LENGTH, MAX_LIMIT, MAX_ROBOT_FILE_BYTES
 from sweepik.trajectory import MAX_NPY_POSES, MAX_POSE_TEXT_BYTES, load_poses
 
@@ -659,13 +660,13 @@ def test_accepted_numpy_scalars_and_object_arrays() -> None:
 def test_large_n_samples_runs_in_small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     """Memory stays bounded by construction: chunk x n_samples <= SAMPLE_BUDGET, whatever chunk_size says."""
     sizes: list[int] = []
-    real = solving._solve_chunk
+    real = chunk.solve_chunk
 
     def spy(robot: sweepik.Robot, red: Any, poses: np.ndarray, *args: Any, **kwargs: Any) -> Any:
         sizes.append(poses.shape[0])
         return real(robot, red, poses, *args, **kwargs)
 
-    monkeypatch.setattr(solving, "_solve_chunk", spy)
+    monkeypatch.setattr(solving, "solve_chunk", spy)
     P = np.repeat(GOOD_POSE[None], 5, axis=0)
     n = solving.SAMPLE_BUDGET // 2
     assert n <= solving.MAX_SAMPLES

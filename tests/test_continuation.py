@@ -14,12 +14,13 @@ import numpy as np
 import pytest
 
 from sweepik import SweepikError, load_robot, solve, solve_many
+from sweepik.engine.chunk import chain_poses as _chain_poses
+from sweepik.engine.settings import ACCEPT_TOL_REL
 from sweepik.io.robot_file import robot_from_dict
 from sweepik.model.pose import pose_error_geodesic
 from sweepik.model.units import orientation_weight
 from sweepik.reductions import get_reduction
 from sweepik.results import joint_distance
-from sweepik.solving import ACCEPT_TOL_REL, _chain_poses
 
 CARM = load_robot("carm")
 #: "the same configuration": every joint within this (mm, radians modulo 2 pi)

@@ -103,8 +103,7 @@ def test_one_pass_settling_equals_the_solver_steps(
     snap onto a limit left to the solver's steps, the others settled at once, in parts on the batch threads) gives
     bit for bit what the steps alone give: batches with singular wrists, solutions at a joint limit, random poses,
     with and without limits."""
-    from sweepik import solving
-    from sweepik.engine import parallel
+    from sweepik.engine import chunk, parallel
 
     monkeypatch.setattr(parallel, "threads", lambda: 3)  # parts on threads, whatever the machine's cores
     monkeypatch.setattr(dedupe, "_PARALLEL_ROWS", 64)
@@ -126,11 +125,11 @@ def test_one_pass_settling_equals_the_solver_steps(
         settled.append(0 if out is None else out[1].size)
         return out
 
-    monkeypatch.setattr(solving, "settle", counting)
+    monkeypatch.setattr(chunk, "settle", counting)
     got = [sweepik.solve_many(robot, poses, reduction=reduction, limits=lim) for lim in (True, False)]
     assert sum(due) > 0, "no pose was due the solver's steps: the mixed case is not exercised"
     assert sum(settled) > 0, "no candidate was settled in one pass"
-    monkeypatch.setattr(solving, "settle", lambda *args, **kwargs: None)
+    monkeypatch.setattr(chunk, "settle", lambda *args, **kwargs: None)
     ref = [sweepik.solve_many(robot, poses, reduction=reduction, limits=lim) for lim in (True, False)]
     for a, b in zip(got, ref, strict=True):
         for column in ("offsets", "q", "error", "error_geodesic", "within_limits", "multiplicity", "n_reachable"):

@@ -10,7 +10,6 @@ from hypothesis import strategies as st
 from numpy.typing import NDArray
 
 from sweepik import Joint, Robot, load_robot
-from sweepik.engine import certify
 
 L1, L2 = 350.0, 402.0  # the paper's C-Arm link lengths (Table 1), mm
 
@@ -242,28 +241,3 @@ def test_prismatic_jacobian_column_is_the_axis(carm: Robot, rng: np.random.Gener
     # The C-Arm's rail moves the tool along base z and does not rotate it.
     J = carm.jacobian(random_configs(carm, rng, 10, spread=3.0))
     np.testing.assert_allclose(J[:, :, 0], np.broadcast_to([0, 0, 1, 0, 0, 0], (10, 6)), atol=1e-15)
-
-
-@pytest.mark.skipif(not certify.AVAILABLE, reason="numba not installed")
-@given(seed=st.integers(0, 2**32 - 1), convention=st.sampled_from(["modified", "standard"]))
-def test_compiled_pose_and_jacobian_match_the_numpy_ones(seed: int, convention: str) -> None:
-    """``fastcertify.pose_and_jacobian`` and ``tool_poses`` (the polish's compiled FK, Jacobian and errors) equal
-    ``Robot.fk``, ``Robot.jacobian`` and ``pose_error_geodesic`` to rounding on random arms (mixed joint types,
-    1-7 joints, base and tool transforms)."""
-    from sweepik.model.pose import pose_error_geodesic
-
-    rng = np.random.default_rng(seed)
-    robot = random_dh_robot(rng, convention)
-    q = random_configs(robot, rng, 8, spread=3.0)
-    T, J = certify.pose_and_jacobian(robot, q)
-    scale = max(1.0, robot.length_scale)
-    np.testing.assert_allclose(T, robot.fk(q), rtol=0, atol=1e-12 * scale)
-    np.testing.assert_allclose(J, robot.jacobian(q), rtol=0, atol=1e-12 * scale)
-    target = robot.fk(q + rng.normal(0.0, 1e-2, q.shape))
-    T2, err = certify.tool_poses(robot, q, target, 0.5)
-    np.testing.assert_array_equal(T2, T)
-    np.testing.assert_allclose(err, pose_error_geodesic(robot.fk(q), target, 0.5), rtol=1e-9, atol=1e-14 * scale)
-    # read-only inputs (e.g. a memory-mapped file's) are taken too, with the same results
-    q.flags.writeable = target.flags.writeable = False
-    np.testing.assert_array_equal(certify.pose_and_jacobian(robot, q)[1], J)
-    np.testing.assert_array_equal(certify.tool_poses(robot, q, target, 0.5)[1], err)

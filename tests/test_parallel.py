@@ -8,7 +8,7 @@ import threading
 import numpy as np
 import pytest
 
-from sweepik.engine import parallel, search
+from sweepik.engine import chunk, parallel, search
 
 
 def _record(out, seen, start, stop):
@@ -128,13 +128,13 @@ def test_a_generic_sweeps_small_batch_is_split_in_two(name: str, split: bool, mo
     n = 3 * solving.SPLIT_MIN + 1
     T = robot.fk(np.random.default_rng(3).uniform(robot.lower, robot.upper, (n, 6)))
     seen: list[tuple[int, int]] = []
-    real = solving._solve_chunk
+    real = chunk.solve_chunk
 
-    def chunk(r: object, red: object, P: np.ndarray, *a: object) -> object:
+    def spy(r: object, red: object, P: np.ndarray, *a: object) -> object:
         seen.append((len(P), parallel.threads()))
         return real(r, red, P, *a)
 
-    monkeypatch.setattr(solving, "_solve_chunk", chunk)
+    monkeypatch.setattr(solving, "solve_chunk", spy)
     before = numba.get_num_threads()
     try:
         numba.set_num_threads(1)

@@ -13,9 +13,9 @@ import sweepik
 from sweepik.engine.continuation import scaled_singular
 from sweepik.engine.partners import close_partners, valley_bottoms
 from sweepik.engine.polish import geodesic_errors, polished
+from sweepik.engine.settings import ACCEPT_TOL_REL
 from sweepik.model.units import orientation_weight
 from sweepik.results import joint_distance
-from sweepik.solving import ACCEPT_TOL_REL
 
 #: A CRX-10iA configuration 1e-5 off its singular set whose pose has a second solution 2e-5 rad away (1.5e-8 rad
 #: apart in the sweep's joint 1, 6e-8 rad from the edge of its branch's domain); only that one came back.

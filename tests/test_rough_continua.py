@@ -12,9 +12,11 @@ import pytest
 from singular import families_certified, recovered
 
 import sweepik
+from sweepik.engine.chunk import chain_poses as _chain_poses
+from sweepik.engine.chunk import theta_range as _theta_range
 from sweepik.engine.rough_continua import rough_continua
+from sweepik.engine.settings import ACCEPT_TOL_REL, POLISH_BELOW_REL
 from sweepik.reductions import get_reduction
-from sweepik.solving import ACCEPT_TOL_REL, POLISH_BELOW_REL, _chain_poses, _theta_range
 
 #: The issue's two UR5 configurations (the second in the limits, solved with them on)
 ISSUE = [

@@ -122,11 +122,11 @@ def _checked_options(
 ) -> dict[str, Any]:
     """The solver options, checked as ``solve_many`` checks them (before any cluster starts), normalised to plain
     Python values (the store keeps them as JSON)."""
-    from sweepik.solving import _held, _prepare
+    from sweepik.solving import held_joints, prepare
 
-    held = _held(robot, locked)
+    held = held_joints(robot, locked)
     arm = robot if held is None else held.arm
-    _, strategy, limits, n_samples, _ = _prepare(
+    _, strategy, limits, n_samples, _ = prepare(
         arm, np.zeros((0, 4, 4)), reduction, strategy, limits, n_samples, 1, free_joint, held
     )
     if stored and isinstance(reduction, Reduction):

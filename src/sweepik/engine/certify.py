@@ -20,6 +20,7 @@ from sweepik.engine import parallel
 from sweepik.engine.dedupe import limit_args
 from sweepik.engine.search import AVAILABLE, PARALLEL_MIN, writable
 from sweepik.engine.settings import PINV_WIDEN
+from sweepik.model import kinematics
 from sweepik.model.pose import GIMBAL_TOL
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.kernels import address_of, lazy_njit, owned_kernel
@@ -689,6 +690,16 @@ def tool_poses(robot, q: Array, target: Array | None = None, weight: float = 1.0
         err,
     )
     return out, err
+
+
+def flange_poses(robot, q: Array) -> Array:
+    """World poses of the last link frame ``(K, 4, 4)`` for configurations ``q (K, n)``: the tool poses
+    (:func:`tool_poses`) with the tool transform taken off; without Numba,
+    :func:`sweepik.model.kinematics.chain_frames`."""
+    if not AVAILABLE:
+        return kinematics.chain_frames(robot, q)[..., -1, :, :]
+    T, _ = tool_poses(robot, q)
+    return T if robot.tool_is_identity else T @ robot.T_tool_flange
 
 
 def pose_errors(robot, q: Array, target: Array, weight: float) -> tuple[Array, Array]:

@@ -71,7 +71,7 @@ def _solve_chain(robot: Robot, q: Array, chain: Array, tol: float) -> NDArray[np
     """``q (..., n)`` are finite and solve the chain poses ``chain`` (broadcast against ``(..., 4, 4)``) within
     ``tol`` (geodesic error of the flange frame; NumPy)."""
     qz = np.nan_to_num(q)
-    flange = search.flange_poses(robot, qz.reshape(-1, qz.shape[-1])).reshape(*qz.shape[:-1], 4, 4)
+    flange = certify.flange_poses(robot, qz.reshape(-1, qz.shape[-1])).reshape(*qz.shape[:-1], 4, 4)
     err = pose_error_geodesic(robot.T_base_world @ flange, chain, orientation_weight(robot.length_unit))
     return np.asarray(np.all(np.isfinite(q), axis=-1) & (err <= tol))
 

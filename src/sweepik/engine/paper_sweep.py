@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.engine import search
+from sweepik.engine import certify
 from sweepik.model.pose import pose_error_paper
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit, orientation_weight
@@ -31,7 +31,7 @@ def _best_error(robot: Robot, red: Reduction, chain: Array, theta: Array, limits
     q = red.solve_rest(chain, theta)  # (N, M, B, n)
     ok = np.all(np.isfinite(q), axis=-1)
     qz = np.where(ok[..., None], q, 0.0)
-    flange = search.flange_poses(robot, qz.reshape(-1, qz.shape[-1])).reshape(*qz.shape[:-1], 4, 4)
+    flange = certify.flange_poses(robot, qz.reshape(-1, qz.shape[-1])).reshape(*qz.shape[:-1], 4, 4)
     T = np.linalg.inv(robot.T_world_base) @ flange  # chain frame, like the target
     J = pose_error_paper(T, chain[:, None, None], orientation_weight(robot.length_unit))
     if limits:

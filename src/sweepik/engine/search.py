@@ -32,7 +32,6 @@ from sweepik._jit import ERROR_MODEL, alive, inlined, internal, unowned
 from sweepik.engine import parallel
 from sweepik.engine import sweep as _ref
 from sweepik.errors import UnknownOptionError
-from sweepik.model.robot import Robot
 from sweepik.reductions.base import overridden_below_kernel
 from sweepik.reductions.kernels import address_of, lazy_njit, owned_kernel
 from sweepik.subproblems.trig import wrap_pi
@@ -1438,64 +1437,3 @@ def _gathered(out: _Out, over: NDArray[np.bool_]) -> tuple[_ref.Candidates, _ref
         fam = out.fam
         spans = _ref.Spans(fp.astype(np.intp), fam[fp, fs, 2].astype(np.intp), fam[fp, fs, 0], fam[fp, fs, 1])
     return cand, spans
-
-
-if AVAILABLE:
-
-    @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
-    def _fk(a, alpha, d, theta, rev, base, q, out, start, stop):
-        """Flange poses ``out[k]`` of configurations ``q[k]``, k = ``start .. stop - 1``, of a modified-DH chain
-        (world frame, tool not applied). Element by element: slice assignments compile their shape checks and
-        error messages (seconds on a fresh install)."""
-        n = a.shape[0]
-        T = np.empty((4, 4))
-        R = np.empty((3, 4))
-        for k in range(start, stop):
-            for r in range(4):
-                for c in range(4):
-                    T[r, c] = base[r, c]
-            for i in range(n):
-                th = theta[i] + (q[k, i] if rev[i] else 0.0)
-                di = d[i] + (0.0 if rev[i] else q[k, i])
-                ct, st = math.cos(th), math.sin(th)
-                ca, sa = math.cos(alpha[i]), math.sin(alpha[i])
-                # link = [[ct, -st, 0, a], [st ca, ct ca, -sa, -sa d], [st sa, ct sa, ca, ca d], [0, 0, 0, 1]]
-                l00, l01, l02, l03 = ct, -st, 0.0, a[i]
-                l10, l11, l12, l13 = st * ca, ct * ca, -sa, -sa * di
-                l20, l21, l22, l23 = st * sa, ct * sa, ca, ca * di
-                for r in range(3):
-                    t0, t1, t2 = T[r, 0], T[r, 1], T[r, 2]
-                    R[r, 0] = t0 * l00 + t1 * l10 + t2 * l20
-                    R[r, 1] = t0 * l01 + t1 * l11 + t2 * l21
-                    R[r, 2] = t0 * l02 + t1 * l12 + t2 * l22
-                    R[r, 3] = t0 * l03 + t1 * l13 + t2 * l23 + T[r, 3]
-                for r in range(3):
-                    for c in range(4):
-                        T[r, c] = R[r, c]
-            for r in range(4):
-                for c in range(4):
-                    out[k, r, c] = T[r, c]
-
-
-def flange_poses(robot: Robot, q: Array) -> Array:
-    """World poses of the last link frame ``(K, 4, 4)`` for configurations ``q (K, n)``: compiled for
-    modified-DH robots when Numba is available, else :func:`sweepik.model.kinematics.chain_frames`."""
-    from sweepik.model import kinematics
-
-    if not AVAILABLE or robot.dh_convention != "modified" or q.ndim != 2:
-        return kinematics.chain_frames(robot, q)[..., -1, :, :]
-    out = np.empty((q.shape[0], 4, 4))
-    parallel.run(
-        _fk,
-        q.shape[0],
-        PARALLEL_MIN * 16,
-        robot.dh_a,
-        robot.dh_alpha,
-        robot.dh_d,
-        robot.dh_theta,
-        robot.is_revolute,
-        np.ascontiguousarray(robot.T_world_base),
-        np.ascontiguousarray(q, dtype=np.float64),
-        out,
-    )
-    return out

@@ -207,13 +207,13 @@ class _FamilyBuilder:
     def candidates(self) -> list[Reduction]:
         if self._candidates is None:
             from sweepik.reductions import get_reduction
-            from sweepik.solving import _held, _prepare
+            from sweepik.solving import held_joints, prepare
 
             o = self.options
-            self.held = _held(self.robot, o["locked"])
+            self.held = held_joints(self.robot, o["locked"])
             arm = self.robot if self.held is None else self.held.arm
             empty = np.zeros((0, 4, 4))
-            red = _prepare(
+            red = prepare(
                 arm, empty, o["reduction"], o["strategy"], o["limits"], o["n_samples"], 1, o["free_joint"], self.held
             )[0]
             self._candidates = [red]

@@ -12,7 +12,7 @@ import pytest
 
 import sweepik
 from sweepik import load_robot, solving
-from sweepik.engine import one_pose, search
+from sweepik.engine import chunk, one_pose, search, settle
 
 pytestmark = pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 
@@ -45,7 +45,8 @@ def _assert_same(a: sweepik.Solutions, b: sweepik.Solutions) -> None:
 
 def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, poses: np.ndarray, **kw: Any) -> list[Any]:
     with monkeypatch.context() as m:
-        m.setattr(solving, "_settled", lambda *args: None)
+        m.setattr(solving, "settled", lambda *args: None)
+        m.setattr(chunk, "settled", lambda *args: None)
         return [sweepik.solve(robot, T, **kw) for T in poses]
 
 
@@ -143,8 +144,10 @@ def test_a_class_overriding_the_singular_checks_keeps_them(monkeypatch: pytest.M
     poses = _poses(robot, 14)[24:30]  # (random ones: the kernel would flag none)
     seen = _counted(monkeypatch)
     settled: list[object] = []
-    real = solving._settled
-    monkeypatch.setattr(solving, "_settled", lambda *args: settled.append(real(*args)) or settled[-1])
+    real = chunk.settled
+    spy = lambda *args: settled.append(real(*args)) or settled[-1]  # noqa: E731
+    monkeypatch.setattr(solving, "settled", spy)
+    monkeypatch.setattr(chunk, "settled", spy)
     for T in poses:
         assert len(sweepik.solve(robot, T, reduction=own)) > 0
     assert seen[one_pose.OK] == len(poses) and asked and settled == [None] * len(poses)
@@ -162,7 +165,7 @@ def test_the_default_reduction_named_takes_the_one_call(
     robot = load_robot(name)
     poses = _poses(robot, 15)[20:26]
     want = [sweepik.solve(robot, T) for T in poses]
-    monkeypatch.setattr(solving, "_prepare", lambda *args: pytest.fail("options checked again"))
+    monkeypatch.setattr(solving, "prepare", lambda *args: pytest.fail("options checked again"))
     for r in names:
         assert is_default(robot, r)
         for a, b in zip([sweepik.solve(robot, T, reduction=r) for T in poses], want, strict=True):
@@ -210,8 +213,8 @@ def test_a_pose_due_a_polish_goes_the_general_way(monkeypatch: pytest.MonkeyPatc
     sends its pose the general way, which polishes it."""
     robot = load_robot("carm")
     poses = _poses(robot, 7)[20:26]
-    monkeypatch.setattr(solving, "POLISH_ABOVE_REL", 0.0)
-    monkeypatch.setattr(solving, "POLISH_PAPER_ABOVE_REL", 0.0)
+    monkeypatch.setattr(settle, "POLISH_ABOVE_REL", 0.0)
+    monkeypatch.setattr(settle, "POLISH_PAPER_ABOVE_REL", 0.0)
     assert _both_ways(monkeypatch, robot, poses) == {one_pose.DUE: len(poses)}
     assert all(len(sweepik.solve(robot, T)) > 0 for T in poses)
 

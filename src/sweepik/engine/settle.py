@@ -1,0 +1,231 @@
+"""Settling a chunk's candidates step by step: the precise strategy's thresholds, the errors of configurations, the
+snap of solutions just outside a limit onto it, the meeting branches of a closed form merged, close partners next
+to folds (``partners``) added. The one compiled pass that does most of it is ``dedupe.settle``."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sweepik.engine import certify
+from sweepik.engine.dedupe import duplicate_tolerance, finish, merged_multiplicity, near_pairs, wrap_inside
+from sweepik.engine.families import (
+    MAX_ISOLATED_SOLUTIONS,
+)
+from sweepik.engine.partners import close_partners, nearly_singular, valley_bottoms
+from sweepik.engine.polish import polish
+from sweepik.engine.settings import (
+    ACCEPT_TOL_REL,
+    MEET_NEAR,
+    MEET_REL,
+    MEET_ROUNDING_REL,
+    MEET_STAY,
+    POLISH_ABOVE_REL,
+    POLISH_BELOW_REL,
+    POLISH_PAPER_ABOVE_REL,
+    SNAP_ITERATIONS,
+    SNAP_REACH,
+)
+from sweepik.model.pose import pose_error_geodesic, pose_error_paper
+from sweepik.model.robot import Robot
+from sweepik.model.units import orientation_weight
+from sweepik.results import joint_distance
+
+Array = NDArray[np.float64]
+
+
+def settle_bounds(robot: Robot) -> tuple[float, float, float, float]:
+    """The precise strategy's thresholds, absolute (times the arm's length scale): polish below, polish above, polish
+    above on the paper's J, acceptance (``POLISH_BELOW_REL`` ... ``ACCEPT_TOL_REL``); the stepwise path and
+    ``dedupe.settle`` take the same values."""
+    ls = robot.length_scale
+    return POLISH_BELOW_REL * ls, POLISH_ABOVE_REL * ls, POLISH_PAPER_ABOVE_REL * ls, ACCEPT_TOL_REL * ls
+
+
+@lru_cache(maxsize=64)
+def per_joint(robot: Robot, value: float) -> Array:
+    """``value`` per joint: as it is for a revolute one (radians), times the length scale for a prismatic one. Cached
+    (robots are values; the solver asks for the same ones on every chunk; the compiled kernels take it, writable, and
+    do not write it)."""
+    return np.where(robot.is_revolute, value, value * robot.length_scale)
+
+
+def snap_reach(robot: Robot) -> Array:
+    """``SNAP_REACH`` per joint."""
+    return per_joint(robot, SNAP_REACH)
+
+
+def snap_to_limits(
+    robot: Robot, q: Array, err_geo: Array, err_paper: Array, poses: Array, pose_idx: NDArray[np.intp], weight: float
+) -> tuple[Array, NDArray[np.bool_]]:
+    """In place: certified configurations ``q (K, n)`` of poses ``poses[pose_idx]`` just outside the limits are
+    clamped to them and polished with the clamped joints held; where that still certifies, it replaces them (with
+    their errors). Returns ``wrap_inside(robot, q)`` of the result (what the deduplication starts from)."""
+    w_all, inside = wrap_inside(robot, q)
+    out = np.nonzero(~inside)[0]
+    if out.size == 0:
+        return w_all, inside
+    w = w_all[out]
+    over = np.maximum(robot.lower - robot.limit_tol - w, w - robot.upper - robot.limit_tol)
+    near = np.all(over <= snap_reach(robot), axis=-1)
+    k, w, over = out[near], w[near], over[near]
+    if k.size == 0:
+        return w_all, inside
+    held = over > 0
+    start = np.clip(w, robot.lower, robot.upper)
+    target = poses[pose_idx[k]]
+    moved = polish(robot, start, target, weight, SNAP_ITERATIONS, fixed=held)
+    eg, ep = errors_of(robot, moved, target, weight)
+    ok = (eg <= ACCEPT_TOL_REL * robot.length_scale) & robot.within_limits(moved)
+    k = k[ok]
+    q[k], err_geo[k], err_paper[k] = moved[ok], eg[ok], ep[ok]
+    if k.size:
+        w_all[k], inside[k] = wrap_inside(robot, q[k])
+    return w_all, inside
+
+
+def closed_form_meetings(
+    robot: Robot,
+    poses: Array,
+    pose_idx: NDArray[np.intp],
+    q: Array,
+    err_geo: Array,
+    err_paper: Array,
+    inside: NDArray[np.bool_],
+    keep: NDArray[np.bool_],
+    mult: NDArray[np.intp],
+) -> tuple[Array, NDArray[np.intp]]:
+    """A closed form's branches that meet: one solution, a multiple root, whether the deduplication found them one
+    (``keep``) or the closed form's rounding split them in two (merged here, in place of ``err_*``, ``inside`` and
+    ``keep``). Returns ``(q, mult)`` (copies where changed)."""
+    if not keep.all():
+        mult = merged_multiplicity(robot, pose_idx, q, keep, mult)
+    pair = _meeting_pairs(robot, pose_idx, q, keep)
+    if pair.size:
+        q, mult = q.copy(), mult.copy()
+        _merge_meeting(robot, poses, pair, q, err_geo, err_paper, inside, keep, mult, pose_idx)
+    return q, mult
+
+
+def _meeting_pairs(robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_]) -> NDArray[np.intp]:
+    """``(P, 2)`` pairs of kept rows of one pose whose configurations ``w`` (wrapped) are within ``MEET_REL``."""
+    return near_pairs(robot, pose_idx, w, keep, per_joint(robot, MEET_REL))
+
+
+def _merge_meeting(
+    robot: Robot,
+    poses: Array,
+    pair: NDArray[np.intp],
+    w: Array,
+    err_geo: Array,
+    err_paper: Array,
+    inside: NDArray[np.bool_],
+    keep: NDArray[np.bool_],
+    mult: NDArray[np.intp],
+    pose_idx: NDArray[np.intp],
+) -> None:
+    """In place: each pair of ``_meeting_pairs`` whose midpoint (polished) solves the pose as well as the better of
+    them, or at rounding level (``POLISH_ABOVE_REL``), becomes that midpoint (its errors, its limit check, the pair's
+    multiplicities summed), the second row dropped.
+    Two distinct roots this close (a pose next to the singular set) keep apart: between them the pose error grows
+    quadratically, far above theirs."""
+    weight = orientation_weight(robot.length_unit)
+    for a, b in pair.tolist():
+        if not (keep[a] and keep[b]):
+            continue
+        d = w[b] - w[a]
+        d = np.where(robot.is_revolute, np.mod(d + np.pi, 2.0 * np.pi) - np.pi, d)
+        target = poses[pose_idx[a]][None]
+        # (polished: the pair's other joints carry rounding of their own, which moves the pose linearly)
+        half = (w[a] + 0.5 * d)[None]
+        moved = polish(robot, half, target, weight, SNAP_ITERATIONS)
+        # (the polish may not carry the midpoint over to one of the pair: two distinct roots are not one)
+        step = np.where(robot.is_revolute, np.mod(moved - half + np.pi, 2.0 * np.pi) - np.pi, moved - half)
+        unit = per_joint(robot, 1.0)
+        apart = float(np.max(np.abs(d) / unit))
+        stays = np.max(np.abs(step[0]) / unit) <= MEET_STAY * apart
+        mid, mid_inside = wrap_inside(robot, moved)
+        eg, ep = errors_of(robot, mid, target, weight)
+        # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``; a pair farther apart than
+        # ``MEET_NEAR``: no worse than twice the worse of them, or than ``MEET_ROUNDING_REL``)
+        best = max(min(err_geo[a], err_geo[b]), POLISH_ABOVE_REL * robot.length_scale)
+        if apart > MEET_NEAR:
+            best = max(2.0 * max(err_geo[a], err_geo[b]), MEET_ROUNDING_REL * robot.length_scale)
+        if stays and eg[0] <= best and (mid_inside[0] or not (inside[a] or inside[b])):
+            w[a], err_geo[a], err_paper[a], inside[a] = mid[0], eg[0], ep[0], mid_inside[0]
+            mult[a] += mult[b]
+            keep[b] = False
+
+
+def next_to_folds(
+    robot: Robot,
+    poses: Array,
+    pose_idx: NDArray[np.intp],
+    q: Array,
+    mult: NDArray[np.intp],
+    err_geo: Array,
+    err_paper: Array,
+    rows: NDArray[np.intp],
+) -> tuple[NDArray[np.intp], Array, NDArray[np.intp], Array, Array]:
+    """The certified solutions ``rows`` the polish gave, next to a fold of the solution set (:mod:`.partners`): one in
+    a flat valley moved to its bottom (in place; never out of the limits, as the polish's drift), and a close partner
+    on the far side of the fold added after the solution it was found from (a pose's rows stay together): the
+    candidates ``(pose_idx, q, mult, err_geo, err_paper)``."""
+    if rows.size:  # (only nearly singular ones: most polished solutions are not)
+        rows = rows[nearly_singular(robot, q[rows])]
+    if rows.size == 0:
+        return pose_idx, q, mult, err_geo, err_paper
+    accept = ACCEPT_TOL_REL * robot.length_scale
+    weight = orientation_weight(robot.length_unit)
+    q_v, moved = valley_bottoms(robot, q[rows], poses[pose_idx[rows]], accept)
+    if moved.any():
+        moved &= robot.within_limits(q_v) | ~robot.within_limits(q[rows])
+        m = rows[moved]
+        q[m] = q_v[moved]
+        err_geo[m], err_paper[m] = errors_of(robot, q[m], poses[pose_idx[m]], weight)
+    # each distinct one once, and none of a pose with more of them than an arm has solutions (a numerical continuum,
+    # along which no partner is taken)
+    distinct = rows[finish(robot, pose_idx[rows], q[rows], err_geo[rows])[2]]
+    count = np.bincount(pose_idx[distinct], minlength=len(poses))
+    distinct = distinct[count[pose_idx[distinct]] <= MAX_ISOLATED_SOLUTIONS]
+    row, q_p, _ = close_partners(robot, q[distinct], poses[pose_idx[distinct]], accept)
+    if row.size:  # (each once, and none its pose has already: found again, it would add to a multiplicity)
+        new = _new_rows(robot, pose_idx, q, distinct[row], q_p)
+        row, q_p = row[new], q_p[new]
+    if row.size == 0:
+        return pose_idx, q, mult, err_geo, err_paper
+    src = distinct[row]
+    eg_p, ep_p = errors_of(robot, q_p, poses[pose_idx[src]], weight)
+    order = np.argsort(np.concatenate([np.arange(pose_idx.size), src]), kind="stable")
+    return (
+        np.concatenate([pose_idx, pose_idx[src]])[order],
+        np.concatenate([q, q_p])[order],
+        np.concatenate([mult, np.ones(src.size, dtype=mult.dtype)])[order],
+        np.concatenate([err_geo, eg_p])[order],
+        np.concatenate([err_paper, ep_p])[order],
+    )
+
+
+def _new_rows(
+    robot: Robot, pose_idx: NDArray[np.intp], q: Array, src: NDArray[np.intp], q_new: Array
+) -> NDArray[np.bool_]:
+    """``(K,)``: the configurations ``q_new (K, n)`` of the poses of rows ``src`` that are neither one of their pose's
+    rows of ``q`` nor an earlier one of ``q_new`` (within ``dedupe.duplicate_tolerance``)."""
+    tol = duplicate_tolerance(robot)
+    out = np.zeros(src.size, dtype=bool)
+    for k in range(src.size):
+        mine = pose_idx == pose_idx[src[k]]
+        known = np.concatenate([q[mine], q_new[:k][out[:k] & (pose_idx[src[:k]] == pose_idx[src[k]])]])
+        out[k] = not np.any(np.all(joint_distance(robot, known, q_new[k]) <= tol, axis=-1))
+    return out
+
+
+def errors_of(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array, Array]:
+    """Geodesic error and the paper's J ``(K,)`` of configurations ``q (K, n)`` against ``target (K, 4, 4)``:
+    compiled as certification computes them (``fastcertify.pose_errors``), else in NumPy."""
+    if certify.AVAILABLE:
+        return certify.pose_errors(robot, q, target, weight)
+    T = certify.flange_poses(robot, q) @ robot.T_flange_tool
+    return pose_error_geodesic(T, target, weight), pose_error_paper(T, target, weight)

@@ -1,0 +1,260 @@
+"""The compiled sweep search (sweepik.engine.search) against the NumPy reference engine (sweepik.engine.sweep): the same
+candidates, families and samples, staged or in one pass, with or without multiplicities, and the edge samples."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from conftest import carm_stress_configurations
+
+import sweepik
+from sweepik import load_robot, solve_many
+from sweepik.engine import chunk, search
+from sweepik.results import joint_distance
+
+CARM = load_robot("carm")
+
+
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
+@pytest.mark.parametrize("reduction", ["carm-d1", "carm-theta2"])
+def test_compiled_and_numpy_engines_agree(reduction: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    T = CARM.fk(carm_stress_configurations(600, seed=3))
+    fast = solve_many(CARM, T, reduction=reduction)
+    monkeypatch.setattr(search, "AVAILABLE", False)
+    ref = solve_many(CARM, T, reduction=reduction)
+    for a, b in zip(fast, ref, strict=True):
+        assert len(a) == len(b)
+        assert len(a.families) == len(b.families)
+        if len(a):
+            d = joint_distance(CARM, a.q[:, None, :], b.q[None, :, :]).max(axis=-1)
+            assert d.min(axis=1).max() <= 1e-8
+
+
+@pytest.mark.skipif(not search.AVAILABLE, reason="the compiled merge (the reference is the NumPy engine's grid)")
+def test_compiled_sample_grid_is_the_numpy_one() -> None:
+    """``fastsweep.sample_grid`` (compiled merge) gives the reference's samples of each pose alone, bit for bit, with
+    no sample for a NaN hint (the reference makes it a spare midpoint, so that its rows have one length): hints
+    inside and outside the range, NaN hints, hints on the uniform grid and repeated (runs of equal samples spread),
+    real reductions. A pose's samples therefore do not depend on the batch it is solved in."""
+    from sweepik.engine import sweep
+
+    def check(red: sweepik.reductions.Reduction, chain: np.ndarray, lo: np.ndarray, hi: np.ndarray, n: int) -> int:
+        grid, count = search.sample_grid(red, chain, lo, hi, n)
+        hints = sweep.grid_hints(red, chain)
+        assert grid.shape[0] == count.shape[0] == chain.shape[0]
+        dropped = 0
+        for i in range(chain.shape[0]):
+            own = None if hints is None else hints[i : i + 1, np.isfinite(hints[i])]
+            ref = sweep.merge_grid(lo[i : i + 1], hi[i : i + 1], n, own)[0]
+            assert count[i] == ref.size
+            np.testing.assert_array_equal(grid[i, : count[i]], ref)
+            assert np.isnan(grid[i, count[i] :]).all()
+            dropped += grid.shape[1] - count[i]
+        return dropped
+
+    rng = np.random.default_rng(4)
+    dropped = 0
+    for name, reduction in (("carm", "carm-d1"), ("carm", "carm-theta2"), ("carm", "auto"), ("xarm6", "auto")):
+        robot = load_robot(name)
+        red = sweepik.reductions.get_reduction(robot, reduction)
+        chain = chunk.chain_poses(robot, robot.fk(rng.uniform(robot.lower, robot.upper, (200, robot.n_joints))))
+        lo, hi = chunk.theta_range(robot, red, chain)
+        if search._hints_kernel(red) is None:
+            dropped += check(red, chain, lo, hi, sweep.N_SAMPLES)
+        else:  # (a hints kernel writes as many for every pose: the reference's grid exactly)
+            grid, count = search.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
+            np.testing.assert_array_equal(grid, sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES))
+            assert (count == grid.shape[1]).all()
+    assert dropped > 0  # (xArm 6's poses differ in their number of hints)
+
+    class Hinted(sweepik.reductions.CArmD1):
+        def sample_hints(self, poses: np.ndarray) -> np.ndarray:
+            return hints
+
+    N, n = 300, 11
+    lo = rng.uniform(-900.0, 0.0, N)
+    hi = lo + rng.uniform(1.0, 3000.0, N)
+    on_grid = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, n)[rng.integers(0, n, (N, 8))]
+    hints = np.where(rng.random((N, 8)) < 0.5, on_grid, rng.uniform(-2000.0, 4000.0, (N, 8)))
+    hints[rng.random((N, 8)) < 0.2] = np.nan
+    hints[:, 3] = hints[:, 2]
+    assert check(Hinted(CARM), np.broadcast_to(np.eye(4), (N, 4, 4)), lo, hi, n) > 0
+
+
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
+def test_margins_made_per_call_share_their_pair_plans_engine_plan() -> None:
+    """The generic sweeps' margins are a reduction made afresh for each solve: the engine's plan of them (kernels,
+    branches, limits) is worked out once per pair plan (``plan_key``), and is the one a fresh plan would be."""
+    from sweepik.reductions.generic import _Margins
+
+    robot = load_robot("fanuc_crx10ia")
+    red = sweepik.reductions.get_reduction(robot, "auto")
+    m1, m2 = _Margins(red, np.zeros((1, 0))), _Margins(red, np.zeros((2, 0)))
+    assert search._plan(m1) is search._plan(m2)
+    fresh = search._make_plan(m2)
+    got = search._plan(m2)
+    assert (got.residual, got.residuals, got.n_all, got.hints) == (fresh.residual, fresh.residuals, fresh.n_all, None)
+    assert np.array_equal(got.branches, fresh.branches) and np.array_equal(got.ends, fresh.ends)
+    other = sweepik.reductions.get_reduction(load_robot("kinova_jaco2"), "auto")
+    if not other.closed_form:
+        assert search._plan(_Margins(other, np.zeros((1, 0)))) is not search._plan(m1)
+
+
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
+def test_search_without_multiplicities_finds_the_same_candidates() -> None:
+    """``fastsweep.search(..., multiplicity=False)`` (the margins' search) gives the same candidates and spans, each
+    with multiplicity 1; with multiplicities, poses with a double root (theta2 = +-90 deg, theta3 = 0, the paper's
+    excluded grid points) and random ones have some above 1 and some of 1, so the comparison sees what it ignores."""
+    from sweepik.engine import sweep
+
+    red = sweepik.reductions.get_reduction(CARM, "carm-d1")
+    q = carm_stress_configurations(100, seed=5)
+    q[:30, 1] = np.pi / 2
+    q[:30, 2] = 0.0
+    q[:30, 4] = 0.3
+    chain = chunk.chain_poses(CARM, CARM.fk(q))
+    lo, hi = chunk.theta_range(CARM, red, chain)
+    full, spans = search.search(red, chain, lo, hi, sweep.N_SAMPLES)
+    bare, spans2 = search.search(red, chain, lo, hi, sweep.N_SAMPLES, multiplicity=False)
+    for a, b in ((full.pose, bare.pose), (full.branch, bare.branch), (full.theta, bare.theta)):
+        np.testing.assert_array_equal(a, b)
+    assert (bare.mult == 1).all() and (full.mult > 1).any() and (full.mult == 1).any()
+    np.testing.assert_array_equal(spans.lo, spans2.lo)
+
+
+def _same_search(a: Any, b: Any) -> None:
+    (ca, sa), (cb, sb) = a, b
+    for x, y in zip((ca.pose, ca.branch, ca.theta, ca.mult), (cb.pose, cb.branch, cb.theta, cb.mult), strict=True):
+        np.testing.assert_array_equal(x, y)
+    for x, y in zip((sa.pose, sa.branch, sa.lo, sa.hi), (sb.pose, sb.branch, sb.lo, sb.hi), strict=True):
+        np.testing.assert_array_equal(x, y)
+
+
+@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
+@pytest.mark.parametrize(
+    ("name", "reduction"),
+    [
+        ("fanuc_crx10ia", "auto"),
+        ("kinova_jaco2", "auto"),
+        ("xarm6", "auto"),
+        ("yaskawa_hc10", "auto"),
+        ("carm", "auto"),
+        ("carm", "carm-d1"),
+    ],
+)
+def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The search in one compiled pass per pose finds what the staged search finds (every pose's samples first, by
+    ``sample_grid``, then the search: ``one_pass=False``), bit for bit, batched and pose by pose: a generic sweep
+    (its swing samples, its margins' zeros, its candidates: ``fastsweep.EdgeSearch``), theta* revolute or prismatic
+    (the C-Arm's rail, automatic decomposition), and a reduction with a hints kernel (carm-d1). Random poses, and
+    poses on the singular set (joint 5 at 0, joint 3 at 0, both). With the buffers cut to one candidate, every pose
+    overflows and is redone by the NumPy engine, in both; cut to the median count (carm-d1), some are: the same
+    candidates in the same order, twins' copies included."""
+    from sweepik.engine import sweep
+
+    robot = load_robot(name)
+    red = sweepik.reductions.get_reduction(robot, reduction)
+    assert search._plan(red).one_pass is not None  # (the one-pass search is what is tested)
+    rng = np.random.default_rng(11)
+    q = rng.uniform(robot.lower, robot.upper, (60, 6))
+    q[:10, 4] = 0.0
+    q[10:20, 2] = 0.0
+    q[20:25, 2] = 0.0
+    q[20:25, 4] = 0.0
+    chain = chunk.chain_poses(robot, robot.fk(q))
+    lo, hi = chunk.theta_range(robot, red, chain)
+    n = sweep.N_SAMPLES
+    one_pass = search.search(red, chain, lo, hi, n)
+    _same_search(one_pass, search.search(red, chain, lo, hi, n, one_pass=False))
+    assert one_pass[0].pose.size >= chain.shape[0]  # (candidates found: the comparison is not of empty sets)
+    for i in range(0, 60, 7):
+        one = search.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n)
+        _same_search(one, search.search(red, chain[i : i + 1], lo[i : i + 1], hi[i : i + 1], n, one_pass=False))
+    monkeypatch.setattr(search, "MAX_CAND", 1)
+    few = slice(0, 25, 6)
+    _same_search(
+        search.search(red, chain[few], lo[few], hi[few], n),
+        search.search(red, chain[few], lo[few], hi[few], n, one_pass=False),
+    )
+    if reduction == "auto":
+        # (a generic sweep redoes a pose whose margins overflow as a whole, the staged search its margins alone:
+        # with buffers cut below the margins' zeros they differ, as they may; MAX_CAND is far above them)
+        return
+    # some poses redone, the others not: the redone ones (and their twins' copies) in their place
+    counts = np.bincount(one_pass[0].pose, minlength=chain.shape[0])
+    cut = int(np.median(counts))
+    assert (counts > cut).any() and (counts <= cut).any()
+    monkeypatch.setattr(search, "MAX_CAND", cut)
+    _same_search(search.search(red, chain, lo, hi, n), search.search(red, chain, lo, hi, n, one_pass=False))
+
+
+@pytest.mark.parametrize("engine", ["compiled", "numpy"])
+def test_edge_samples_far_from_zero_are_no_candidates(engine: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A sample next to a branch-domain edge or at the range's ends is a candidate only where its residual is within
+    ``FAR_NOISE`` x noise of zero (as an extremum): a root there would make it small. Every candidate the search
+    gives is then that close to zero; before, over half the CRX-10iA's candidates were such samples, far from it.
+    (Next to a family's samples they stay candidates: the C-Arm's grid poses are unchanged, see docs/performance.md.)
+    """
+    from sweepik.engine import sweep
+
+    if engine == "compiled" and not search.AVAILABLE:
+        pytest.skip("numba not installed")
+    if engine == "numpy":
+        monkeypatch.setattr(search, "AVAILABLE", False)
+    robot = load_robot("fanuc_crx10ia")
+    red = sweepik.reductions.get_reduction(robot, None)
+    chain = chunk.chain_poses(robot, robot.fk(np.random.default_rng(4).uniform(robot.lower, robot.upper, (30, 6))))
+    lo, hi = chunk.theta_range(robot, red, chain)
+    if engine == "compiled":
+        cand, _ = search.search(red, chain, lo, hi, sweep.N_SAMPLES)
+    else:
+        cand, _ = sweep.find_candidates(red, chain, lo, hi, sweep.N_SAMPLES)
+    f = red.residual(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+    assert cand.theta.size >= 4 * len(chain)  # (the arm's roots: 7.8 solutions a pose on average)
+    assert np.all(np.abs(f) <= sweep.FAR_NOISE * red.residual_noise)
+
+
+@pytest.mark.parametrize("name", ["fanuc_crx10ia", "xarm6"])
+def test_edge_intervals_left_alone_hide_no_roots(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """An interval beside a branch-domain edge that sits at a sample is resampled at the first level only where it
+    bends in that edge's coordinate (``sweep.EDGE_PROBE_REL``). Those left alone hide no pair of roots: sampled
+    densely (in the edge's coordinate, where a pair would sit), the residual changes sign exactly as often as its two
+    ends show (once or not at all), and comes no nearer zero than they do unless it crosses. Random poses and poses
+    on the singular set (joints at 0 and 90 deg)."""
+    from sweepik.engine import sweep
+
+    monkeypatch.setattr(search, "AVAILABLE", False)
+    robot = load_robot(name)
+    red = sweepik.reductions.get_reduction(robot, None)
+    rng = np.random.default_rng(8)
+    q = rng.uniform(robot.lower, robot.upper, (40, 6))
+    q[20:30, 4] = 0.0
+    q[30:, 2] = np.pi / 2
+    chain = chunk.chain_poses(robot, robot.fk(q))
+    lo, hi = chunk.theta_range(robot, red, chain)
+    seen: list[tuple[Any, ...]] = []
+    judge = sweep._Search._edge_at_sample
+
+    def recorded(self: Any, p: Any, b: Any, th: Any, fin: Any, *rest: Any) -> Any:
+        judged, bent = judge(self, p, b, th, fin, *rest)
+        i, j = np.nonzero(judged & ~bent)
+        seen.append((p[i], b[i], th[i, j], th[i, j + 1], fin[i, j], fin[i, j + 1], rest[2][i, j + 1]))
+        return judged, bent
+
+    monkeypatch.setattr(sweep._Search, "_edge_at_sample", recorded)
+    sweep.find_candidates(red, chain, lo, hi, sweep.N_SAMPLES)
+    p, b, t0, t1, f0, f1, right = (np.concatenate(c) for c in zip(*seen, strict=True))
+    assert p.size >= len(chain)  # (most edges' intervals are left alone: the test is not vacuous)
+    # dense samples, uniform in sqrt(|theta - edge|)
+    edge, other = np.where(right, t1, t0), np.where(right, t0, t1)
+    x = np.linspace(0.0, 1.0, 2001)[None, :] ** 2
+    dense = edge[:, None] + (other - edge)[:, None] * x
+    f = red.residual(chain[p], dense, np.broadcast_to(b[:, None], dense.shape))
+    assert np.isfinite(f).all()
+    changes = np.count_nonzero(np.sign(f[:, 1:]) * np.sign(f[:, :-1]) < 0, axis=1)
+    crosses = f0 * f1 < 0
+    np.testing.assert_array_equal(changes, crosses.astype(int))
+    ends = np.minimum(np.abs(f0), np.abs(f1))
+    assert np.all(crosses | (np.abs(f).min(axis=1) >= 0.5 * ends))
