@@ -19,7 +19,7 @@ from scipy.optimize import brentq
 
 #: Offsets from the singular set along the moved joint (radians, or times the length scale for a slide).
 OFFSETS = (0.0, 0.0, 1e-9, 1e-7, 1e-5, 1e-4, 1e-3)
-#: The certification's tolerance on the geodesic pose error, relative to the length scale (``solver.ACCEPT_TOL_REL``
+#: The certification's tolerance on the geodesic pose error, relative to the length scale (``settings.ACCEPT_TOL_REL``
 #: with the margin the solver's polish leaves).
 SAME_ROOT_REL = 1e-12
 

@@ -98,7 +98,7 @@ def test_read_only_poses(name: str, tmp_path) -> None:
 def test_chunks_solved_side_by_side_change_nothing(name):
     """Several chunks are solved two at a time on threads (parallel.in_order): the same columns as one chunk, and
     iter_solve yields the same solutions in the same order. xArm 6 (a generic sweep whose poses differ in their
-    number of sample hints): a pose's samples do not depend on its batch (``fastsweep.sample_grid``)."""
+    number of sample hints): a pose's samples do not depend on its batch (``search.sample_grid``)."""
     robot = sweepik.load_robot(name)
     T = _poses(robot, np.random.default_rng(11), 150)
     one = sweepik.solve_many(robot, T)

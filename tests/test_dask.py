@@ -278,7 +278,7 @@ def test_cli_sample(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_default_chunking_is_solve_many_bit_for_bit_on_a_swept_arm(client: Client, tmp_path: Path) -> None:
     """A swept 6R arm's store equals solve_many bit for bit (the default chunk size follows solve_many's batches; with
-    the compiled engine a pose's samples do not depend on its batch anyway, see ``fastsweep.sample_grid``)."""
+    the compiled engine a pose's samples do not depend on its batch anyway, see ``search.sample_grid``)."""
     import sweepik
 
     arm = sweepik.load_robot("fanuc_crx10ia")

@@ -46,8 +46,8 @@ def test_self_motion_reported_by_both_reductions_without_duplicates(reduction: s
 )
 def test_compiled_family_steps_are_the_numpy_ones(name: str, reduction: str | None) -> None:
     """The family pieces' compiled steps give the NumPy steps' values bit for bit: the cut location
-    (``fastcertify.locate_cuts`` against ``families._locate_cuts``, with and without limits) and
-    the golden-section search for limit dips (``fastcertify.dip_search`` against ``families._golden_dips``,
+    (``certify.locate_cuts`` against ``families._locate_cuts``, with and without limits) and
+    the golden-section search for limit dips (``certify.dip_search`` against ``families._golden_dips``,
     including members that do not exist, NaN limit excess, and the common stop of all dips)."""
     from sweepik.engine import certify, families
 
@@ -76,7 +76,7 @@ def test_compiled_family_steps_are_the_numpy_ones(name: str, reduction: str | No
     best_x = 0.5 * (a + b)
     best_e = np.full(K, 10.0 * robot.length_scale)
     ref = families._golden_dips(robot, red, chain, pose, branch, a, b, best_x, best_e)
-    got = certify.dip_search(robot, red, chain, pose, branch, a, b, best_x, best_e, families._DIP_STEPS)
+    got = certify.dip_search(robot, red, chain, pose, branch, a, b, best_x, best_e, settings.DIP_STEPS)
     np.testing.assert_array_equal(got[0], ref[0])
     np.testing.assert_array_equal(got[1], ref[1])
 

@@ -11,7 +11,7 @@ from conftest import carm_stress_configurations
 
 import sweepik
 from sweepik import load_robot
-from sweepik.engine import chunk, search
+from sweepik.engine import candidates, chunk, search
 
 CARM = load_robot("carm")
 
@@ -151,7 +151,7 @@ def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
     assert red.periodic and search._hints_kernel(red) is OwnHints.kernel_hints
     chain = CARM.fk(carm_stress_configurations(50, seed=13))
     lo, hi = chunk.theta_range(CARM, red, chain)
-    ref = sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
+    ref = candidates.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
     grid, count = search.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
     np.testing.assert_array_equal(grid, ref)  # (a hints kernel's NaN hint is a spare sample, as in the reference)
     assert (count == ref.shape[1]).all()

@@ -308,7 +308,7 @@ def test_shoulder_double_root_with_the_wrist_nearly_straight(name: str, a5: floa
 def test_two_roots_next_to_the_elbow_fold_stay_two() -> None:
     """PUMA 560 with its elbow 1e-7 rad short of straight: two distinct roots 3e-4 apart, each solving the pose to
     rounding. Their polished midpoint misses it by 6e-15 of the arm's size (well within the certification, 60 times
-    more than they do): merging them as one split double root lost the configuration (``solver.MEET_NEAR``)."""
+    more than they do): merging them as one split double root lost the configuration (``settings.MEET_NEAR``)."""
     from singular import recovered
 
     robot = load_robot("puma560")

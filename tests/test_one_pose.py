@@ -1,5 +1,5 @@
-"""The one-call path of a single pose (``fastsolve.settle_one``, ``fastsolve.settle_closed``,
-``solver._settled``) gives what the general path gives, bit for bit, and hands the poses it cannot settle
+"""The one-call path of a single pose (``one_pose.settle_one``, ``one_pose.settle_closed``,
+``chunk.settled``) gives what the general path gives, bit for bit, and hands the poses it cannot settle
 to it."""
 
 from __future__ import annotations

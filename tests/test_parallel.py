@@ -114,7 +114,7 @@ def test_in_order_nested_in_a_chunk_runs_in_that_chunks_thread():
 @pytest.mark.parametrize(("name", "split"), [("fanuc_crx10ia", True), ("carm", False), ("ur5", False)])
 def test_a_generic_sweeps_small_batch_is_split_in_two(name: str, split: bool, monkeypatch: pytest.MonkeyPatch) -> None:
     """A generic sweep's batch of at most ``IN_FLIGHT`` chunks is split evenly into IN_FLIGHT chunks solved side by
-    side, each on its share of the threads (``solver._chunking``); the solutions are one chunk's, bit for bit (each
+    side, each on its share of the threads (``solving._chunking``); the solutions are one chunk's, bit for bit (each
     pose is solved on its own). Not below ``IN_FLIGHT x SPLIT_MIN`` poses, nor for a cheaper search (the C-Arm's
     hints kernel, a closed form), nor on one thread (nothing to overlap)."""
     import numba

@@ -1,4 +1,4 @@
-"""Newton polish: the compiled steps (``fastcertify.polish_rows``) and the NumPy loop (``polish.polish`` without Numba)
+"""Newton polish: the compiled steps (``certify.polish_rows``) and the NumPy loop (``polish.polish`` without Numba)
 are the same method; both converge from near a solution, with joints held or not, and agree."""
 
 from __future__ import annotations

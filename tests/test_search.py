@@ -11,7 +11,7 @@ from conftest import carm_stress_configurations
 
 import sweepik
 from sweepik import load_robot, solve_many
-from sweepik.engine import chunk, search
+from sweepik.engine import candidates, chunk, search
 from sweepik.results import joint_distance
 
 CARM = load_robot("carm")
@@ -34,7 +34,7 @@ def test_compiled_and_numpy_engines_agree(reduction: str, monkeypatch: pytest.Mo
 
 @pytest.mark.skipif(not search.AVAILABLE, reason="the compiled merge (the reference is the NumPy engine's grid)")
 def test_compiled_sample_grid_is_the_numpy_one() -> None:
-    """``fastsweep.sample_grid`` (compiled merge) gives the reference's samples of each pose alone, bit for bit, with
+    """``search.sample_grid`` (compiled merge) gives the reference's samples of each pose alone, bit for bit, with
     no sample for a NaN hint (the reference makes it a spare midpoint, so that its rows have one length): hints
     inside and outside the range, NaN hints, hints on the uniform grid and repeated (runs of equal samples spread),
     real reductions. A pose's samples therefore do not depend on the batch it is solved in."""
@@ -42,12 +42,12 @@ def test_compiled_sample_grid_is_the_numpy_one() -> None:
 
     def check(red: sweepik.reductions.Reduction, chain: np.ndarray, lo: np.ndarray, hi: np.ndarray, n: int) -> int:
         grid, count = search.sample_grid(red, chain, lo, hi, n)
-        hints = sweep.grid_hints(red, chain)
+        hints = candidates.grid_hints(red, chain)
         assert grid.shape[0] == count.shape[0] == chain.shape[0]
         dropped = 0
         for i in range(chain.shape[0]):
             own = None if hints is None else hints[i : i + 1, np.isfinite(hints[i])]
-            ref = sweep.merge_grid(lo[i : i + 1], hi[i : i + 1], n, own)[0]
+            ref = candidates.merge_grid(lo[i : i + 1], hi[i : i + 1], n, own)[0]
             assert count[i] == ref.size
             np.testing.assert_array_equal(grid[i, : count[i]], ref)
             assert np.isnan(grid[i, count[i] :]).all()
@@ -65,7 +65,7 @@ def test_compiled_sample_grid_is_the_numpy_one() -> None:
             dropped += check(red, chain, lo, hi, sweep.N_SAMPLES)
         else:  # (a hints kernel writes as many for every pose: the reference's grid exactly)
             grid, count = search.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
-            np.testing.assert_array_equal(grid, sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES))
+            np.testing.assert_array_equal(grid, candidates.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES))
             assert (count == grid.shape[1]).all()
     assert dropped > 0  # (xArm 6's poses differ in their number of hints)
 
@@ -104,7 +104,7 @@ def test_margins_made_per_call_share_their_pair_plans_engine_plan() -> None:
 
 @pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 def test_search_without_multiplicities_finds_the_same_candidates() -> None:
-    """``fastsweep.search(..., multiplicity=False)`` (the margins' search) gives the same candidates and spans, each
+    """``search.search(..., multiplicity=False)`` (the margins' search) gives the same candidates and spans, each
     with multiplicity 1; with multiplicities, poses with a double root (theta2 = +-90 deg, theta3 = 0, the paper's
     excluded grid points) and random ones have some above 1 and some of 1, so the comparison sees what it ignores."""
     from sweepik.engine import sweep
@@ -147,7 +147,7 @@ def _same_search(a: Any, b: Any) -> None:
 def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """The search in one compiled pass per pose finds what the staged search finds (every pose's samples first, by
     ``sample_grid``, then the search: ``one_pass=False``), bit for bit, batched and pose by pose: a generic sweep
-    (its swing samples, its margins' zeros, its candidates: ``fastsweep.EdgeSearch``), theta* revolute or prismatic
+    (its swing samples, its margins' zeros, its candidates: ``search.EdgeSearch``), theta* revolute or prismatic
     (the C-Arm's rail, automatic decomposition), and a reduction with a hints kernel (carm-d1). Random poses, and
     poses on the singular set (joint 5 at 0, joint 3 at 0, both). With the buffers cut to one candidate, every pose
     overflows and is redone by the NumPy engine, in both; cut to the median count (carm-d1), some are: the same

@@ -249,23 +249,35 @@ def test_sp6_recovers_constructed_solution(seed):
     assert min(_ang(x, t1) + _ang(y, t2) for x, y in zip(a[:n], b[:n], strict=True)) < 1e-8
 
 
+def _turned(v, k, p, t):
+    """``v . Rot(k, t) p`` for angles ``t`` (array), by Rodrigues' formula (NumPy, independent of the subproblems)."""
+    v, k, p = (np.asarray(x, dtype=float) for x in (v, k, p))
+    return (v @ p - (v @ k) * (k @ p)) * np.cos(t) + (v @ np.cross(k, p)) * np.sin(t) + (v @ k) * (k @ p)
+
+
+def _solve_turned(h, k, p, d):
+    """Both ``t`` with ``h . Rot(k, t) p = d`` for each ``d`` (array; NaN where there is none), in NumPy."""
+    h, k, p = (np.asarray(x, dtype=float) for x in (h, k, p))
+    a, b = h @ p - (h @ k) * (k @ p), h @ np.cross(k, p)
+    with np.errstate(invalid="ignore"):
+        half = np.arccos((d - (h @ k) * (k @ p)) / np.hypot(a, b))
+    phi = np.arctan2(b, a)
+    return phi + half, phi - half
+
+
 @pytest.mark.parametrize("seed", range(40))
 def test_sp6_matches_scan(seed):
-    """Brute force: theta2 from the first equation (sp4) on a dense theta1 grid, the second's sign changes. Every
-    root the scan finds is returned, and every returned pair solves both equations (the scan can miss a root where
-    sp4's two branches meet, so it bounds the count from below)."""
+    """Brute force: theta2 from the first equation on a dense theta1 grid (both of its branches, in NumPy), the
+    second's sign changes. Every root the scan finds is returned, and every returned pair solves both equations (the
+    scan can miss a root where the first equation's two branches meet, so it bounds the count from below)."""
     rng = np.random.default_rng(100 + seed)
     data = _sp6_data(rng)
     d = rng.normal(size=2)
     a, b, n = _sp6(data, d)
     (h1, k1, p1), (h2, k2, p2), (h3, k3, p3), (h4, k4, p4) = data
     found = []
-    for branch in (0, 1):
-        g = np.full(GRID.size, np.nan)
-        for i, t in enumerate(GRID):
-            x, y, c, _ = sp4(_t(h2), _t(p2), _t(k2), float(d[0] - h1 @ _R(k1, t) @ p1))
-            if in_domain(c):
-                g[i] = h3 @ _R(k3, t) @ p3 + h4 @ _R(k4, (x, y)[branch]) @ p4 - d[1]
+    for t2 in _solve_turned(h2, k2, p2, d[0] - _turned(h1, k1, p1, GRID)):
+        g = _turned(h3, k3, p3, GRID) + _turned(h4, k4, p4, t2) - d[1]
         ok = np.isfinite(g[1:]) & np.isfinite(g[:-1])
         found += list(GRID[:-1][ok & (np.sign(g[1:]) != np.sign(g[:-1]))])
     assert len(found) <= n <= 4

@@ -19,7 +19,7 @@ from sweepik._jit import alive, inlined, unowned
 from sweepik.engine import parallel
 from sweepik.engine.dedupe import limit_args
 from sweepik.engine.search import AVAILABLE, PARALLEL_MIN, writable
-from sweepik.engine.settings import PINV_WIDEN
+from sweepik.engine.settings import J_CUTOFF_FACTOR, PINV_WIDEN
 from sweepik.model import kinematics
 from sweepik.model.pose import GIMBAL_TOL
 from sweepik.model.units import orientation_weight
@@ -32,9 +32,6 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 _EXACT_GIMBAL = 1e-12  # as pose._EXACT_GIMBAL
-#: Candidates whose geodesic error exceeds this times the orientation weight (1e-4 x 100 mm = 0.01 mm) are far
-#: from any solution (accepted ones are below 1e-9 mm, polished ones below 3e-3 mm): their J is reported as inf.
-J_CUTOFF_FACTOR = 1e-4
 _MAX_FLOAT = float(np.finfo(np.float64).max)
 
 if AVAILABLE:
@@ -246,7 +243,7 @@ if AVAILABLE:
                 return False
         return True
 
-    #: ``_certify_every_branch``'s arguments (``fastsolve`` calls it by its address too).
+    #: ``_certify_every_branch``'s arguments (``one_pose`` calls it by its address too).
     _CERTIFY_EVERY_SIG = (
         (_CFGS, float64[:, ::1], float64[:, :, ::1], int64)
         + (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64)
@@ -744,7 +741,7 @@ def locate_cuts(robot, red, chain: Array, world: Array, pose, branch, a: Array, 
 
 
 def certify_every_branch(robot, red, chain: Array, world: Array, params: Array | None = None):
-    """A closed form's candidates, every branch of every pose (pose-major, as ``solver._every_branch``), certified
+    """A closed form's candidates, every branch of every pose (pose-major, as ``chunk.every_branch``), certified
     with its all-branch configuration kernel (``owned_kernel(red, "kernel_configurations")``, which must exist):
     ``(q (N n_branches, n), geodesic errors, paper errors)``, as :func:`certify` gives them branch by branch."""
     N, nb = chain.shape[0], red.n_branches

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import certify, one_pose, search
+from sweepik.engine.candidates import Candidates, Spans, twin_copies
 from sweepik.engine.companion import joined
 from sweepik.engine.continuation import continuum_families
 from sweepik.engine.dedupe import finish, settle
@@ -41,7 +42,7 @@ from sweepik.engine.settle import (
     snap_reach,
     snap_to_limits,
 )
-from sweepik.engine.sweep import Candidates, Spans, find_candidates, twin_copies
+from sweepik.engine.sweep import find_candidates
 from sweepik.errors import ShapeError
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit, orientation_weight
@@ -416,7 +417,7 @@ def _block(
 def _settled_single(
     robot: Robot, red: Reduction, poses: Array, chain: Array, limits: bool, n_samples: int
 ) -> Block | None:
-    """``solve_chunk`` of one pose (``chain``: its chain pose) in one compiled call (``fastsolve``), the same values;
+    """``solve_chunk`` of one pose (``chain``: its chain pose) in one compiled call (``one_pose``), the same values;
     None where the pose needs one of its rarer steps (``settled``)."""
     out = settled(robot, red, poses, chain, limits, n_samples)
     if out is None:
@@ -439,7 +440,7 @@ def _settled_single(
 def settled(
     robot: Robot, red: Reduction, poses: Array, chain: Array, limits: bool, n_samples: int
 ) -> one_pose.Settled | None:
-    """One pose's solutions from the one compiled call (``fastsolve``); None where the pose needs one of its rarer
+    """One pose's solutions from the one compiled call (``one_pose``); None where the pose needs one of its rarer
     steps (a polish, families, special solutions, a continuum along another joint, the fallback, branches of a
     closed form that meet) or a second reduction's solutions (a ``companion``)."""
     if getattr(red, "companion", None) is not None:

@@ -19,9 +19,21 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from sweepik.engine.candidates import Spans
 from sweepik.engine.families import certified_members, families_of, off_families
 from sweepik.engine.polish import polished, pose_and_jacobian
-from sweepik.engine.sweep import Spans
+from sweepik.engine.settings import (
+    PROBE_ERROR,
+    PROBE_STEP,
+    SEED_BATCH,
+    TRACE_HALVINGS,
+    TRACE_JUMP,
+    TRACE_MIN,
+    TRACE_NEWTON,
+    TRACE_SHARE,
+    TRACE_SINGULAR,
+    TRACE_STEPS,
+)
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import Reduction
@@ -29,40 +41,6 @@ from sweepik.results import Family, weighted_joint_distance
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.intp]
-
-#: Nominal steps of the traced joint over a turn (revolute) or over its travel (prismatic) ...
-TRACE_STEPS = 64
-#: ... halved on a failed step at most this many times before the family is taken to end there.
-TRACE_HALVINGS = 14
-#: A corrected member farther than this from its prediction (``solutions.weighted_joint_distance``: radians, and
-#: 100 mm of a slide per radian) is refused: the correction jumped to another piece of the solution set.
-TRACE_JUMP = 0.25
-#: Newton steps per correction (at most: a member stops once within rounding). Where the continuum crosses another
-#: singular set (carm_swapped's theta2 self-motion at theta2 = -90 deg) Newton converges only linearly: with 6 steps
-#: the tracing stopped ~1e-3 short of the crossing on both sides, and the solutions in that gap went missing.
-TRACE_NEWTON = 20
-#: A seed is followed only where a continuum can pass along the joint: the arm's Jacobian (lengths over the arm's
-#: length scale) has its smallest singular value below this fraction of its largest (members of a continuum: ~1e-17,
-#: ~1e-9 where two singular directions meet, and up to ~1e-7 where the member is pinned down only to the root of the
-#: rounding: a PUMA 560 member with A5 = 9e-7, A4 = 0, its wrist continuum's direction the second smallest at
-#: 9.4e-8; regular solutions: above ~1e-3) ...
-TRACE_SINGULAR = 1e-5
-#: ... and the joint's share of the nearly null directions (the continuum's tangent among them) is above this.
-TRACE_SHARE = 1e-3
-#: Seeds corrected at once (``continuum_families``).
-SEED_BATCH = 8
-#: A traced stretch shorter than this fraction of a step is no family (the candidate is isolated).
-TRACE_MIN = 0.5
-#: A trace's first step is this fraction of a step; until the trace has gone ``TRACE_MIN`` of a step from its seed,
-#: its steps are not halved below it (then they double up to a whole step). A member of a continuum can be followed
-#: that far (~2.5e-4 rad) from anywhere on it, and corrected there to rounding level (Newton with the traced joint held
-#: converges quadratically along a continuum: rank 5) ...
-PROBE_STEP = 2.0**-8
-#: ... so a first step corrected no closer than this times the certification's tolerance starts from an isolated
-#: solution next to a singular set (a wrist centre 1e-7 off a Staubli RX160's axis 1: 0.17 of the tolerance after a
-#: first step, 1.2 after 16 times that). Following such a solution as far as the tolerance lets it go, with steps
-#: halved down to 2^-14, cost 30-45 ms a seed (8 seeds: 250-430 ms a pose).
-PROBE_ERROR = 1e-2
 
 
 def scaled_singular(robot: Robot, q: Array) -> tuple[Array, Array]:

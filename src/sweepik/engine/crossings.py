@@ -20,31 +20,12 @@ from numpy.typing import NDArray
 
 from sweepik.engine.continuation import scaled_singular
 from sweepik.engine.families import golden_least
+from sweepik.engine.settings import CROSS_RANK, CROSS_SAMPLES, CROSS_SINGULAR, CROSS_STEP, CROSS_STEPS, VERTEX_REL
 from sweepik.model.robot import Robot
 from sweepik.results import Family
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.intp]
-
-#: Members sampled along a family (its interval, ends included) ...
-CROSS_SAMPLES = 65
-#: ... and golden-section steps at most around a least second singular value between them, until it is below
-#: ``CROSS_SINGULAR`` (a crossing, located to about that over its slope: far closer than the seeds'
-#: step) or cannot get there any more (its slope bounded by twice the rise to the samples beside it).
-CROSS_STEPS = 40
-#: The second singular value (over the largest) at a crossing: members of a continuum have their smallest at ~1e-17.
-CROSS_SINGULAR = 1e-7
-#: A family whose second singular value stays below this over half its members is not searched: the arm
-#: loses a second rank all along it (the KR 6's wrist centre on axis 1 with the elbow straight), where no other
-#: continuum branches off at one point.
-CROSS_RANK = 1e-5
-#: A least sampled value is searched only where the V through it and its neighbours reaches down to this fraction of
-#: it (exactly to zero for a crossing between two samples, up to the curvature of the singular value).
-VERTEX_REL = 0.25
-#: Distance of the seeds from the crossing along the second null direction (radians; times the length scale for a
-#: slide): far enough that the correction does not fall back onto the family, near enough to land on the continuum
-#: that crosses it.
-CROSS_STEP = 1e-3
 
 
 def _second_singular(robot: Robot, family: Family, theta: Array) -> Array:

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from sweepik.engine import parallel
 from sweepik.engine.search import AVAILABLE
+from sweepik.engine.settings import DEDUPE_ANGLE, DEDUPE_LENGTH_REL
 from sweepik.results import joint_distance
 
 if TYPE_CHECKING:
@@ -41,10 +42,6 @@ __all__ = [
     "DEDUPE_LENGTH_REL",
 ]
 
-#: Two solutions are the same when every revolute joint agrees within this (radians, modulo 2 pi) ...
-DEDUPE_ANGLE = 1e-6
-#: ... and every prismatic joint within this times the arm's length scale.
-DEDUPE_LENGTH_REL = 1e-8
 #: A pose with more candidates than this (a numerical continuum) is deduplicated by buckets, not pair by pair.
 _LARGE_GROUP = 64
 #: ``settle`` runs on several threads from this many candidates on (fewer: a thread hand-off costs more).
@@ -490,7 +487,7 @@ if AVAILABLE:
                 for y in range(first[last - 1], first[last + 1]):
                     _drop_worse(q, score, rev, tol, sorted_rows[x], sorted_rows[y], keep)
 
-    #: ``_settle``'s arguments (``fastsolve`` calls it by its address too).
+    #: ``_settle``'s arguments (``one_pose`` calls it by its address too).
     _SETTLE_SIG = (
         (float64[:, ::1], float64[::1], float64[::1], int64[::1], float64[::1], boolean[::1], float64[::1])
         + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, boolean[::1], int64[::1])

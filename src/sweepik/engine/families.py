@@ -10,8 +10,23 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import certify, search
-from sweepik.engine.settings import ACCEPT_TOL_REL
-from sweepik.engine.sweep import CLUSTER_FAMILY_REL, Spans
+from sweepik.engine.candidates import Spans
+from sweepik.engine.settings import (
+    ACCEPT_TOL_REL,
+    CLUSTER_FAMILY_REL,
+    CONTINUUM_LINK,
+    CONTINUUM_THIN,
+    CUT_BISECT,
+    DIP_STEPS,
+    FAMILY_SAMPLES,
+    INNER_PROBES,
+    MAX_ISOLATED_SOLUTIONS,
+    MEMBER_TOL,
+    NEAR_FAMILY_SAMPLES,
+    NUDGE_REL,
+    PEAK_REACH,
+    PEAK_STEPS,
+)
 from sweepik.model.pose import pose_error_geodesic
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
@@ -19,9 +34,6 @@ from sweepik.reductions import Reduction
 from sweepik.results import Family, joint_distance
 
 Array = NDArray[np.float64]
-
-#: Samples along a family span to certify its members and cut it to the joint limits.
-_FAMILY_SAMPLES = 33
 
 
 def family_members(
@@ -33,15 +45,9 @@ def family_members(
     return red.solve_rest(chain[pose], theta[:, None], branch[:, None])[:, 0]
 
 
-#: Where the branch's closed form breaks down at an isolated theta* of a family (a removable singular point, e.g. the
-#: C-Arm's wrist crossing joint 2's axis, d1 = Pz), ``certified_members`` gives the member this far away (relative
-#: to the interval): the branch is continuous on either side, and the solution at the point is their limit.
-_NUDGE_REL = 2.0**-30
-
-
 def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Array, lo: float, hi: float) -> Array:
     """Members ``(K, n)`` at ``theta (K,)`` (inside ``[lo, hi]``) of one family (chain pose ``(4, 4)``, branch),
-    each certified by FK: one that is not is replaced by the member ``_NUDGE_REL (hi - lo)`` further in, or back
+    each certified by FK: one that is not is replaced by the member ``NUDGE_REL (hi - lo)`` further in, or back
     (if neither is a solution, it is left as it is)."""
 
     robot = red.robot
@@ -56,7 +62,7 @@ def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Arr
     if ok.all():
         return q
     bad = np.nonzero(~ok)[0]
-    step = _NUDGE_REL * max(hi - lo, 1.0)
+    step = NUDGE_REL * max(hi - lo, 1.0)
     for sign in (1.0, -1.0):
         x = np.clip(theta[bad] + sign * step, lo, hi)
         qn, okn = members(x)
@@ -142,12 +148,6 @@ def _members_excess(
     return ok & inside, np.where(ok[..., None], over, np.nan)
 
 
-#: Where a family piece ends between its samples (1/32 of the span apart) is located to 2**-_CUT_BISECT of that,
-#: ~1e-8 mm on the C-Arm's rail (``_locate_cuts``).
-_CUT_BISECT = 32
-#: Golden-section steps locating the least limit excess between samples (the bracket shrinks 0.618x a step;
-#: the search stops once every bracket has a point inside the limits).
-_DIP_STEPS = 50
 _GOLDEN = 0.5 * (np.sqrt(5.0) - 1.0)
 
 
@@ -171,7 +171,7 @@ def _locate_cuts(
     <= 0 at ``a``, > 0 at ``b``) takes ~10 member evaluations instead of ``steps``. The step is kept at least half
     the target width from the ends, so that a bracket with an end next to the cut closes at once; where the last
     three steps together did not halve the bracket, the next one bisects (at most ``3 steps + 3`` steps). The NumPy
-    reference of ``fastcertify.locate_cuts``."""
+    reference of ``certify.locate_cuts``."""
     a, b = np.array(a, dtype=np.float64), np.array(b, dtype=np.float64)
     K, n = a.size, robot.n_joints
     target = np.ldexp(np.abs(b - a), -steps)
@@ -253,7 +253,7 @@ def _limit_dips(
     a, b = grid[k, np.maximum(i - 1, 0)], grid[k, np.minimum(i + 1, M - 1)]
     best_x, best_e = grid[k, i], big[k, i]
     if red.uses_kernel and search.AVAILABLE:
-        best_x, best_e = certify.dip_search(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e, _DIP_STEPS)
+        best_x, best_e = certify.dip_search(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e, DIP_STEPS)
     else:
         best_x, best_e = _golden_dips(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e)
     found = best_e <= 0.0
@@ -277,7 +277,7 @@ def _golden_dips(
     best_x: Array,
     best_e: Array,
 ) -> tuple[Array, Array]:
-    """The golden-section steps of ``_limit_dips`` (the NumPy reference; ``fastcertify.dip_search``)."""
+    """The golden-section steps of ``_limit_dips`` (the NumPy reference; ``certify.dip_search``)."""
     return golden_least(lambda x: _limit_excess(robot, red, chain, pose, branch, x), a, b, best_x, best_e)
 
 
@@ -287,7 +287,7 @@ def golden_least(
     b: Array,
     best_x: Array,
     best_e: Array,
-    steps: int = _DIP_STEPS,
+    steps: int = DIP_STEPS,
     slope: Array | None = None,
 ) -> tuple[Array, Array]:
     """Golden-section search of the least ``excess(x)`` in each bracket ``[a, b]``, starting from the best point
@@ -314,19 +314,6 @@ def golden_least(
         ec, ed = np.where(left, e_fresh, ed), np.where(left, ec, e_fresh)
         c, d = new_c, new_d
     return best_x, best_e
-
-
-#: A local maximum of a joint's limit excess among a span's samples, inside the limits, is searched between its
-#: neighbouring samples when it lies within this many times the rise from a neighbour below zero: the excess can
-#: exceed zero between two samples inside the limits only where it is still climbing that steeply (a joint turning
-#: through +-pi, outside limits narrower than the circle, between two samples is the common case). Where the excess
-#: is linear on both sides of its peak, the peak is at most one rise above the sample (1 would do); 1.5 leaves room
-#: for curvature.
-PEAK_REACH = 1.5
-#: Golden-section steps of a peak's search: the bracket (two sample steps) shrinks to 0.618^24 ~ 1e-5 of itself, so
-#: an excursion out of the limits wider than ~1e-5 of the sampling is found (most searches find none and run them
-#: all: fewer than the dips' steps, which usually stop early).
-_PEAK_STEPS = 24
 
 
 def _limit_peaks(
@@ -358,7 +345,7 @@ def _limit_peaks(
 
     # the excess changes at most ~PEAK_REACH x its rise per sample step (the brackets are two steps wide)
     slope = PEAK_REACH * rise[k, i, j] / np.maximum(0.5 * (b - a), np.finfo(float).tiny)
-    best_x, best_e = golden_least(negated, a, b, grid[k, i], -big[k, i, j], _PEAK_STEPS, slope)
+    best_x, best_e = golden_least(negated, a, b, grid[k, i], -big[k, i, j], PEAK_STEPS, slope)
     found = best_e < 0.0
     rows = k[found]
     width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
@@ -402,7 +389,7 @@ def families_of(
     used, pose = np.unique(spans.pose, return_inverse=True)
     chain_all, chain, world = chain, chain[used], world[used]
     branch = spans.branch
-    u = np.linspace(0.0, 1.0, _FAMILY_SAMPLES)
+    u = np.linspace(0.0, 1.0, FAMILY_SAMPLES)
     grid = spans.lo[:, None] + (spans.hi - spans.lo)[:, None] * u
     if limits:
         # a stretch inside the limits narrower than the sampling (a joint dipping just under its limit between
@@ -435,10 +422,10 @@ def families_of(
         a, b = inside[cut], outside[cut]
         if red.uses_kernel and search.AVAILABLE:  # (the same steps, compiled: no array work per step)
             a, b = certify.locate_cuts(
-                robot, red, chain, world, pose[which], branch[which], a, b, _CUT_BISECT, limits, tol
+                robot, red, chain, world, pose[which], branch[which], a, b, CUT_BISECT, limits, tol
             )
         else:
-            a, b = _locate_cuts(robot, red, chain, world, pose[which], branch[which], a, b, _CUT_BISECT, limits, tol)
+            a, b = _locate_cuts(robot, red, chain, world, pose[which], branch[which], a, b, CUT_BISECT, limits, tol)
         inside[cut] = a
     n = K.size
     lo, hi = inside[:n], inside[n:]
@@ -475,10 +462,6 @@ def families_of(
     return out, np.concatenate([used[pose[pk]].astype(np.intp), near_p]), np.concatenate([q_pts, near_q])
 
 
-#: Members sampled along a span none of whose members is a solution, returned as candidates to polish.
-NEAR_FAMILY_SAMPLES = 9
-
-
 def _near_family_members(
     robot: Robot,
     red: Reduction,
@@ -505,13 +488,9 @@ def _near_family_members(
     return used[pose[k]][finite].astype(np.intp), q[finite]
 
 
-#: Two points are the same member when every joint agrees within this (radians modulo 2 pi / relative length).
-_MEMBER_TOL = 1e-6
-
-
 def _same_configuration(robot: Robot, a: Array, b: Array) -> NDArray[np.bool_]:
     d = joint_distance(robot, a, b)
-    return np.asarray(np.all(d <= _MEMBER_TOL * np.maximum(1.0, np.abs(a)), axis=-1))
+    return np.asarray(np.all(d <= MEMBER_TOL * np.maximum(1.0, np.abs(a)), axis=-1))
 
 
 def _repeated_pieces(
@@ -523,7 +502,7 @@ def _repeated_pieces(
     dup = np.zeros(P, dtype=bool)
     if P < 2:
         return dup
-    tol = _MEMBER_TOL * np.maximum(1.0, hi - lo)
+    tol = MEMBER_TOL * np.maximum(1.0, hi - lo)
     # pairs (i, j), j < i, of the same pose with the same interval (within i's tolerance): every earlier piece of
     # each piece's pose, all at once (a pose has a few pieces)
     order = np.argsort(pose, kind="stable")
@@ -599,24 +578,18 @@ def off_families(robot: Robot, checks: list[tuple[Array, tuple[Family, ...]]]) -
     return [~on[offsets[g] : offsets[g + 1]] for g in range(len(checks))]
 
 
-#: Where a family's members are probed to tell whether it lies on other families (fractions of its interval): not
-#: its ends, which may sit at a fold of the continuum, where two traces of it stop at different distances (the other
-#: joints move as the square root of the distance to the fold: 1e-5 rad of the free joint short of it, ~3e-3 rad).
-_INNER_PROBES = (0.05, 0.25, 0.5, 0.75, 0.95)
-
-
 def inner_off(robot: Robot, found: Sequence[Family], known: tuple[Family, ...]) -> NDArray[np.bool_]:
     """``(len(found),)``: the families of ``found`` that do not lie on ``known``: one of their members at
-    ``_INNER_PROBES`` of their interval is not a member of any of ``known``."""
+    ``INNER_PROBES`` of their interval is not a member of any of ``known``."""
     if not found:
         return np.zeros(0, dtype=bool)
-    members = [f.at(f.interval[0] + (f.interval[1] - f.interval[0]) * np.array(_INNER_PROBES)) for f in found]
+    members = [f.at(f.interval[0] + (f.interval[1] - f.interval[0]) * np.array(INNER_PROBES)) for f in found]
     return np.array([o.any() for o in off_families(robot, [(m, known) for m in members])], dtype=bool)
 
 
 def _in_interval(th: Array, lo: Array | float, hi: Array | float) -> NDArray[np.bool_]:
     """theta* ``th`` within a family's interval ``[lo, hi]``: a configuration at an end of it is on it."""
-    slack = _MEMBER_TOL * np.maximum(1.0, np.abs(th))
+    slack = MEMBER_TOL * np.maximum(1.0, np.abs(th))
     return np.asarray((th >= lo - slack) & (th <= hi + slack))
 
 
@@ -629,7 +602,7 @@ def unique_families(families: tuple[Family, ...]) -> tuple[Family, ...]:
     probes: list[Array] = []  # members at 5 points of each kept family's interval
     for f in families:
         lo, hi = f.interval
-        tol = _MEMBER_TOL * max(1.0, hi - lo)
+        tol = MEMBER_TOL * max(1.0, hi - lo)
         mine: Array | None = None
         duplicate = False
         for g, g_members in zip(out, probes, strict=True):
@@ -642,19 +615,6 @@ def unique_families(families: tuple[Family, ...]) -> tuple[Family, ...]:
             out.append(f)
             probes.append(f.at(np.linspace(lo, hi, 5)) if mine is None else mine)
     return tuple(out)
-
-
-#: A 6-DOF serial arm has at most 16 isolated IK solutions (a general 6R arm; fewer with prismatic joints). A pose
-#: with more certified, distinct solutions holds a numerical continuum: near a self-motion (e.g. two joint axes
-#: almost coaxial) a whole arc of configurations reproduces the pose to rounding level, the residual's rounding
-#: noise crosses zero along it again and again, and the Newton polish moves every such crossing onto the arc.
-MAX_ISOLATED_SOLUTIONS = 16
-#: On such a pose, solutions closer than this (joint distance, radians; prismatic joints in units of the
-#: paper's 100 mm per radian, see ``trajectory.weighted_joint_distance``) are linked; each linked group is
-#: reported once, by its medoid: the pose pins these solutions down no better than the group's extent.
-CONTINUUM_LINK = 0.05
-#: A pose with more solutions than this is thinned to one per grid cell before they are linked (bounded memory).
-CONTINUUM_THIN = 1024
 
 
 def collapse_continua(robot: Robot, pose: NDArray[np.intp], q: Array) -> NDArray[np.bool_]:

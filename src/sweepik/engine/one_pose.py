@@ -1,5 +1,5 @@
-"""One pose from its chain pose to its final candidates in one compiled call: the search (``fastsweep``'s one-pass
-kernels), the certification (``fastcertify``) and the settling (``dedupe.settle``: limits, duplicates) chained
+"""One pose from its chain pose to its final candidates in one compiled call: the search (``search``'s one-pass
+kernels), the certification (``certify``) and the settling (``dedupe.settle``: limits, duplicates) chained
 (``settle_one``); for a closed form, its all-branch certification and the settling (``settle_closed``).
 
 Each of these, called from Python, costs more in Python steps around its kernel (buffers, argument checks,
@@ -7,7 +7,7 @@ candidate records) than the kernel's own work takes for one pose: ~50 of a C-Arm
 takes every argument, allocates the buffers in compiled code, and calls the kernels by their addresses
 (``kernels.address_of``: they are not linked in and recompiled, so each kernel here compiles in 1-2 s on a fresh
 install). What it cannot settle on its own it says, and the solver takes that pose the general way
-(``solver._solve_chunk``): family spans, a candidate buffer overflow, a multiple root at a limit of theta*, a
+(``chunk.solve_chunk``): family spans, a candidate buffer overflow, a multiple root at a limit of theta*, a
 candidate due a polish or a snap to a limit, a candidate where a continuum may run along another joint
 (``Reduction.continuum_kernel``).
 """
@@ -21,10 +21,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import search
+from sweepik.engine.candidates import unit_grid
 from sweepik.engine.certify import chain_args
 from sweepik.engine.dedupe import duplicate_tolerance, limit_args
 from sweepik.engine.search import AVAILABLE, _plan, writable
-from sweepik.engine.sweep import _unit_grid
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.kernels import (
     CONFIGURATION_SIG,
@@ -48,7 +48,7 @@ DUE = 2
 #: ... or a continuum may run along another joint through a certified one (``Reduction.continuum_joints``) ...
 CONTINUUM = 3
 #: ... or two branches of a closed form meet (one dropped as the other's duplicate, or two kept within the reach
-#: given, ``solver.MEET_REL``): the solver merges them into one solution of higher multiplicity ...
+#: given, ``settings.MEET_REL``): the solver merges them into one solution of higher multiplicity ...
 MEET = 4
 #: ... or a closed form's pose is degenerate, or a step may leave its joint free there (``Reduction.singular_kernel``):
 #: the solver asks ``degenerate`` and ``continuum_joints`` (its fallback sweep, the continua it traces).
@@ -173,7 +173,7 @@ if AVAILABLE:
     ):  # pragma: no cover  # fmt: skip
         """``settle_one``'s kernel: pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``),
         certified and settled; ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped
-        to them (``solver._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of
+        to them (``chunk._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of
         the continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``only_inside``:
         the solutions within the limits only (``_final``)."""
         # (np.empty and explicit loops: np.zeros, slice copies and the like each add to the first compilation)
@@ -349,7 +349,7 @@ def _fixed(
         j = red.free_joint
         head = (addr, one.ints[1], plan.branches, one.margin_branches, one.steps, one.noise)
         limits = np.array([robot.lower[j], robot.upper[j]], dtype=np.float64)
-        middle = (_unit_grid(n_samples), plan.ends, one.twins)
+        middle = (unit_grid(n_samples), plan.ends, one.twins)
         tail = (*_tail(robot, thresholds, reach), c_joints, c_thr)
         return _Fixed(head, middle, limits, tail, one.hint_range)
 

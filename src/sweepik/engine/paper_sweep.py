@@ -11,19 +11,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import certify
+from sweepik.engine.settings import COARSE_STEP_DEG, COARSE_STEP_MM, HALF_WIDTH, LEVELS
 from sweepik.model.pose import pose_error_paper
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit, orientation_weight
 from sweepik.reductions.base import Reduction
 
 Array = NDArray[np.float64]
-
-#: Coarse step of the sweep: 10 mm (prismatic theta*) or 1 degree (revolute theta*).
-COARSE_STEP_MM = 10.0
-COARSE_STEP_DEG = 1.0
-#: Number of refinement levels (each a tenth of the previous step) and steps on each side per level.
-LEVELS = 4
-HALF_WIDTH = 10
 
 
 def _best_error(robot: Robot, red: Reduction, chain: Array, theta: Array, limits: bool) -> tuple[Array, Array]:

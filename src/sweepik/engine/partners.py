@@ -15,7 +15,7 @@ A point found counts as a second solution when the midpoint between the two miss
 and Newton from it goes over to one of them (``PARTNER_STAY``): along a continuum, or a numerical one (a pose a hair
 off a self-motion), it stays where it is; between two roots whose pose error stays below the certification's
 tolerance all the way, Newton ends anywhere between them (those two come from the closed form or the sweep as they
-are: ``solver.MEET_NEAR``).
+are: ``settings.MEET_NEAR``).
 """
 
 from __future__ import annotations
@@ -26,33 +26,22 @@ from numpy.typing import NDArray
 from sweepik.engine.continuation import scaled_singular
 from sweepik.engine.families import golden_least
 from sweepik.engine.polish import geodesic_errors, polished
+from sweepik.engine.settings import (
+    PARTNER_MIDPOINT,
+    PARTNER_NEWTON,
+    PARTNER_ROUNDING,
+    PARTNER_SAME,
+    PARTNER_SINGULAR,
+    PARTNER_STAY,
+    PARTNER_STEPS,
+    VALLEY_REACH,
+    VALLEY_SAMPLES,
+    VALLEY_STEPS,
+)
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import Array, IntArray
 from sweepik.results import joint_distance
-
-#: A solution is probed when its Jacobian's smallest singular value is at most this fraction of its largest (lengths
-#: over the arm's size): across a fold (the pose error ~ a x^2 along the nearly null direction) two roots d apart have
-#: a smallest singular value of ~a d (the CRX-10iA pair, 2e-5 apart: 8.7e-7, a = 0.04), so 1e-4 takes roots up to
-#: ~1e-3 apart on such a fold, and fewer solutions of random poses than 1e-3 (each probe is 8 short Newton runs).
-PARTNER_SINGULAR = 1e-4
-#: Distances along the nearly null direction (radians, or length over the arm's size) Newton starts from, each way.
-PARTNER_STEPS = (1e-6, 1e-5, 1e-4, 1e-3)
-#: Newton steps from each start (it converges in ~5 from next to a root; a start that does not is no partner).
-PARTNER_NEWTON = 12
-#: A point found must solve the pose to the rounding of forward kinematics (this times the arm's size, as
-#: ``solver.MEET_ROUNDING_REL``), not merely within the certification's tolerance: between two roots 3e-4 apart next
-#: to a PUMA 560's elbow fold the pose error stays below 3 % of that tolerance along a curved valley, and Newton ends
-#: anywhere in it (6e-15 of the size); the CRX-10iA's partner: 2e-16.
-PARTNER_ROUNDING = 1e-15
-#: A point found is the solution itself when every joint lies within this of it (radians; relative for a slide).
-PARTNER_SAME = 1e-9
-#: ... and a second solution only when the midpoint between them misses the pose by more than this times the
-#: certification's tolerance (the CRX-10iA pair: 50 times) ...
-PARTNER_MIDPOINT = 4.0
-#: ... and Newton from that midpoint ends within this fraction of their distance of one of them (it goes over to it),
-#: or does not reach the pose.
-PARTNER_STAY = 0.1
 
 
 def nearly_singular(robot: Robot, q: Array) -> NDArray[np.bool_]:
@@ -99,19 +88,6 @@ def close_partners(robot: Robot, q: Array, world: Array, tol: float) -> tuple[In
     near = np.minimum(np.linalg.norm(m - q[k[ok]], axis=-1), np.linalg.norm(m - found[ok], axis=-1))
     ok = ok[(m_err > tol) | (near <= PARTNER_STAY * d)]
     return k[ok].astype(np.intp), found[ok], err[ok]
-
-
-#: A polished solution whose pose error stays above FK rounding (``PARTNER_ROUNDING``) next to a fold lies in a flat
-#: valley of near-solutions (a double root that a near-structure blurs: an I2RT YAM, axes 2-4 parallel to 3e-6 rad,
-#: its polish stopping 1e-5 ... 5e-4 rad from the root at 4e-3 ... 7e-2 of the tolerance). Its lowest point is searched
-#: along the nearly null direction within this reach each way (radians; times the length scale for a slide; the YAM
-#: valley above is certified to 2e-3 each way, 20 times the tolerance at 1e-2) ...
-VALLEY_REACH = 1e-2
-#: ... on this many samples (each corrected by Newton with the joint that direction moves most held), then by golden
-#: section between the neighbours of the least (``families.golden_least``). A valley whose
-#: ends at the reach still solve the pose is a continuum's stretch: no point of it is moved.
-VALLEY_SAMPLES = 41
-VALLEY_STEPS = 30
 
 
 def valley_bottoms(robot: Robot, q: Array, world: Array, tol: float) -> tuple[Array, NDArray[np.bool_]]:

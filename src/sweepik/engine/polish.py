@@ -5,7 +5,7 @@ while theta2 swings through pi within |Pz - d1| ~ |Px|): there a root in theta* 
 leaves ~1e-10 mm of pose error. One or two Newton steps on all six joints remove it. Next to a singular
 configuration (an elbow almost straight) the step is damped: halved until it lowers the error.
 
-With Numba the same steps run compiled (``fastcertify.polish_rows``): the continuation of a traced family corrects a
+With Numba the same steps run compiled (``certify.polish_rows``): the continuation of a traced family corrects a
 few hundred configurations one by one, ~1.5 ms each in NumPy (a shoulder-singular pose of a spherical-wrist arm, four
 families along joint 1: 250-450 ms, now ~55 ms). This NumPy loop is what runs without Numba.
 """
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.engine.settings import PINV_RCOND, PINV_WIDEN
+from sweepik.engine.settings import BACKTRACK, ITERATIONS, PINV_RCOND, PINV_WIDEN
 from sweepik.model import kinematics
 from sweepik.model.pose import pose_error_geodesic
 from sweepik.model.robot import Robot
@@ -41,15 +41,6 @@ def geodesic_errors(robot: Robot, q: Array, target: Array, weight: float) -> Arr
     if AVAILABLE:
         return tool_poses(robot, q, target, weight)[1]
     return pose_error_geodesic(_pose(robot, q), target, weight)
-
-
-#: Newton steps at most (a step that does not lower the error ends a configuration's polish).
-ITERATIONS = 8
-#: A Newton step that raises the error is halved up to this many times (backtracking): next to a fold of the
-#: arm's workspace (an elbow nearly straight) the full step overshoots, a shorter one converges. Where the arm loses
-#: two ranks (a KR 6 with its wrist centre on axis 1 and its elbow straight) the step from a member interpolated
-#: between traced ones points far along the nearly null direction: 8 halvings never got below its 6e-5 error, 20 do.
-BACKTRACK = 20
 
 
 def polish(
@@ -129,5 +120,5 @@ def polished(
 
 
 def _pose(robot: Robot, q: Array) -> Array:
-    """World tool poses (the NumPy path: with Numba the compiled ``fastcertify`` kernels are used instead)."""
+    """World tool poses (the NumPy path: with Numba the compiled ``certify`` kernels are used instead)."""
     return kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool

@@ -22,10 +22,11 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from sweepik.engine.candidates import Spans, sample_grid
 from sweepik.engine.continuation import continuum_families, correct
 from sweepik.engine.families import off_families
 from sweepik.engine.polish import geodesic_errors
-from sweepik.engine.sweep import FAMILY_MIN_RUN, Spans, sample_grid
+from sweepik.engine.sweep import FAMILY_MIN_RUN
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import Array, IntArray, Reduction
@@ -45,7 +46,7 @@ def rough_continua(
     tol: float,
 ) -> tuple[dict[int, list[Family]], IntArray, Array, Spans]:
     """The continua along ``red``'s theta* of the chain poses ``chain (N, 4, 4)`` (world poses ``world``) on their
-    sample grids over ``[lo, hi]`` (``sweep.sample_grid``), traced: ``(families per pose, pose index, q, masked)``,
+    sample grids over ``[lo, hi]`` (``candidates.sample_grid``), traced: ``(families per pose, pose index, q, masked)``,
     the pose index and ``q`` of the isolated members ``continuum_families`` gives (pieces shrinking to a point at the
     limits) and ``masked``, the stretches of theta* (per pose and branch) where the branch's member is a traced
     family's member or a solution outside the limits: a search there finds nothing else. ``near``: the pose error
@@ -117,7 +118,7 @@ def _stretches(mask: NDArray[np.bool_], theta: Array) -> Spans:
 
 
 class RoughRedo:
-    """``fastsweep.search``'s ``before_redo`` for a chunk of poses: the rough continua of the poses it redoes
+    """``search.search``'s ``before_redo`` for a chunk of poses: the rough continua of the poses it redoes
     (``rough_continua`` on them), kept in the chunk's pose numbering (``families``, and ``pose``, ``q`` of the isolated
     members), their stretches returned for the search to leave out."""
 

@@ -29,8 +29,37 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sweepik._jit import ERROR_MODEL, alive, inlined, internal, unowned
-from sweepik.engine import parallel
+from sweepik.engine import candidates, parallel
 from sweepik.engine import sweep as _ref
+from sweepik.engine.settings import (
+    BEND,
+    CLUSTER_FAMILY_REL,
+    DIFF_LEVELS,
+    DIFF_SHRINK,
+    DIFF_STEP_REL,
+    EDGE_PROBE_REL,
+    EXTREMUM_REACH,
+    FAMILY_BISECT,
+    FAMILY_MIN_RUN,
+    FAMILY_TOL,
+    FAR_NOISE,
+    FLAT_BISECT,
+    FLAT_MAX_REL,
+    FLAT_PROBE_REL,
+    FLAT_SHORT_TOL,
+    JUMP_NOISE,
+    MAX_CAND,
+    MAX_FAM,
+    MAX_LEVELS,
+    MULT_LEVEL,
+    MULT_MAX,
+    PARALLEL_MIN,
+    STACK,
+    SUB_SAMPLES,
+    U_EDGE,
+    U_UNIFORM,
+    XTOL_REL,
+)
 from sweepik.errors import UnknownOptionError
 from sweepik.reductions.base import overridden_below_kernel
 from sweepik.reductions.kernels import address_of, lazy_njit, owned_kernel
@@ -46,37 +75,6 @@ except ImportError:  # pragma: no cover - exercised only without numba
 
 Array = NDArray[np.float64]
 
-FAMILY_TOL = _ref.FAMILY_TOL
-FAMILY_MIN_RUN = _ref.FAMILY_MIN_RUN
-FAMILY_BISECT = _ref.FAMILY_BISECT
-SUB = _ref.SUB_SAMPLES
-MAX_LEVELS = _ref.MAX_LEVELS
-BEND = _ref.BEND
-XTOL_REL = _ref.XTOL_REL
-DIFF_STEP_REL = _ref.DIFF_STEP_REL
-DIFF_SHRINK = _ref.DIFF_SHRINK
-DIFF_LEVELS = _ref.DIFF_LEVELS
-EXTREMUM_REACH = _ref.EXTREMUM_REACH
-CLUSTER_FAMILY_REL = _ref.CLUSTER_FAMILY_REL
-FLAT_PROBE_REL = _ref.FLAT_PROBE_REL
-FLAT_MAX_REL = _ref.FLAT_MAX_REL
-FLAT_BISECT = _ref.FLAT_BISECT
-FLAT_SHORT_TOL = _ref.FLAT_SHORT_TOL
-JUMP_NOISE = _ref.JUMP_NOISE
-MULT_LEVEL = _ref.MULT_LEVEL
-MULT_MAX = _ref.MULT_MAX
-FAR_NOISE = _ref.FAR_NOISE
-EDGE_PROBE_REL = _ref.EDGE_PROBE_REL
-#: Candidates and family spans kept per pose (the C-Arm has at most 8 rail positions; edges and near misses add
-#: candidates). Overflow is reported and the pose is redone by the NumPy engine.
-MAX_CAND = 256
-MAX_FAM = 16
-#: Pending resampled intervals per pose and branch (depth-first, so a few dozen suffice).
-STACK = 512
-#: Batches at least this large are searched with parallel threads.
-PARALLEL_MIN = 64
-_U_UNIFORM = _ref._U_UNIFORM
-_U_EDGE = _ref._U_EDGE
 
 if AVAILABLE:
 
@@ -244,7 +242,7 @@ if AVAILABLE:
             # root of the central difference g(x) = f(x + h) - f(x - h)
             xe = _root_diff(res, p, b, a, c, ga, gc, h)
             if level == 0 and (1.0 if fc > 0 else -1.0) * res(p, xe, b) > FAR_NOISE * noise:
-                return  # located far from zero on fc's side: neither root nor touching (sweep.FAR_NOISE)
+                return  # located far from zero on fc's side: neither root nor touching (settings.FAR_NOISE)
         fx = res(p, xe, b)
         if math.isnan(fx):
             return
@@ -369,7 +367,7 @@ if AVAILABLE:
     @inlined
     def _edge_samples(b, th, f, valid, level, fmask, noise, out_t, out_b, cnt):
         """``_scan``'s samples next to a domain edge (or at the range ends, level 0) that are candidates: near zero,
-        or next to a family's samples (``fmask``: ``sweep.FAR_NOISE``)."""
+        or next to a family's samples (``fmask``: ``settings.FAR_NOISE``)."""
         M = th.shape[0]
         for j in range(M):
             if not valid[j]:
@@ -452,23 +450,23 @@ if AVAILABLE:
                     continue
                 us = _U_EDGE_ARR if near_edge else _U_UNIFORM_ARR
                 k0 = top[0]
-                for k in range(SUB + 2):
+                for k in range(SUB_SAMPLES + 2):
                     stk_t[k0, k] = th[j] + (th[j + 1] - th[j]) * us[k]
                 stk_f[k0, 0] = f[j]
-                stk_f[k0, SUB + 1] = f[j + 1]
+                stk_f[k0, SUB_SAMPLES + 1] = f[j + 1]
                 # the uniform grid is every branch's, and a domain edge is usually every branch's too: the sub-samples
                 # of an interval next to one are evaluated for all branches at once (the same values); so are those of
                 # an interval that a branch still to come bends in too (the all-branch kernel costs less than two)
                 s = 0 if near_edge else 1
                 if level == 0 and n_all > 0 and (near_edge or edge_ok[1, j] or _bends_later(f_all, th, later, j)):
                     if not edge_ok[s, j]:
-                        for k in range(1, SUB + 1):
+                        for k in range(1, SUB_SAMPLES + 1):
                             res_all(p, stk_t[k0, k], edge_f[s, j, k])
                         edge_ok[s, j] = True
-                    for k in range(1, SUB + 1):
+                    for k in range(1, SUB_SAMPLES + 1):
                         stk_f[k0, k] = edge_f[s, j, k, b]
                 else:
-                    for k in range(1, SUB + 1):
+                    for k in range(1, SUB_SAMPLES + 1):
                         stk_f[k0, k] = res(p, stk_t[k0, k], b)
                 stk_i[k0, 0] = level + 1
                 stk_i[k0, 1] = 1 if open_l else 0
@@ -604,14 +602,14 @@ if AVAILABLE:
         edge coordinates of a sequence. Explicit loops rather than np.zeros, np.full, slice copies or np.argsort:
         each of those adds to the first compilation (docs/performance.md)."""
         c = np.empty(1, dtype=np.int64)
-        stk_t = np.empty((STACK, SUB + 2))
-        stk_f = np.empty((STACK, SUB + 2))
+        stk_t = np.empty((STACK, SUB_SAMPLES + 2))
+        stk_f = np.empty((STACK, SUB_SAMPLES + 2))
         stk_i = np.empty((STACK, 3), dtype=np.int64)
         stk_c = np.empty((STACK, 5))
         no_ctx = np.empty(4)
         for k in range(4):
             no_ctx[k] = np.nan
-        W = M if M > SUB + 2 else SUB + 2
+        W = M if M > SUB_SAMPLES + 2 else SUB_SAMPLES + 2
         return c, stk_t, stk_f, stk_i, stk_c, no_ctx, np.empty(W, dtype=np.bool_), np.empty(W)
 
     @inlined
@@ -621,13 +619,13 @@ if AVAILABLE:
         samples and of the sub-samples of level-0 intervals (``_scan``) with which of those are known, one branch's
         residuals, the stack's top, the candidates' probes, the samples masked as a family's."""
         nb_all = n_all if n_all > 1 else 1
-        buf_t, buf_f, buf_c = np.empty(SUB + 2), np.empty(SUB + 2), np.empty(4)
-        f_all, edge_f = np.empty((M, nb_all)), np.empty((2, M, SUB + 1, nb_all))
+        buf_t, buf_f, buf_c = np.empty(SUB_SAMPLES + 2), np.empty(SUB_SAMPLES + 2), np.empty(4)
+        f_all, edge_f = np.empty((M, nb_all)), np.empty((2, M, SUB_SAMPLES + 1, nb_all))
         edge_ok, f, top = np.empty((2, M), dtype=np.bool_), np.empty(M), np.empty(1, dtype=np.int64)
         return buf_t, buf_f, buf_c, f_all, edge_f, edge_ok, f, top, np.empty((K, 2)), np.empty(M, dtype=np.bool_)
 
-    _U_UNIFORM_ARR = _U_UNIFORM.copy()
-    _U_EDGE_ARR = _U_EDGE.copy()
+    _U_UNIFORM_ARR = U_UNIFORM.copy()
+    _U_EDGE_ARR = U_EDGE.copy()
 
     from numba import boolean, float64, int64
 
@@ -729,7 +727,7 @@ if AVAILABLE:
                         break
                     top[0] -= 1
                     k0 = top[0]
-                    for k in range(SUB + 2):  # copied: the scan pushes its own intervals from k0 on
+                    for k in range(SUB_SAMPLES + 2):  # copied: the scan pushes its own intervals from k0 on
                         buf_t[k] = stk_t[k0, k]
                         buf_f[k] = stk_f[k0, k]
                     for k in range(4):
@@ -767,8 +765,9 @@ if AVAILABLE:
 
     @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
     def _merge_grid(lo, hi, s, hints, out, count, start, stop):
-        """``sweep.merge_grid`` for poses ``start .. stop - 1`` into ``out (N, n + H)`` and ``count (N,)``, element by
-        element (the same arithmetic), but for the NaN hints: none of a pose's samples (see ``sample_grid``)."""
+        """``candidates.merge_grid`` for poses ``start .. stop - 1`` into ``out (N, n + H)`` and ``count (N,)``,
+        element by element (the same arithmetic), but for the NaN hints: none of a pose's samples (see
+        ``sample_grid``)."""
         for i in range(start, stop):
             count[i] = _merge_row(lo[i], hi[i], s, hints[i], out[i], True)
 
@@ -776,7 +775,8 @@ if AVAILABLE:
     def _hinted_grid(hints, params, ends, periodic, lo, hi, s, out, start, stop):
         """``sample_grid`` for poses ``start .. stop - 1`` of a reduction with a hints kernel (its address
         ``hints``): the pose's hints, then ``ends`` (theta*'s limits, for a non-periodic theta*), wrapped into
-        [-pi, pi] for a periodic one, as ``sweep.grid_hints``; merged as ``sweep.merge_grid`` (a kernel writes as
+        [-pi, pi] for a periodic one, as ``candidates.grid_hints``; merged as ``candidates.merge_grid`` (a kernel
+        writes as
         many hints for every pose: a NaN one is a spare sample, as in the reference)."""
         fn = as_hints(hints)
         H = out.shape[1] - s.shape[0]
@@ -919,7 +919,7 @@ if AVAILABLE:
     @inlined
     def _with_ends(row, k, ends, periodic):
         """theta*'s ``ends`` after the first ``k`` samples of ``row``, and all of them wrapped into [-pi, pi] for a
-        periodic theta*, as ``sweep.grid_hints`` gives them: their new number."""
+        periodic theta*, as ``candidates.grid_hints`` gives them: their new number."""
         for j in range(ends.shape[0]):
             row[k] = ends[j]
             k += 1
@@ -931,7 +931,8 @@ if AVAILABLE:
     @inlined
     def _twin_copies(out_t, out_b, out_m, cnt, i, twins):
         """Pose ``i``'s candidates on the first branch of a class of twins, copied to the class's other branches
-        after its own, class member by member (``twins``: ``sweep.twin_maps``), as ``sweep.twin_candidates`` copies
+        after its own, class member by member (``twins``: ``candidates.twin_maps``), as ``candidates.twin_candidates``
+        copies
         them; its count runs past the buffer if they do not fit (the pose is then redone)."""
         n0 = cnt[i]
         if n0 > out_t.shape[1]:
@@ -1056,7 +1057,7 @@ class EdgeSearch(NamedTuple):
     amplitudes: int
     steps: NDArray[np.int64]  # the steps whose amplitudes it examines
     n_swing: int  # the samples it writes per pose, at most
-    n_samples: int  # its grid's samples (the sweep's default: ``sweep.N_SAMPLES``)
+    n_samples: int  # its grid's samples (the sweep's default: ``settings.N_SAMPLES``)
     hint_range: Any  # ``hint_range(reduction, poses) -> (lo, hi)``: theta*'s range its hints are sought over
     # (a function, not a bound method: the engine keeps its plan while the reduction lives, and no longer)
     # the address of a kernel computing the residuals and the margins at once (``kernels.RESIDUALS_SIG``: the
@@ -1074,7 +1075,8 @@ def writable(a: ArrayLike) -> Array:
 def sample_grid(
     reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None
 ) -> tuple[Array, NDArray[np.int64]]:
-    """:func:`sweepik.engine.sweep.sample_grid`, the merge compiled (for a single pose its NumPy steps cost ~80 us), and
+    """:func:`sweepik.engine.candidates.sample_grid`, the merge compiled (for a single pose its NumPy steps cost ~80
+    us), and
     the hints too where the reduction has a hints kernel (``Reduction.kernel_hints``; ``params``: its
     ``kernel_params(poses)``, if at hand). Returns ``(grid (N, M), count (N,))``: pose i's samples are the first
     ``count[i]`` of its row.
@@ -1098,13 +1100,13 @@ def sample_grid(
             plan.periodic,
             np.ascontiguousarray(lo, dtype=np.float64),
             np.ascontiguousarray(hi, dtype=np.float64),
-            _ref._unit_grid(n_samples),
+            candidates.unit_grid(n_samples),
             out,
         )
         return out, np.full(N, out.shape[1], dtype=np.int64)
-    hints = _ref.grid_hints(reduction, poses)
+    hints = candidates.grid_hints(reduction, poses)
     if not AVAILABLE:
-        grid = _ref.merge_grid(lo, hi, n_samples, hints)
+        grid = candidates.merge_grid(lo, hi, n_samples, hints)
         return grid, np.full(N, grid.shape[1], dtype=np.int64)
     if hints is None:
         hints = np.empty((N, 0))
@@ -1116,7 +1118,7 @@ def sample_grid(
         PARALLEL_MIN * 16,
         np.ascontiguousarray(lo, dtype=np.float64),
         np.ascontiguousarray(hi, dtype=np.float64),
-        _ref._unit_grid(n_samples),
+        candidates.unit_grid(n_samples),
         np.ascontiguousarray(hints, dtype=np.float64),
         out,
         count,
@@ -1149,7 +1151,7 @@ class _OnePass(NamedTuple):
     noise: Array  # the search's residual noise and the margins'
     n_samples: int | None  # the only sample count it takes (None: any)
     hint_range: Any  # ``EdgeSearch.hint_range``; None: the search's range
-    twins: NDArray[np.int64]  # ``sweep.twin_maps`` of the reduction, one row each (none: no twins)
+    twins: NDArray[np.int64]  # ``candidates.twin_maps`` of the reduction, one row each (none: no twins)
 
 
 _PLANS: weakref.WeakKeyDictionary[object, _Plan] = weakref.WeakKeyDictionary()
@@ -1205,7 +1207,7 @@ def _one_pass(red, plan: _Plan) -> _OnePass | None:
     ints[_E_RES], ints[_E_RES_ALL], ints[_E_N_ALL] = plan.residual, plan.residuals, plan.n_all
     ints[_E_PERIODIC] = plan.periodic
     noise = np.array([red.residual_noise, 0.0], dtype=np.float64)
-    maps = _ref.twin_maps(red)
+    maps = candidates.twin_maps(red)
     twins = np.array(maps, dtype=np.int64) if maps else np.zeros((0, max(int(red.n_branches), 1)), dtype=np.int64)
     if plan.hints is not None:
         ints[_E_HINTS], ints[_E_N_HINTS] = plan.hints, plan.n_hints
@@ -1269,14 +1271,14 @@ def search(
     params: Array | None = None,
     multiplicity: bool = True,
     one_pass: bool = True,
-    before_redo: Callable[[NDArray[np.intp]], _ref.Spans] | None = None,
+    before_redo: Callable[[NDArray[np.intp]], candidates.Spans] | None = None,
 ):
     """Candidates and family spans, as :func:`sweepik.engine.sweep.find_candidates`, computed by the kernel.
     Poses whose candidate or family buffers overflow are redone by the NumPy engine; ``before_redo(idx)`` gives the
     stretches of those poses (``idx``) it leaves out (``find_candidates``' ``masked``). ``multiplicity`` False: the
     candidates' multiplicities are not wanted (each is given as 1; ~4 residuals a candidate less). The candidates
     and spans of the first branch of each class of ``reduction.twins`` are given to the others too
-    (``sweep.twin_copies``). A reduction with a hints kernel or an ``EdgeSearch`` finds each pose's samples and
+    (``candidates.twin_copies``). A reduction with a hints kernel or an ``EdgeSearch`` finds each pose's samples and
     candidates, twins' copies included, in one compiled pass, unless ``one_pass`` is False: then ``sample_grid``
     gives the samples of every pose first (the same samples: the tests compare the two)."""
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
@@ -1297,13 +1299,13 @@ def search(
     if N == 1 and cnt[0] <= MAX_CAND and fcnt[0] == 0 and (redo is None or not redo[0]):
         # (a single pose: the general bookkeeping costs ~40 us)
         k0 = int(cnt[0])
-        single = _ref.Candidates(
+        single = candidates.Candidates(
             pose=np.zeros(k0, dtype=np.intp),
             branch=out_b[0, :k0].astype(np.intp),
             theta=out_t[0, :k0].copy(),
             mult=out_m[0, :k0].astype(np.intp),
         )
-        return (single if one is not None else _ref.twin_candidates(reduction, single)), _ref.Spans.empty()
+        return (single if one is not None else candidates.twin_candidates(reduction, single)), candidates.Spans.empty()
     over = (cnt > MAX_CAND) | (fcnt > MAX_FAM)
     if redo is not None:
         over |= redo
@@ -1314,26 +1316,28 @@ def search(
         masked = None if before_redo is None else before_redo(idx)
         c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples, masked)
         if one is not None:  # (the one-pass kernels copied the others' candidates to their twins)
-            c2 = _ref.twin_candidates(reduction, c2)
-        cand = _ref.Candidates(
+            c2 = candidates.twin_candidates(reduction, c2)
+        cand = candidates.Candidates(
             np.concatenate([cand.pose, idx[c2.pose]]),
             np.concatenate([cand.branch, c2.branch]),
             np.concatenate([cand.theta, c2.theta]),
             np.concatenate([cand.mult, c2.mult]),
         )
-        spans = _ref.Spans.concat([spans, _ref.Spans(idx[s2.pose].astype(np.intp), s2.branch, s2.lo, s2.hi)])
-    cand = _ref.Candidates(
+        spans = candidates.Spans.concat(
+            [spans, candidates.Spans(idx[s2.pose].astype(np.intp), s2.branch, s2.lo, s2.hi)]
+        )
+    cand = candidates.Candidates(
         pose=cand.pose.astype(np.intp),
         branch=cand.branch.astype(np.intp),
         theta=cand.theta,
         mult=cand.mult.astype(np.intp),
     )
     if one is None:
-        return _ref.twin_copies(reduction, cand, spans)
-    if redone and reduction.twins:  # the redone poses in their place, as ``sweep.twin_candidates`` puts them
+        return candidates.twin_copies(reduction, cand, spans)
+    if redone and reduction.twins:  # the redone poses in their place, as ``candidates.twin_candidates`` puts them
         order = np.argsort(cand.pose, kind="stable")
-        cand = _ref.Candidates(cand.pose[order], cand.branch[order], cand.theta[order], cand.mult[order])
-    return cand, _ref.twin_spans(reduction, spans)
+        cand = candidates.Candidates(cand.pose[order], cand.branch[order], cand.theta[order], cand.mult[order])
+    return cand, candidates.twin_spans(reduction, spans)
 
 
 @dataclass
@@ -1383,7 +1387,7 @@ def _run_one_pass(reduction, plan, one, poses, params, lo, hi, n_samples, multip
         hhi,
         lo,
         hi,
-        _ref._unit_grid(n_samples),
+        candidates.unit_grid(n_samples),
         plan.ends,
         one.twins,
         out.t,
@@ -1425,15 +1429,15 @@ def _run_search(reduction, plan, params, theta, n_theta, lo, hi, multiplicity, o
     )
 
 
-def _gathered(out: _Out, over: NDArray[np.bool_]) -> tuple[_ref.Candidates, _ref.Spans]:
+def _gathered(out: _Out, over: NDArray[np.bool_]) -> tuple[candidates.Candidates, candidates.Spans]:
     """The candidates and family spans of the poses that did not overflow (``over``), pose by pose."""
     counts = np.where(over, 0, out.cnt)
     pose_idx = np.repeat(np.arange(over.size), counts)
     slot = np.arange(pose_idx.size) - np.repeat(np.cumsum(counts) - counts, counts)
-    cand = _ref.Candidates(pose_idx, out.b[pose_idx, slot], out.t[pose_idx, slot], out.m[pose_idx, slot])
-    spans = _ref.Spans.empty()
+    cand = candidates.Candidates(pose_idx, out.b[pose_idx, slot], out.t[pose_idx, slot], out.m[pose_idx, slot])
+    spans = candidates.Spans.empty()
     if out.fcnt.any():
         fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(out.fcnt, MAX_FAM)[:, None]) & ~over[:, None])
         fam = out.fam
-        spans = _ref.Spans(fp.astype(np.intp), fam[fp, fs, 2].astype(np.intp), fam[fp, fs, 0], fam[fp, fs, 1])
+        spans = candidates.Spans(fp.astype(np.intp), fam[fp, fs, 2].astype(np.intp), fam[fp, fs, 0], fam[fp, fs, 1])
     return cand, spans

@@ -224,7 +224,7 @@ def _new_rows(
 
 def errors_of(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array, Array]:
     """Geodesic error and the paper's J ``(K,)`` of configurations ``q (K, n)`` against ``target (K, 4, 4)``:
-    compiled as certification computes them (``fastcertify.pose_errors``), else in NumPy."""
+    compiled as certification computes them (``certify.pose_errors``), else in NumPy."""
     if certify.AVAILABLE:
         return certify.pose_errors(robot, q, target, weight)
     T = certify.flange_poses(robot, q) @ robot.T_flange_tool

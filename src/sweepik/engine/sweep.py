@@ -25,199 +25,44 @@ configurations, certifies each by forward kinematics and applies limits.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import lru_cache
-
 import numpy as np
 from numpy.typing import NDArray
 
+from sweepik.engine.candidates import (
+    Candidates,
+    Spans,
+    sample_grid,
+)
 from sweepik.engine.rootfind import find_roots
+from sweepik.engine.settings import (
+    BEND,
+    CLUSTER_FAMILY_REL,
+    DIFF_LEVELS,
+    DIFF_SHRINK,
+    DIFF_STEP_REL,
+    EDGE_PROBE_REL,
+    EXTREMUM_REACH,
+    FAMILY_BISECT,
+    FAMILY_MIN_RUN,
+    FAMILY_TOL,
+    FAR_NOISE,
+    FLAT_BISECT,
+    FLAT_MAX_REL,
+    FLAT_PROBE_REL,
+    FLAT_SHORT_TOL,
+    JUMP_NOISE,
+    MAX_LEVELS,
+    MULT_LEVEL,
+    MULT_MAX,
+    N_SAMPLES,
+    U_EDGE,
+    U_UNIFORM,
+    XTOL_REL,
+)
 from sweepik.model import kinematics
 from sweepik.model.pose import pose_error_geodesic
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import Array, IntArray, Reduction
-
-#: Default number of uniform samples of theta* over its range (hints and refinements come on top).
-#: Checked against an independent polynomial solver (tests/carm_oracle.py) and against dense sampling.
-N_SAMPLES = 64
-#: Samples per refined interval, and the number of refinement levels (resolution: step / SUB**LEVELS).
-SUB_SAMPLES = 8
-MAX_LEVELS = 4
-#: An interval is resampled when min(|f_i|, |f_i+1|) <= BEND * |f''| h^2 (a parabola dips h^2 |f''| / 8
-#: below its chord: BEND = 1 leaves a factor 8 for curvature varying within the step). Next to a domain edge
-#: (square-root behaviour: no curvature estimate in theta) curvature is judged in the coordinate
-#: sqrt(|theta - edge|), in which the residual is smooth (``_edge_coordinate``), and the interval is resampled only
-#: where that test says so; at the first level only where the edge sits at a sample (``EDGE_PROBE_REL``), else
-#: always.
-BEND = 1.0
-#: An interior extremum of |residual| is examined only if its sample is within EXTREMUM_REACH |f''| h^2 of
-#: zero: 8 times the deepest dip a parabola through the three samples can have (|f''| h^2 / 2).
-EXTREMUM_REACH = 4.0
-_U_UNIFORM = np.linspace(0.0, 1.0, SUB_SAMPLES + 2)
-_U_EDGE = 0.5 * (1.0 - np.cos(np.pi * _U_UNIFORM))
-#: |residual| at or below which a sample counts as lying on a self-motion family (residuals are computed to
-#: ~1e-15; an isolated root makes three consecutive samples this small only with probability ~0). No looser: a
-#: pose a hair off a self-motion (theta5 = 1e-9 at theta2 = 90 deg on the C-Arm) has a residual of that hair's
-#: size along the whole former family, with isolated roots in it that a looser threshold would hide, while its
-#: members miss the pose by more than the FK acceptance (about 1e-12 rad of orientation).
-FAMILY_TOL = 1e-12
-#: Roots of one branch joined by a stretch where the residual stays at rounding noise form a cluster; a
-#: cluster longer than this fraction of the theta* range is reported as a family (a numerical continuum:
-#: every point of it solves the pose to rounding precision), a shorter one as its midpoint. A double root
-#: (f ~ c x^2) is flat at noise level over ~2 sqrt(1e-16 / c), about 1e-8 of the range: far shorter.
-CLUSTER_FAMILY_REL = 1e-5
-#: Probe distance (relative to the range) deciding whether a root sits in a flat stretch of the residual,
-#: the largest half-width searched for such a stretch, and bisection steps locating its ends.
-FLAT_PROBE_REL = 1e-9
-FLAT_MAX_REL = 1e-2
-FLAT_BISECT = 30
-#: ... but a stretch too short to be a family (it marks a root of high multiplicity, see ``_center_flat``) only
-#: to this fraction of its half-width: its centre is the root, and rounding leaves the root undetermined across
-#: the whole stretch anyway (2^-12; 30 halvings would pin the ends to 1e-9 of it).
-FLAT_SHORT_TOL = 2.0**-12
-#: Bisection steps locating where a family ends between its last sample and the next one.
-FAMILY_BISECT = 40
-#: Minimum number of consecutive vanishing samples that make a family.
-FAMILY_MIN_RUN = 3
-#: A flat stretch (|residual| within the noise around a root) ends where the residual leaves the noise. It
-#: leaves it *smoothly* next to an isolated root of high multiplicity (just past the end |f| is barely above
-#: the noise) and by a *jump* (a branch swap) or at a domain edge (NaN) where a continuum ends: a residual
-#: analytic along a branch that vanishes on an interval vanishes up to such an end. |f| above JUMP_NOISE x noise
-#: just past the end counts as a jump.
-JUMP_NOISE = 1e3
-#: Multiplicity of a root: from the growth of |f| away from it, measured where |f| first exceeds
-#: MULT_LEVEL x noise (on either side), comparing |f| at distances d and 2 d (ratio 2^m for a root of order m).
-MULT_LEVEL = 1e4
-#: Largest multiplicity reported (rounding decides nothing finer).
-MULT_MAX = 8
-#: A located extremum of |residual| whose |residual| exceeds FAR_NOISE x the residual's noise (on the side of its
-#: samples) is not a candidate: 1e-2 for residuals of O(1) sines and cosines (noise 1e-14; C-Arm: the sine of the
-#: wrist's misalignment), 1e-2 of the arm's size for the pose-error residual; far above what certification
-#: (2e-13 of the arm's size) or the Newton polish (candidates within 1e-6 of it) accept. Extrema found that far
-#: after their first location are not located further. Samples next to a domain edge or at the range's ends
-#: farther from zero are no candidates either; next to a family's samples (masked as NaN) they stay candidates
-#: whatever their residual: their flat-stretch probe can join two pieces of the family.
-FAR_NOISE = 1e12
-#: A domain edge sits at a sample (a generic sweep's margins' zeros are samples) when its branch's residual is not
-#: finite this far past it (relative to the theta* range): the first level then judges the interval beside it in that
-#: edge's coordinate, as the levels below do (``BEND``).
-EDGE_PROBE_REL = 1e-9
-#: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
-XTOL_REL = 1e-16
-#: Half-step of the central difference used to locate extrema, relative to the theta* range.
-#: Balances rounding (1e-16 / h) against truncation (h^2): the extremum lands within ~1e-8 of the range.
-DIFF_STEP_REL = 1e-7
-#: The extremum is then relocated with steps DIFF_SHRINK and DIFF_SHRINK^2 times smaller (DIFF_LEVELS in all).
-DIFF_SHRINK = 16.0
-DIFF_LEVELS = 3
-
-
-@dataclass(frozen=True)
-class Candidates:
-    """Flat candidate list: pose index, branch, theta* value and the root's multiplicity (1 for a simple root,
-    2 where two solutions merge, ...), for ``K`` candidates."""
-
-    pose: IntArray
-    branch: IntArray
-    theta: Array
-    mult: IntArray
-
-
-@dataclass(frozen=True)
-class Spans:
-    """Runs of theta* along which a branch of a pose solves the pose identically (self-motion families): pose
-    index, branch and the run's ends ``[lo, hi]``, for ``K`` runs (arrays: a batch has thousands of them)."""
-
-    pose: IntArray
-    branch: IntArray
-    lo: Array
-    hi: Array
-
-    @staticmethod
-    def empty() -> Spans:
-        """No spans (one shared instance, its arrays read-only: most sweeps find none)."""
-        return _NO_SPANS
-
-    @staticmethod
-    def concat(parts: list[Spans]) -> Spans:
-        if len(parts) == 1:
-            return parts[0]
-        return Spans(
-            np.concatenate([s.pose for s in parts]).astype(np.intp),
-            np.concatenate([s.branch for s in parts]).astype(np.intp),
-            np.concatenate([s.lo for s in parts]).astype(np.float64),
-            np.concatenate([s.hi for s in parts]).astype(np.float64),
-        )
-
-    def __len__(self) -> int:
-        return int(self.pose.size)
-
-
-def _no_spans() -> Spans:
-    arrays = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0), np.zeros(0))
-    for a in arrays:
-        a.flags.writeable = False
-    return Spans(*arrays)
-
-
-_NO_SPANS = _no_spans()
-
-
-@lru_cache(maxsize=8)
-def _unit_grid(n: int) -> Array:
-    return np.linspace(0.0, 1.0, n)
-
-
-def grid_hints(reduction: Reduction, poses: Array) -> Array | None:
-    """The samples ``(N, H)`` that ``sample_grid`` adds to the uniform grid (NaN: none): the reduction's hints and,
-    for a non-periodic theta*, its limits (a solution exactly at a limit, a rail end, is then a sample); for a
-    periodic theta* wrapped into [-pi, pi]."""
-    hints = reduction.sample_hints(poses)
-    if not reduction.periodic:
-        j = reduction.free_joint
-        ends = np.empty((poses.shape[0], 2))
-        ends[:, 0], ends[:, 1] = reduction.robot.lower[j], reduction.robot.upper[j]
-        hints = ends if hints is None else np.concatenate([hints, ends], axis=1)
-    if hints is not None and hints.size and reduction.periodic:
-        hints = np.pi - np.mod(np.pi - hints, 2.0 * np.pi)
-    return hints
-
-
-def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
-    """Sorted theta* samples ``(N, M)``: a uniform grid on [lo, hi] plus the reduction's hints inside it
-    (``grid_hints``; :func:`sweepik.engine.search.sample_grid` is the compiled version)."""
-    return merge_grid(lo, hi, n_samples, grid_hints(reduction, poses))
-
-
-def merge_grid(lo: Array, hi: Array, n_samples: int, hints: Array | None) -> Array:
-    """``sample_grid`` from the hints: the uniform grid, the hints inside [lo, hi], sorted, repeats spread."""
-    s = _unit_grid(n_samples)
-    grid = lo[:, None] + (hi - lo)[:, None] * s[None, :]
-    if hints is not None and hints.size:
-        inside = np.isfinite(hints) & (hints >= lo[:, None]) & (hints <= hi[:, None])
-        # a hint outside the range becomes a midpoint of the uniform grid (a distinct, harmless extra sample)
-        spare = lo[:, None] + (hi - lo)[:, None] * ((np.arange(hints.shape[1]) + 0.5) / (n_samples - 1))[None, :]
-        hints = np.where(inside, hints, spare)
-        grid = np.concatenate([grid, hints], axis=1)
-    grid = np.sort(grid, axis=1)
-    # a sample repeated (a hint on the grid, hints outside the range all set to lo) would leave zero-width
-    # intervals, where the three-sample extremum test cannot work (a double root exactly at that sample would go
-    # unseen): each run of equal samples is spread evenly towards the next distinct sample
-    new_run = np.ones(grid.shape, dtype=bool)
-    new_run[:, 1:] = grid[:, 1:] > grid[:, :-1]
-    if new_run.all():
-        return grid
-    M = grid.shape[1]
-    idx = np.broadcast_to(np.arange(M), grid.shape)
-    start = np.maximum.accumulate(np.where(new_run, idx, 0), axis=1)
-    nxt = np.full(grid.shape, M)
-    nxt[:, :-1] = np.minimum.accumulate(np.where(new_run, idx, M)[:, :0:-1], axis=1)[:, ::-1]
-    r_i, r_j = np.nonzero(~new_run & (nxt < M))
-    if r_i.size:
-        s0, e0 = start[r_i, r_j], nxt[r_i, r_j]
-        base = grid[r_i, s0]
-        grid[r_i, r_j] = base + (grid[r_i, e0] - base) * (r_j - s0) / (e0 - s0)
-    return grid
 
 
 def _edge_coordinate(theta: Array, edge: Array) -> Array:
@@ -448,7 +293,7 @@ class _Search:
         """The intervals ``(r_i, r_j)`` resampled and scanned one level down."""
         M = th.shape[1]
         # uniform sub-samples; next to a domain edge (square-root behaviour) clustered towards both ends
-        u = np.where(near_edge[r_i, r_j, None], _U_EDGE[None, :], _U_UNIFORM[None, :])
+        u = np.where(near_edge[r_i, r_j, None], U_EDGE[None, :], U_UNIFORM[None, :])
         sub = th[r_i, r_j, None] + (th[r_i, r_j + 1] - th[r_i, r_j])[:, None] * u
         pp, bb = p[r_i], b[r_i]
         fs = self.residual(pp, bb, sub)
@@ -798,76 +643,3 @@ def find_candidates(
     search.scan(p, b, theta[p], fs, vs, 0, family=fam if fam.any() else None)
     cand = search.finish()
     return cand, Spans.concat([spans, search.spans])
-
-
-def twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candidates, Spans]:
-    """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
-    branches of the class too: their residuals are the same, their configurations differ. A pose's copies follow
-    its own candidates, poses stay in order."""
-    return twin_candidates(red, cand), twin_spans(red, spans)
-
-
-def twin_candidates(red: Reduction, cand: Candidates) -> Candidates:
-    """``twin_copies``' candidates: each pose's own, then their copies (class member by member, in order), poses in
-    order (``fastsweep``'s one-pass search makes the same copies pose by pose)."""
-    if not red.twins:
-        return cand
-    c_rows, c_branch = _twin_rows(red, cand.branch)
-    pose = np.concatenate([cand.pose, cand.pose[c_rows]])
-    # in pose order again, as the search gave them (certification and settling run on parts of whole poses)
-    order = np.argsort(pose, kind="stable") if pose.size > 1 and pose[0] != pose[-1] else slice(None)
-    return Candidates(
-        pose[order],
-        np.concatenate([cand.branch, c_branch])[order],
-        np.concatenate([cand.theta, cand.theta[c_rows]])[order],
-        np.concatenate([cand.mult, cand.mult[c_rows]])[order],
-    )
-
-
-def twin_spans(red: Reduction, spans: Spans) -> Spans:
-    """``twin_copies``' family spans: all of them, then their copies."""
-    if not red.twins or not len(spans):  # (most sweeps find none)
-        return spans
-    s_rows, s_branch = _twin_rows(red, spans.branch)
-    return Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])])
-
-
-def twin_maps(red: Reduction) -> tuple[IntArray, ...]:
-    """``red.twins`` as maps: for the d-th other member of the classes (d = 1, 2, ...), each branch's twin in that
-    place (-1: none); none without twins."""
-    twins = red.twins
-    if not twins:
-        return ()
-    try:  # (as the reductions give them: tuples of ints, the cache's key as it is)
-        return _twin_maps(twins, red.n_branches)
-    except TypeError:  # (unhashable classes: lists, arrays)
-        return _twin_maps(tuple(tuple(int(b) for b in cls) for cls in twins), red.n_branches)
-
-
-def _twin_rows(red: Reduction, branch: IntArray) -> tuple[IntArray, IntArray]:
-    """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
-    that branch: ``(rows, branches)``."""
-    rows, branches = [], []
-    for twin in twin_maps(red):
-        t = twin[branch]
-        k = np.nonzero(t >= 0)[0]
-        rows.append(k)
-        branches.append(t[k])
-    if len(rows) == 1:  # (classes of two: one map)
-        return rows[0], branches[0]
-    return np.concatenate(rows).astype(np.intp), np.concatenate(branches)
-
-
-@lru_cache(maxsize=64)
-def _twin_maps(twins: tuple[tuple[int, ...], ...], n_branches: int) -> tuple[IntArray, ...]:
-    """For the d-th other member of the classes of ``twins`` (d = 1, 2, ...): each branch's twin in that place (-1:
-    none), read only."""
-    maps = []
-    for d in range(1, max(len(cls) for cls in twins)):
-        twin = np.full(n_branches, -1, dtype=np.intp)
-        for cls in twins:
-            if len(cls) > d:
-                twin[cls[0]] = cls[d]
-        twin.flags.writeable = False
-        maps.append(twin)
-    return tuple(maps)

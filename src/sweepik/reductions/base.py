@@ -85,7 +85,7 @@ class Reduction(ABC):
     #: overrides ``sample_hints``.
     kernel_hints: Any = None
     n_kernel_hints: int = 0
-    #: Optional method ``edge_search(self) -> fastsweep.EdgeSearch | None``: the hints are zeros of another residual
+    #: Optional method ``edge_search(self) -> search.EdgeSearch | None``: the hints are zeros of another residual
     #: (the generic sweeps' margins), which the engine then finds in the same compiled pass as the candidates, pose
     #: by pose. Ignored unless set by the class that sets ``kernel`` and unless a subclass below that class
     #: overrides ``sample_hints``.
@@ -173,7 +173,7 @@ class Reduction(ABC):
 
     def continuum_poses(self, poses: Array) -> NDArray[np.bool_] | None:
         """``(N,)`` the poses where ``continuum_joints`` may flag a candidate, told from the pose alone (a reduction
-        that can tell: its poses elsewhere take the one compiled call, ``fastsolve``, without a continuum kernel);
+        that can tell: its poses elsewhere take the one compiled call, ``one_pose``, without a continuum kernel);
         None: it cannot tell without the candidates."""
         return None
 
@@ -190,12 +190,12 @@ class Reduction(ABC):
     def continuum_kernel(self) -> tuple[int, int, Array, NDArray[np.int64]] | None:
         """``continuum_joints`` of a sweep's candidates as the arguments of ``geometric.continuum_rows`` that do not
         change (the amplitude kernel's address, branches per position branch, thresholds, joints), for a compiled
-        caller (``fastsolve.settle_one``); None where it finds none for them. A class that overrides
+        caller (``one_pose.settle_one``); None where it finds none for them. A class that overrides
         ``continuum_joints`` and not this one has its candidates checked in Python (the general path)."""
         return None
 
     def singular_kernel(self) -> tuple[int, Array] | None:
-        """For a compiled caller (``fastsolve.settle_closed``): a closed form's ``degenerate`` poses and those where
+        """For a compiled caller (``one_pose.settle_closed``): a closed form's ``degenerate`` poses and those where
         ``continuum_joints`` may flag a branch, in one kernel: the address of ``(params, thr, out, low, start, stop)``
         (``kernels.SINGULAR_SIG``), which sets ``out[i]`` or ``low[i]`` for such a pose i, and its ``thr``. None:
         the solver asks ``degenerate`` and ``continuum_joints`` in Python (also where a class overrides either of

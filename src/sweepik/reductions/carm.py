@@ -365,7 +365,8 @@ class CArmTheta2(_CArmBase):
         For poses with |Px| below ``BLIND_PX_REL * (L1 + L2)`` the d1 sweep supplies the solutions with
         |cos(theta2)| <= ``BLIND_COS``; the theta2 sweep supplies all others.
         """
-        from sweepik.engine.sweep import find_candidates, twin_copies  # local import: the engine imports this package
+        from sweepik.engine.candidates import twin_copies  # local imports: the engine imports this package
+        from sweepik.engine.sweep import find_candidates
 
         Px = poses[:, 0, 3]
         idx = np.nonzero(np.abs(Px) <= BLIND_PX_REL * (self.L1 + self.L2))[0]

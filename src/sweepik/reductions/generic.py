@@ -375,7 +375,7 @@ class GeometricReduction(Reduction):
 
     def edge_search(self) -> Any:
         """``sample_hints`` as the engine finds them in the same compiled pass as the search
-        (``fastsweep.EdgeSearch``, ``Reduction.edge_search``); None for a closed form (no sweep)."""
+        (``search.EdgeSearch``, ``Reduction.edge_search``); None for a closed form (no sweep)."""
         if self.closed_form:
             return None
         from sweepik.engine import (
@@ -540,7 +540,7 @@ def _classes(f: Array) -> list[list[int]]:
 
 
 class _PlanKey:
-    """A pair plan's key to the engine's cached plan of its margins (``fastsweep._plan``): a fresh ``_Margins``
+    """A pair plan's key to the engine's cached plan of its margins (``search._plan``): a fresh ``_Margins``
     is made for each call, so the plan cannot be kept with it."""
 
     __slots__ = ("__weakref__",)

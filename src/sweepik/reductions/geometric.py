@@ -528,7 +528,7 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
 
 
 #: ``_swing`` with its signature (``kernels.SWING_SIG``): the engine calls it by its address too
-#: (``fastsweep.EdgeSearch``).
+#: (``search.EdgeSearch``).
 swing = LazyKernel(_swing, SWING_SIG, cache=True, nogil=True)
 
 
@@ -765,7 +765,7 @@ def _residual_kernels(case: int, free: int, rev: tuple[bool, ...]) -> tuple[Any,
     def every(p, x, out):
         """``residuals`` of the four branches and ``margins`` of the three steps at once, into ``out[:4]`` and
         ``out[4:7]``, bit for bit theirs (the margins' cosines are those the residuals' first four joints come
-        from): the engine's uniform samples (``fastsweep.EdgeSearch.every``) for a plan that searches both
+        from): the engine's uniform samples (``search.EdgeSearch.every``) for a plan that searches both
         first-step branches (``LAYOUT['need']`` 3)."""
         nb = int(p[_POS_BRANCHES])
         both = BOTH + 0 * nb  # (a run-time value: see position.place)

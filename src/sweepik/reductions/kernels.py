@@ -134,7 +134,7 @@ if _njit is not None:
     HINTS_SIG = void(float64[::1], float64[::1])
     #: ``swing(amplitude, amplitudes, params, lo, hi, n, periodic, steps, out, start, stop)``: a generic sweep's swing
     #: samples of poses ``start .. stop - 1`` (``geometric.swing_hints``; ``amplitude`` and ``amplitudes`` the
-    #: addresses of its amplitude kernels), which the engine calls pose by pose (``fastsweep.EdgeSearch``).
+    #: addresses of its amplitude kernels), which the engine calls pose by pose (``search.EdgeSearch``).
     SWING_SIG = void(
         int64, int64, float64[:, ::1], float64[::1], float64[::1], int64, boolean, int64[::1], float64[:, ::1], int64,
         int64,

@@ -1,0 +1,193 @@
+"""The candidate set of a sweep, as arrays: ``Candidates`` (pose, branch, theta*, multiplicity) and ``Spans`` (family
+runs of theta*), the copies a reduction's twin branches share, and the sample grid (a uniform grid plus the
+reduction's hints) both search engines sample."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from sweepik.reductions.base import Array, IntArray, Reduction
+
+
+@dataclass(frozen=True)
+class Candidates:
+    """Flat candidate list: pose index, branch, theta* value and the root's multiplicity (1 for a simple root,
+    2 where two solutions merge, ...), for ``K`` candidates."""
+
+    pose: IntArray
+    branch: IntArray
+    theta: Array
+    mult: IntArray
+
+
+@dataclass(frozen=True)
+class Spans:
+    """Runs of theta* along which a branch of a pose solves the pose identically (self-motion families): pose
+    index, branch and the run's ends ``[lo, hi]``, for ``K`` runs (arrays: a batch has thousands of them)."""
+
+    pose: IntArray
+    branch: IntArray
+    lo: Array
+    hi: Array
+
+    @staticmethod
+    def empty() -> Spans:
+        """No spans (one shared instance, its arrays read-only: most sweeps find none)."""
+        return _NO_SPANS
+
+    @staticmethod
+    def concat(parts: list[Spans]) -> Spans:
+        if len(parts) == 1:
+            return parts[0]
+        return Spans(
+            np.concatenate([s.pose for s in parts]).astype(np.intp),
+            np.concatenate([s.branch for s in parts]).astype(np.intp),
+            np.concatenate([s.lo for s in parts]).astype(np.float64),
+            np.concatenate([s.hi for s in parts]).astype(np.float64),
+        )
+
+    def __len__(self) -> int:
+        return int(self.pose.size)
+
+
+def _no_spans() -> Spans:
+    arrays = (np.zeros(0, np.intp), np.zeros(0, np.intp), np.zeros(0), np.zeros(0))
+    for a in arrays:
+        a.flags.writeable = False
+    return Spans(*arrays)
+
+
+_NO_SPANS = _no_spans()
+
+
+@lru_cache(maxsize=8)
+def unit_grid(n: int) -> Array:
+    return np.linspace(0.0, 1.0, n)
+
+
+def grid_hints(reduction: Reduction, poses: Array) -> Array | None:
+    """The samples ``(N, H)`` that ``sample_grid`` adds to the uniform grid (NaN: none): the reduction's hints and,
+    for a non-periodic theta*, its limits (a solution exactly at a limit, a rail end, is then a sample); for a
+    periodic theta* wrapped into [-pi, pi]."""
+    hints = reduction.sample_hints(poses)
+    if not reduction.periodic:
+        j = reduction.free_joint
+        ends = np.empty((poses.shape[0], 2))
+        ends[:, 0], ends[:, 1] = reduction.robot.lower[j], reduction.robot.upper[j]
+        hints = ends if hints is None else np.concatenate([hints, ends], axis=1)
+    if hints is not None and hints.size and reduction.periodic:
+        hints = np.pi - np.mod(np.pi - hints, 2.0 * np.pi)
+    return hints
+
+
+def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
+    """Sorted theta* samples ``(N, M)``: a uniform grid on [lo, hi] plus the reduction's hints inside it
+    (``grid_hints``; :func:`sweepik.engine.search.sample_grid` is the compiled version)."""
+    return merge_grid(lo, hi, n_samples, grid_hints(reduction, poses))
+
+
+def merge_grid(lo: Array, hi: Array, n_samples: int, hints: Array | None) -> Array:
+    """``sample_grid`` from the hints: the uniform grid, the hints inside [lo, hi], sorted, repeats spread."""
+    s = unit_grid(n_samples)
+    grid = lo[:, None] + (hi - lo)[:, None] * s[None, :]
+    if hints is not None and hints.size:
+        inside = np.isfinite(hints) & (hints >= lo[:, None]) & (hints <= hi[:, None])
+        # a hint outside the range becomes a midpoint of the uniform grid (a distinct, harmless extra sample)
+        spare = lo[:, None] + (hi - lo)[:, None] * ((np.arange(hints.shape[1]) + 0.5) / (n_samples - 1))[None, :]
+        hints = np.where(inside, hints, spare)
+        grid = np.concatenate([grid, hints], axis=1)
+    grid = np.sort(grid, axis=1)
+    # a sample repeated (a hint on the grid, hints outside the range all set to lo) would leave zero-width
+    # intervals, where the three-sample extremum test cannot work (a double root exactly at that sample would go
+    # unseen): each run of equal samples is spread evenly towards the next distinct sample
+    new_run = np.ones(grid.shape, dtype=bool)
+    new_run[:, 1:] = grid[:, 1:] > grid[:, :-1]
+    if new_run.all():
+        return grid
+    M = grid.shape[1]
+    idx = np.broadcast_to(np.arange(M), grid.shape)
+    start = np.maximum.accumulate(np.where(new_run, idx, 0), axis=1)
+    nxt = np.full(grid.shape, M)
+    nxt[:, :-1] = np.minimum.accumulate(np.where(new_run, idx, M)[:, :0:-1], axis=1)[:, ::-1]
+    r_i, r_j = np.nonzero(~new_run & (nxt < M))
+    if r_i.size:
+        s0, e0 = start[r_i, r_j], nxt[r_i, r_j]
+        base = grid[r_i, s0]
+        grid[r_i, r_j] = base + (grid[r_i, e0] - base) * (r_j - s0) / (e0 - s0)
+    return grid
+
+
+def twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candidates, Spans]:
+    """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
+    branches of the class too: their residuals are the same, their configurations differ. A pose's copies follow
+    its own candidates, poses stay in order."""
+    return twin_candidates(red, cand), twin_spans(red, spans)
+
+
+def twin_candidates(red: Reduction, cand: Candidates) -> Candidates:
+    """``twin_copies``' candidates: each pose's own, then their copies (class member by member, in order), poses in
+    order (``search``'s one-pass search makes the same copies pose by pose)."""
+    if not red.twins:
+        return cand
+    c_rows, c_branch = _twin_rows(red, cand.branch)
+    pose = np.concatenate([cand.pose, cand.pose[c_rows]])
+    # in pose order again, as the search gave them (certification and settling run on parts of whole poses)
+    order = np.argsort(pose, kind="stable") if pose.size > 1 and pose[0] != pose[-1] else slice(None)
+    return Candidates(
+        pose[order],
+        np.concatenate([cand.branch, c_branch])[order],
+        np.concatenate([cand.theta, cand.theta[c_rows]])[order],
+        np.concatenate([cand.mult, cand.mult[c_rows]])[order],
+    )
+
+
+def twin_spans(red: Reduction, spans: Spans) -> Spans:
+    """``twin_copies``' family spans: all of them, then their copies."""
+    if not red.twins or not len(spans):  # (most sweeps find none)
+        return spans
+    s_rows, s_branch = _twin_rows(red, spans.branch)
+    return Spans.concat([spans, Spans(spans.pose[s_rows], s_branch, spans.lo[s_rows], spans.hi[s_rows])])
+
+
+def twin_maps(red: Reduction) -> tuple[IntArray, ...]:
+    """``red.twins`` as maps: for the d-th other member of the classes (d = 1, 2, ...), each branch's twin in that
+    place (-1: none); none without twins."""
+    twins = red.twins
+    if not twins:
+        return ()
+    try:  # (as the reductions give them: tuples of ints, the cache's key as it is)
+        return _twin_maps(twins, red.n_branches)
+    except TypeError:  # (unhashable classes: lists, arrays)
+        return _twin_maps(tuple(tuple(int(b) for b in cls) for cls in twins), red.n_branches)
+
+
+def _twin_rows(red: Reduction, branch: IntArray) -> tuple[IntArray, IntArray]:
+    """The rows of ``branch`` on the first branch of a class of twins, once for each other branch of the class, and
+    that branch: ``(rows, branches)``."""
+    rows, branches = [], []
+    for twin in twin_maps(red):
+        t = twin[branch]
+        k = np.nonzero(t >= 0)[0]
+        rows.append(k)
+        branches.append(t[k])
+    if len(rows) == 1:  # (classes of two: one map)
+        return rows[0], branches[0]
+    return np.concatenate(rows).astype(np.intp), np.concatenate(branches)
+
+
+@lru_cache(maxsize=64)
+def _twin_maps(twins: tuple[tuple[int, ...], ...], n_branches: int) -> tuple[IntArray, ...]:
+    """For the d-th other member of the classes of ``twins`` (d = 1, 2, ...): each branch's twin in that place (-1:
+    none), read only."""
+    maps = []
+    for d in range(1, max(len(cls) for cls in twins)):
+        twin = np.full(n_branches, -1, dtype=np.intp)
+        for cls in twins:
+            if len(cls) > d:
+                twin[cls[0]] = cls[d]
+        twin.flags.writeable = False
+        maps.append(twin)
+    return tuple(maps)
