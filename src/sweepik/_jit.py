@@ -5,13 +5,16 @@ from __future__ import annotations
 
 from typing import Any, Final
 
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
 _njit: Any
 try:
     from numba import njit as _njit
 except ImportError:  # pragma: no cover - without numba the NumPy engine is used
     _njit = None
 
-__all__ = ["internal", "inlined", "unowned", "alive", "function_at", "ERROR_MODEL"]
+__all__ = ["internal", "inlined", "unowned", "alive", "function_at", "writable", "ERROR_MODEL"]
 
 #: Numba's error model for every compiled function of sweepik: IEEE results for a division by zero (inf, NaN), as
 #: the NumPy reference engine gives them, rather than a ZeroDivisionError raised from deep inside a kernel (which
@@ -106,3 +109,9 @@ def function_at(sig: Any) -> Any:
         return fnty(address), codegen
 
     return at
+
+
+def writable(a: ArrayLike) -> NDArray[np.float64]:
+    """``a`` as a C-contiguous, writable float64 array (the compiled signatures' kind): copied only if needed."""
+    a = np.asarray(a)
+    return np.array(a, dtype=np.float64, order="C", copy=not a.flags.writeable or None)

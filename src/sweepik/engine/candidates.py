@@ -4,6 +4,7 @@ reduction's hints) both search engines sample."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -68,11 +69,30 @@ def unit_grid(n: int) -> Array:
     return np.linspace(0.0, 1.0, n)
 
 
+#: The engine's sweep for the zeros of a reduction's ``edge_reduction``: ``zeros(reduction, poses, lo, hi) -> (N, K)``
+#: (NaN-padded), registered by :mod:`sweepik.engine.search` when it is imported (the search lives above this module).
+_edge_zeros: Callable[[Reduction, Array, Array, Array], Array] | None = None
+
+
+def set_edge_zeros(zeros: Callable[[Reduction, Array, Array, Array], Array]) -> None:
+    """Register the engine's sweep for the domain edges' samples (``grid_hints``)."""
+    global _edge_zeros
+    _edge_zeros = zeros
+
+
 def grid_hints(reduction: Reduction, poses: Array) -> Array | None:
-    """The samples ``(N, H)`` that ``sample_grid`` adds to the uniform grid (NaN: none): the reduction's hints and,
+    """The samples ``(N, H)`` that ``sample_grid`` adds to the uniform grid (NaN: none): the zeros of the reduction's
+    ``edge_reduction`` (its domain edges), then its hints and,
     for a non-periodic theta*, its limits (a solution exactly at a limit, a rail end, is then a sample); for a
     periodic theta* wrapped into [-pi, pi]."""
     hints = reduction.sample_hints(poses)
+    edges = reduction.edge_reduction(poses, hints)
+    if edges is not None:  # the domain edges' samples first (the zeros of the reduction it gives)
+        assert _edge_zeros is not None, "sweepik.engine.search registers the edge zeros when imported"
+        zeros = _edge_zeros(edges[0], poses, edges[1], edges[2])
+        theta = zeros if hints is None else np.concatenate([zeros, hints], axis=1)
+        keep = np.any(np.isfinite(theta), axis=0)
+        hints = theta[:, keep] if keep.any() else None
     if not reduction.periodic:
         j = reduction.free_joint
         ends = np.empty((poses.shape[0], 2))

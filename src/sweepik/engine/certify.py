@@ -15,10 +15,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik._jit import alive, inlined, unowned
+from sweepik._jit import alive, inlined, unowned, writable
 from sweepik.engine import parallel
 from sweepik.engine.dedupe import limit_args
-from sweepik.engine.search import AVAILABLE, PARALLEL_MIN, writable
+from sweepik.engine.search import AVAILABLE, PARALLEL_MIN
 from sweepik.engine.settings import J_CUTOFF_FACTOR, PINV_WIDEN
 from sweepik.model import kinematics
 from sweepik.model.pose import GIMBAL_TOL

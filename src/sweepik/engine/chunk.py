@@ -47,6 +47,7 @@ from sweepik.errors import ShapeError
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit, orientation_weight
 from sweepik.reductions import Reduction, get_reduction
+from sweepik.reductions.base import IntArray
 from sweepik.reductions.kernels import owned_kernel
 from sweepik.results import Block, Family, Solutions
 
@@ -276,10 +277,7 @@ def _precise_candidates(
         cand = _limit_copies(robot, red, cand, hi - lo)
         q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
     found = _Found(cand.pose, q, cand.mult, err_geo, err_paper, {})
-    special = red.special_solutions(chain)
-    sp_mult = None
-    if isinstance(special, tuple):
-        special, sp_mult = special
+    special, sp_mult = special_solutions(red, chain)
     if special is not None:
         sp_p, sp_k = np.nonzero(np.all(np.isfinite(special), axis=-1))
         ones = np.ones(sp_p.size, dtype=np.intp)
@@ -316,6 +314,35 @@ def _precise_candidates(
         if fam_p.size:
             found.add(robot, poses, fam_p, fam_q, np.ones(fam_p.size, dtype=np.intp))
     return found
+
+
+def special_solutions(red: Reduction, chain: Array) -> tuple[Array | None, IntArray | None]:
+    """The candidates of the reduction's blind spots, ``(q (N, K, n) NaN-padded, multiplicities (N, K) or None)``:
+    its ``special_solutions``, and the configurations the reduction of its ``blind_spot`` finds on the poses it
+    names (swept here, twins' copies included), those ``blind_spot_kept`` keeps; ``(None, None)`` without."""
+    special = red.special_solutions(chain)
+    if special is not None:
+        return special if isinstance(special, tuple) else (special, None)
+    blind = red.blind_spot(chain)
+    if blind is None:
+        return None, None
+    idx, other, rng = blind
+    cand, _ = twin_copies(other, *find_candidates(other, chain[idx], rng[:, 0], rng[:, 1]))
+    q = other.solve_rest(chain[idx][cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
+    keep = np.all(np.isfinite(q), axis=-1) & red.blind_spot_kept(q)
+    pose, q, mult = cand.pose[keep], q[keep], cand.mult[keep]
+    if pose.size == 0:
+        return None, None
+    counts = np.bincount(pose, minlength=idx.size)
+    width = max(8, int(counts.max()))
+    out = np.full((chain.shape[0], width, q.shape[1]), np.nan)
+    out_m = np.ones((chain.shape[0], width), dtype=np.intp)
+    order = np.argsort(pose, kind="stable")
+    pose, q, mult = pose[order], q[order], mult[order]
+    slot = np.arange(pose.size) - np.concatenate([[0], np.cumsum(counts)[:-1]])[pose]
+    out[idx[pose], slot] = q
+    out_m[idx[pose], slot] = mult
+    return out, out_m
 
 
 def _settled_rows(
@@ -457,8 +484,8 @@ def settled(
         )
     if out is None or out.status != one_pose.OK or out.certified > MAX_ISOLATED_SOLUTIONS:
         return None
-    special = red.special_solutions(chain)
-    if special is not None and np.isfinite(special[0] if isinstance(special, tuple) else special).all(-1).any():
+    special, _ = special_solutions(red, chain)
+    if special is not None and np.isfinite(special).all(-1).any():
         return None
     if out.checked:  # (its singular set, checked in the call: ``Reduction.singular_kernel``)
         return out

@@ -20,11 +20,12 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from sweepik._jit import writable
 from sweepik.engine import search
 from sweepik.engine.candidates import unit_grid
 from sweepik.engine.certify import chain_args
 from sweepik.engine.dedupe import duplicate_tolerance, limit_args
-from sweepik.engine.search import AVAILABLE, _plan, writable
+from sweepik.engine.search import AVAILABLE, _plan
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.kernels import (
     CONFIGURATION_SIG,

@@ -26,9 +26,9 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from sweepik._jit import ERROR_MODEL, alive, inlined, internal, unowned
+from sweepik._jit import ERROR_MODEL, alive, inlined, internal, unowned, writable
 from sweepik.engine import candidates, parallel
 from sweepik.engine import sweep as _ref
 from sweepik.engine.settings import (
@@ -53,6 +53,7 @@ from sweepik.engine.settings import (
     MAX_LEVELS,
     MULT_LEVEL,
     MULT_MAX,
+    N_SAMPLES,
     PARALLEL_MIN,
     STACK,
     SUB_SAMPLES,
@@ -1045,33 +1046,6 @@ if AVAILABLE:
             _twin_copies(out_t, out_b, out_m, cnt, i, twins)
 
 
-class EdgeSearch(NamedTuple):
-    """A reduction whose sample hints are the zeros of its margins (a generic sweep: the edges of its branch
-    domains, ``generic._Margins``) sampled with its swing samples (``geometric.swing_hints``), which are hints too:
-    what ``search`` needs to find them and the candidates in one compiled pass per pose (``Reduction.edge_search``;
-    its ``sample_hints`` must give the same samples, the reference's and ``sample_grid``'s way)."""
-
-    margins: object  # the margins' reduction (its engine plan: kernels, branches, residual noise)
-    swing: int  # the address of the swing kernel (``kernels.SWING_SIG``)
-    amplitude: int  # ... of the amplitude kernels it takes
-    amplitudes: int
-    steps: NDArray[np.int64]  # the steps whose amplitudes it examines
-    n_swing: int  # the samples it writes per pose, at most
-    n_samples: int  # its grid's samples (the sweep's default: ``settings.N_SAMPLES``)
-    hint_range: Any  # ``hint_range(reduction, poses) -> (lo, hi)``: theta*'s range its hints are sought over
-    # (a function, not a bound method: the engine keeps its plan while the reduction lives, and no longer)
-    # the address of a kernel computing the residuals and the margins at once (``kernels.RESIDUALS_SIG``: the
-    # reduction's ``n_branches`` residuals, then the margins' 3), for the uniform samples that both searches take
-    # (used where the margins have an all-branch kernel of 3); 0: none, each search evaluates its own
-    every: int = 0
-
-
-def writable(a: ArrayLike) -> Array:
-    """``a`` as a C-contiguous, writable float64 array (the compiled signatures' kind): copied only if needed."""
-    a = np.asarray(a)
-    return np.array(a, dtype=np.float64, order="C", copy=not a.flags.writeable or None)
-
-
 def sample_grid(
     reduction, poses: Array, lo: Array, hi: Array, n_samples: int, params: Array | None = None
 ) -> tuple[Array, NDArray[np.int64]]:
@@ -1197,7 +1171,7 @@ def _one_pass(red, plan: _Plan) -> _OnePass | None:
     edges = None
     if plan.hints is None:
         edge_search = owned_kernel(red, "edge_search")
-        if edge_search is None or overridden_below_kernel(red.__class__, ("sample_hints",)):
+        if edge_search is None or overridden_below_kernel(red.__class__, ("sample_hints", "edge_reduction")):
             return None
         edges = edge_search(red)  # (read from the class: a function of the reduction)
         if edges is None:
@@ -1246,7 +1220,7 @@ def _hints_kernel(reduction):
     """``reduction.kernel_hints`` where it belongs to the reduction's ``kernel`` and no subclass below overrides
     ``sample_hints`` (the kernel would bypass it)."""
     kernel = owned_kernel(reduction, "kernel_hints")
-    if kernel is None or overridden_below_kernel(type(reduction), ("sample_hints",)):
+    if kernel is None or overridden_below_kernel(type(reduction), ("sample_hints", "edge_reduction")):
         return None
     n = owned_kernel(reduction, "n_kernel_hints")
     if not (isinstance(n, int) and n >= 1):
@@ -1338,6 +1312,28 @@ def search(
         order = np.argsort(cand.pose, kind="stable")
         cand = candidates.Candidates(cand.pose[order], cand.branch[order], cand.theta[order], cand.mult[order])
     return cand, candidates.twin_spans(reduction, spans)
+
+
+def edge_zeros(reduction, poses: Array, lo: Array, hi: Array) -> Array:
+    """Zeros ``(N, K)`` (NaN-padded) of ``reduction``'s residual over ``[lo, hi]`` (``(N,)`` each), without their
+    multiplicities: the domain edges a reduction's ``edge_reduction`` describes (``candidates.grid_hints``). Compiled;
+    the NumPy reference without Numba."""
+    N = poses.shape[0]
+    if AVAILABLE:
+        cand, _ = search(reduction, poses, lo, hi, N_SAMPLES, None, multiplicity=False)
+    else:
+        cand, _ = _ref.find_candidates(reduction, poses, lo, hi, N_SAMPLES)
+    if N == 1:
+        return cand.theta[None, :]
+    counts = np.bincount(cand.pose, minlength=N)
+    out = np.full((N, int(counts.max(initial=0))), np.nan)
+    order = np.argsort(cand.pose, kind="stable")
+    slot = np.arange(cand.pose.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    out[cand.pose[order], slot] = cand.theta[order]
+    return out
+
+
+candidates.set_edge_zeros(edge_zeros)
 
 
 @dataclass

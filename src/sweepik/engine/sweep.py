@@ -607,6 +607,9 @@ class PoseErrorResidual(Reduction):
     def sample_hints(self, poses: Array) -> Array | None:
         return self.inner.sample_hints(poses)
 
+    def edge_reduction(self, poses: Array, hints: Array | None) -> tuple[Reduction, Array, Array] | None:
+        return self.inner.edge_reduction(poses, hints)
+
 
 def find_candidates(
     reduction: Reduction,

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from functools import cache
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,6 +43,28 @@ def overridden_below_kernel(cls: type, names: tuple[str, ...]) -> bool:
     mro = cls.__mro__
     below = mro[: mro.index(kernel_owner(cls))]
     return any(name in vars(c) for c in below for name in names)
+
+
+class EdgeSearch(NamedTuple):
+    """A reduction whose sample hints are the zeros of its margins (a generic sweep: the edges of its branch
+    domains, ``generic._Margins``) sampled with its swing samples (``geometric.swing_hints``), which are hints too:
+    what the engine's search (:mod:`sweepik.engine.search`) needs to find them and the candidates in one compiled pass
+    per pose (``Reduction.edge_search``;
+    its ``sample_hints`` must give the same samples, the reference's and ``sample_grid``'s way)."""
+
+    margins: object  # the margins' reduction (its engine plan: kernels, branches, residual noise)
+    swing: int  # the address of the swing kernel (``kernels.SWING_SIG``)
+    amplitude: int  # ... of the amplitude kernels it takes
+    amplitudes: int
+    steps: NDArray[np.int64]  # the steps whose amplitudes it examines
+    n_swing: int  # the samples it writes per pose, at most
+    n_samples: int  # its grid's samples (the sweep's default: ``settings.N_SAMPLES``)
+    hint_range: Any  # ``hint_range(reduction, poses) -> (lo, hi)``: theta*'s range its hints are sought over
+    # (a function, not a bound method: the engine keeps its plan while the reduction lives, and no longer)
+    # the address of a kernel computing the residuals and the margins at once (``kernels.RESIDUALS_SIG``: the
+    # reduction's ``n_branches`` residuals, then the margins' 3), for the uniform samples that both searches take
+    # (used where the margins have an all-branch kernel of 3); 0: none, each search evaluates its own
+    every: int = 0
 
 
 class Reduction(ABC):
@@ -85,7 +107,7 @@ class Reduction(ABC):
     #: overrides ``sample_hints``.
     kernel_hints: Any = None
     n_kernel_hints: int = 0
-    #: Optional method ``edge_search(self) -> search.EdgeSearch | None``: the hints are zeros of another residual
+    #: Optional method ``edge_search(self) -> EdgeSearch | None``: the hints are zeros of another residual
     #: (the generic sweeps' margins), which the engine then finds in the same compiled pass as the candidates, pose
     #: by pose. Ignored unless set by the class that sets ``kernel`` and unless a subclass below that class
     #: overrides ``sample_hints``.
@@ -151,6 +173,23 @@ class Reduction(ABC):
         residual bends sharply. Roots next to a domain edge are only bracketed if the edge is a sample.
         """
         return None
+
+    def edge_reduction(self, poses: Array, hints: Array | None) -> tuple[Reduction, Array, Array] | None:
+        """Where a branch's domain begins or ends, as a reduction whose zeros over ``[lo, hi]`` (``(N,)`` each) the
+        engine finds with its sweep and samples before ``hints`` (this reduction's ``sample_hints(poses)``): a root at
+        or next to a domain edge is bracketed only if the edge is a sample. None: no such samples."""
+        return None
+
+    def blind_spot(self, poses: Array) -> tuple[IntArray, Reduction, Array] | None:
+        """The poses (indices into ``poses``) where this reduction is blind or ill-conditioned somewhere along
+        theta*, a reduction that sees them and its sweep range ``(K, 2)``: the engine sweeps it on those poses and
+        hands the configurations to ``blind_spot_kept``, whose are added to ``special_solutions``. None: none."""
+        return None
+
+    def blind_spot_kept(self, q: Array) -> NDArray[np.bool_]:
+        """Which configurations ``q (K, n)`` that the ``blind_spot`` reduction found this reduction keeps (those in
+        its blind slice: the others it finds itself)."""
+        return np.ones(q.shape[0], dtype=bool)
 
     def special_solutions(self, poses: Array) -> Array | tuple[Array, IntArray] | None:
         """Candidate configurations ``(N, K, n)`` (NaN-padded) at theta* values where the reduction itself

@@ -309,7 +309,7 @@ class CArmTheta2(_CArmBase):
 
     Given theta2, entry {2,4} fixes ``d1 = Pz - Px tan(theta2)``. Blind spot: cos(theta2) = 0, where d1
     drops out of that equation (possible only when Px = 0), and its neighbourhood, where d1 is
-    ill-conditioned; ``special_solutions`` covers it with the d1 reduction. Self-motion families
+    ill-conditioned; ``blind_spot`` hands it to the d1 reduction. Self-motion families
     (theta2 = +-90 deg with theta5 = 0) lie entirely in that slice: ``degenerate`` hands them to carm-d1.
     """
 
@@ -357,36 +357,20 @@ class CArmTheta2(_CArmBase):
         spot cos(theta2) = 0, where a theta2 sweep cannot describe them; carm-d1 reports them."""
         return self._wrist_on_axis(poses)
 
-    def special_solutions(self, poses: Array) -> tuple[Array, IntArray] | None:
-        """Solutions near the blind spot cos(theta2) = 0, found with the d1 reduction (with their multiplicity).
+    def blind_spot(self, poses: Array) -> tuple[IntArray, Reduction, Array] | None:
+        """Poses near the blind spot cos(theta2) = 0, with the d1 reduction that solves them.
 
         Near theta2 = +-90 deg, d1 = Pz - Px tan(theta2) races through its range within a window of width
         ~|Px| / (L1 + L2) in theta2, so a theta2 sweep is ill-conditioned there and blind at its centre.
         For poses with |Px| below ``BLIND_PX_REL * (L1 + L2)`` the d1 sweep supplies the solutions with
-        |cos(theta2)| <= ``BLIND_COS``; the theta2 sweep supplies all others.
+        |cos(theta2)| <= ``BLIND_COS`` (``blind_spot_kept``); the theta2 sweep supplies all others.
         """
-        from sweepik.engine.candidates import twin_copies  # local imports: the engine imports this package
-        from sweepik.engine.sweep import find_candidates
-
         Px = poses[:, 0, 3]
         idx = np.nonzero(np.abs(Px) <= BLIND_PX_REL * (self.L1 + self.L2))[0]
         if idx.size == 0:
             return None
         d1red = CArmD1(self.robot)
-        rng = d1red.search_range(poses[idx])
-        cand, _ = twin_copies(d1red, *find_candidates(d1red, poses[idx], rng[:, 0], rng[:, 1]))
-        q = d1red.solve_rest(poses[idx][cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
-        keep = np.all(np.isfinite(q), axis=-1) & (np.abs(np.cos(q[:, 1])) <= BLIND_COS)
-        pose, q, mult = cand.pose[keep], q[keep], cand.mult[keep]
-        if pose.size == 0:
-            return None
-        counts = np.bincount(pose, minlength=idx.size)
-        width = max(8, int(counts.max()))
-        out = np.full((poses.shape[0], width, 6), np.nan)
-        out_m = np.ones((poses.shape[0], width), dtype=np.intp)
-        order = np.argsort(pose, kind="stable")
-        pose, q, mult = pose[order], q[order], mult[order]
-        slot = np.arange(pose.size) - np.concatenate([[0], np.cumsum(counts)[:-1]])[pose]
-        out[idx[pose], slot] = q
-        out_m[idx[pose], slot] = mult
-        return out, out_m
+        return idx, d1red, d1red.search_range(poses[idx])
+
+    def blind_spot_kept(self, q: Array) -> NDArray[np.bool_]:
+        return np.abs(np.cos(q[:, 1])) <= BLIND_COS

@@ -14,10 +14,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import parallel
+from sweepik.engine.settings import N_SAMPLES, PARALLEL_MIN
 from sweepik.model.chain import Chain
 from sweepik.model.robot import Robot
 from sweepik.reductions import geometric
-from sweepik.reductions.base import Array, IntArray, Reduction
+from sweepik.reductions.base import Array, EdgeSearch, IntArray, Reduction
 from sweepik.reductions.plan import Plan, plans
 from sweepik.reductions.position import CASES, FINAL_JOINTS, STEP_JOINTS
 
@@ -260,7 +261,6 @@ class GeometricReduction(Reduction):
         shoulder = self._shoulder_continua
         if not out or shoulder is None:
             return out
-        from sweepik.engine.search import PARALLEL_MIN  # local: the engine imports the reductions
 
         by, deg = out[0]
         free = np.zeros(poses.shape[0], dtype=np.bool_)
@@ -284,7 +284,6 @@ class GeometricReduction(Reduction):
         last = self._last_singular
         if last is not None and last[0] is poses:
             return last[1], last[2]
-        from sweepik.engine.search import PARALLEL_MIN  # local: the engine imports the reductions
 
         N = poses.shape[0]
         out, low = np.zeros(N, dtype=np.bool_), np.zeros(N, dtype=np.bool_)
@@ -343,15 +342,10 @@ class GeometricReduction(Reduction):
 
     def sample_hints(self, poses: Array) -> Array | None:
         """Samples where the residual can change faster than the grid resolves: windows where a step's angle
-        swings (``geometric.swing_hints``), and the theta* values where a branch's domain begins or ends, the
-        zeros of the steps' margins ``1 - c^2`` (``pair_margin`` of ``geometric.case_kernels``), found by the same
-        sweep as the residual's zeros (with the swing windows as samples). A root at or next to a domain edge is
-        bracketed only if the edge is a sample; a domain narrower than the grid step is found as a pair of close
-        margin zeros."""
+        swings (``geometric.swing_hints``). The theta* values where a branch's domain begins or ends come from
+        ``edge_reduction``."""
         if self.closed_form or poses.shape[0] == 0:
             return None
-        from sweepik.engine.sweep import N_SAMPLES  # local: the engine imports the reductions
-
         lo, hi = self._range(poses)
         swings = np.full((poses.shape[0], geometric.SWING_PER_POSE), np.nan)
         ks = np.asarray(self._steps[1], dtype=np.int64)
@@ -368,33 +362,36 @@ class GeometricReduction(Reduction):
             self._case_kernels.amplitudes,
         )
         keep = np.any(np.isfinite(swings), axis=0)
-        swings = swings[:, keep]
-        theta = np.concatenate([_Margins(self, swings, poses).zeros(poses, lo, hi, params), swings], axis=1)
-        keep = np.any(np.isfinite(theta), axis=0)
-        return theta[:, keep] if keep.any() else None
+        return swings[:, keep]
+
+    def edge_reduction(self, poses: Array, hints: Array | None) -> tuple[Reduction, Array, Array] | None:
+        """The zeros of the steps' margins ``1 - c^2`` (``pair_margin`` of ``geometric.case_kernels``), where a
+        branch's domain begins or ends, found by the engine's sweep with the swing windows (``hints``) as samples: a
+        root at or next to a domain edge is bracketed only if the edge is a sample, and a domain narrower than the
+        grid step is found as a pair of close margin zeros."""
+        if self.closed_form or poses.shape[0] == 0:
+            return None
+        lo, hi = self._range(poses)
+        return _Margins(self, np.zeros((poses.shape[0], 0)) if hints is None else hints, poses), lo, hi
 
     def edge_search(self) -> Any:
         """``sample_hints`` as the engine finds them in the same compiled pass as the search
-        (``search.EdgeSearch``, ``Reduction.edge_search``); None for a closed form (no sweep)."""
+        (``EdgeSearch``, ``Reduction.edge_search``); None for a closed form (no sweep)."""
         if self.closed_form:
             return None
-        from sweepik.engine import (
-            search,
-            sweep,  # local: the engine imports the reductions
-        )
         from sweepik.reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG, SWING_SIG, address_of
 
         ck = self._case_kernels
         L, row = geometric.LAYOUT, self._solving_row
         every = row[L["pos_branches"]] == 4 and row[L["need"]] == 3  # (pair_every's plans: both first steps)
-        return search.EdgeSearch(
+        return EdgeSearch(
             margins=_Margins(self, np.empty((0, 0))),
             swing=address_of(geometric.swing, SWING_SIG),
             amplitude=address_of(ck.amplitude, RESIDUAL_SIG),
             amplitudes=address_of(ck.amplitudes, RESIDUALS_SIG),
             steps=np.asarray(self._steps[1], dtype=np.int64),
             n_swing=geometric.SWING_PER_POSE,
-            n_samples=sweep.N_SAMPLES,
+            n_samples=N_SAMPLES,
             hint_range=GeometricReduction._range,
             every=address_of(ck.pair_every, RESIDUALS_SIG) if every else 0,
         )
@@ -589,25 +586,3 @@ class _Margins(Reduction):
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
         raise NotImplementedError("margins have no configurations")
-
-    def zeros(self, poses: Array, lo: Array, hi: Array, params: Array | None = None) -> Array:
-        """Zeros ``(N, K)`` (NaN-padded) of every margin over theta*'s sweep range ``[lo, hi]`` (``params``: the pair
-        plan's ``kernel_params(poses)``, if at hand)."""
-        from sweepik.engine import (
-            search,
-            sweep,  # local: the engine imports the reductions
-        )
-
-        N = poses.shape[0]
-        if search.AVAILABLE:
-            cand, _ = search.search(self, poses, lo, hi, sweep.N_SAMPLES, params, multiplicity=False)
-        else:
-            cand, _ = sweep.find_candidates(self, poses, lo, hi, sweep.N_SAMPLES)
-        if N == 1:
-            return cand.theta[None, :]
-        counts = np.bincount(cand.pose, minlength=N)
-        out = np.full((N, int(counts.max(initial=0))), np.nan)
-        order = np.argsort(cand.pose, kind="stable")
-        slot = np.arange(cand.pose.size) - np.repeat(np.cumsum(counts) - counts, counts)
-        out[cand.pose[order], slot] = cand.theta[order]
-        return out

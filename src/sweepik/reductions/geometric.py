@@ -39,8 +39,9 @@ from numba import float64, int64, njit
 from numba.extending import register_jitable
 from numpy.typing import NDArray
 
-from sweepik._jit import ERROR_MODEL, inlined
+from sweepik._jit import ERROR_MODEL, inlined, writable
 from sweepik.engine import parallel
+from sweepik.engine.settings import PARALLEL_MIN
 from sweepik.reductions.kernels import (
     CONFIGURATION_SIG,
     CONFIGURATIONS_SIG,
@@ -509,8 +510,6 @@ def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
     ``h``, where its angles turn by up to pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
     ``amplitude`` of ``case_kernels``: the arm's kernel, given as ``amplitude``, with ``amplitudes`` its all-step
     kernel, which must compute at least the steps ``ks``). Batches use both cores, as the engine's search."""
-    from sweepik.engine.search import PARALLEL_MIN, writable  # local: the engine imports the reductions
-
     parallel.run(
         swing,
         params.shape[0],
