@@ -318,21 +318,32 @@ def _precise_candidates(
 
 def special_solutions(red: Reduction, chain: Array) -> tuple[Array | None, IntArray | None]:
     """The candidates of the reduction's blind spots, ``(q (N, K, n) NaN-padded, multiplicities (N, K) or None)``:
-    its ``special_solutions``, and the configurations the reduction of its ``blind_spot`` finds on the poses it
-    names (swept here, twins' copies included), those ``blind_spot_kept`` keeps; ``(None, None)`` without."""
+    its ``special_solutions``, then the configurations the reduction of its ``blind_spot`` finds on the poses it
+    names (swept here, twins' copies included) that ``blind_spot_kept`` keeps; ``(None, None)`` without either."""
     special = red.special_solutions(chain)
-    if special is not None:
-        return special if isinstance(special, tuple) else (special, None)
+    own, own_mult = special if isinstance(special, tuple) else (special, None)
+    blind = _blind_spot_solutions(red, chain)
+    if blind is None:
+        return own, own_mult
+    if own is None:
+        return blind
+    if own_mult is None:
+        own_mult = np.ones(own.shape[:2], dtype=np.intp)
+    return np.concatenate([own, blind[0]], axis=1), np.concatenate([own_mult, blind[1]], axis=1)
+
+
+def _blind_spot_solutions(red: Reduction, chain: Array) -> tuple[Array, IntArray] | None:
+    """``special_solutions``' part from the reduction's ``blind_spot`` (None: no blind spot, or nothing kept)."""
     blind = red.blind_spot(chain)
     if blind is None:
-        return None, None
+        return None
     idx, other, rng = blind
     cand, _ = twin_copies(other, *find_candidates(other, chain[idx], rng[:, 0], rng[:, 1]))
     q = other.solve_rest(chain[idx][cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
     keep = np.all(np.isfinite(q), axis=-1) & red.blind_spot_kept(q)
     pose, q, mult = cand.pose[keep], q[keep], cand.mult[keep]
     if pose.size == 0:
-        return None, None
+        return None
     counts = np.bincount(pose, minlength=idx.size)
     width = max(8, int(counts.max()))
     out = np.full((chain.shape[0], width, q.shape[1]), np.nan)
