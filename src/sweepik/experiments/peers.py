@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from sweepik.errors import SweepikError, UnknownOptionError
 from sweepik.model.chain import Chain
 from sweepik.model.units import mm_per_unit
 
@@ -213,7 +214,7 @@ def _ssik_revolute_6r(robot: Any) -> tuple[Array, Array, Array]:
     H, P, R_end, rev = chain_arrays(robot)
     if len(rev) != 6 or not rev.all():
         kinds = "".join("R" if r else "P" for r in rev)
-        raise ValueError(f"ssik solves 6R arms (six revolute joints); {robot.name} is {kinds}")
+        raise SweepikError(f"ssik solves 6R arms (six revolute joints); {robot.name} is {kinds}")
     return H, P, R_end
 
 
@@ -420,7 +421,7 @@ def ssik_solver(
     try:
         solve(robot.fk(_SSIK_CHECK_Q[0]))
     except Exception as exc:  # any failure of the foreign package on a reachable pose: it cannot solve this arm
-        raise ValueError(f"ssik ({about['source']}, {about['solver']}) fails on {robot.name}: {exc}") from exc
+        raise SweepikError(f"ssik ({about['source']}, {about['solver']}) fails on {robot.name}: {exc}") from exc
     return solve, about
 
 
@@ -446,8 +447,8 @@ def _ssik_choose(robot: Any, sources: tuple[str, ...]) -> tuple[Callable[[Array]
                 "solver": ssik_manipulator(robot).solver_name,
             }
         else:
-            raise ValueError(f"unknown ssik source {source!r}; expected some of {SSIK_SOURCES}")
-    raise ValueError(f"none of the ssik sources {sources} applies to {robot.name}")
+            raise UnknownOptionError(f"unknown ssik source {source!r}; expected some of {SSIK_SOURCES}")
+    raise SweepikError(f"none of the ssik sources {sources} applies to {robot.name}")
 
 
 def _ssik_live(robot: Any) -> Callable[[Array], Any]:
@@ -469,13 +470,13 @@ def ssik_status(robot: Any) -> dict[str, Any]:
     "fails", "reason": a sentence}``."""
     try:
         _ssik_revolute_6r(robot)  # (first: a prismatic arm is out of ssik's reach, installed or not)
-    except ValueError as exc:
+    except SweepikError as exc:
         return {"solves": False, "why": "not 6R", "reason": str(exc)}
     try:
         _, about = ssik_solver(robot)
     except ImportError:
         return {"solves": False, "why": "not installed", "reason": "ssik is not installed (pip install ssik)"}
-    except ValueError as exc:
+    except SweepikError as exc:
         return {"solves": False, "why": "fails", "reason": str(exc)}
     return {"solves": True, **about}
 
