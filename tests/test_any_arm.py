@@ -343,6 +343,38 @@ FAMILIES = {
         ("revolute", 0, 90, _L(g), 0),
         ("revolute", 0, 0, _L(g), 0),
     ],
+    # a general 3R positioning chain (no two axes meeting or parallel) + spherical wrist: Pieper's quartic (rrr)
+    "wrist_general": lambda g: [
+        *[("revolute", _L(g), float(g.uniform(20, 70)), _L(g), 0) for _ in range(3)],
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 90, 0, 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # the same at the base (a spherical shoulder, as the Panda with joint 5 held): rrr on the reversed chain
+    "shoulder_general": lambda g: [
+        ("revolute", 0, -90, _L(g), 0),
+        ("revolute", 0, 90, 0, 0),
+        *[("revolute", _L(g), float(g.uniform(20, 70)), _L(g), 0) for _ in range(4)],
+    ],
+    # a Cartesian gantry carrying a wrist whose axes are pairwise offset: orientation from the three revolute joints,
+    # then the slides linearly (decoupled)
+    "gantry_offset_wrist": lambda g: [
+        ("prismatic", 0, -90, 0, 0),
+        ("prismatic", 0, -90, 0, -90),
+        ("prismatic", 0, 0, 0, 0),
+        ("revolute", _L(g), float(g.uniform(20, 70)), _L(g), 0),
+        ("revolute", _L(g), float(g.uniform(20, 70)), _L(g), 0),
+        ("revolute", 0, 0, _L(g), 0),
+    ],
+    # slides and turns interleaved (R P R P R P), every axis oblique: decoupled, the slides turning with the joints
+    "interleaved_rp": lambda g: [
+        ("revolute", 0.2 * _L(g), float(g.uniform(20, 70)), _L(g), 0),
+        ("prismatic", 0.2 * _L(g), float(g.uniform(20, 70)), 0.1, 0),
+        ("revolute", 0.2 * _L(g), float(g.uniform(20, 70)), _L(g), 0),
+        ("prismatic", 0.2 * _L(g), float(g.uniform(20, 70)), 0.1, 0),
+        ("revolute", 0.2 * _L(g), float(g.uniform(20, 70)), _L(g), 0),
+        ("prismatic", 0.0, 0, 0.1, 0),
+    ],
     # C-Arm-like: a prismatic rail first, other dimensions
     "rail_pair": lambda g: [
         ("prismatic", 0, 0, 0, 0),

@@ -17,7 +17,7 @@ from sweepik.engine import parallel
 from sweepik.engine.settings import N_SAMPLES, PARALLEL_MIN
 from sweepik.model.chain import Chain
 from sweepik.model.robot import Robot
-from sweepik.reductions import geometric
+from sweepik.reductions import decoupled, geometric
 from sweepik.reductions.base import Array, EdgeSearch, IntArray, Reduction
 from sweepik.reductions.plan import Plan, plans
 from sweepik.reductions.position import CASES, FINAL_JOINTS, STEP_JOINTS
@@ -89,12 +89,15 @@ class GeometricReduction(Reduction):
         # the pair and wrist families' kernels are made for the arm's position case (geometric.case_kernels)
         self._case = (
             None
-            if plan.family == "parallel"
+            if plan.family in ("parallel", "decoupled")
             else geometric.case_kernels(int(row[L["case"]]), plan.free, tuple(bool(r) for r in chain.revolute[:4]))
         )
         if plan.family == "parallel":
             self._kernels = (geometric.wrist_residual, geometric.parallel_configuration)
             self.kernel_configurations = geometric.parallel_configurations
+        elif plan.family == "decoupled":
+            self._kernels = (geometric.wrist_residual, decoupled.configuration)
+            self.kernel_configurations = decoupled.configurations
         elif plan.family == "pair":
             self._kernels = (self._case_kernels.pair_residual, self._case_kernels.pair_configuration)
             self.kernel_residuals = self._case_kernels.pair_residuals
@@ -198,6 +201,8 @@ class GeometricReduction(Reduction):
 
         if self.plan.family == "parallel":
             return address_of(geometric.parallel_singular_flags, SINGULAR_SIG), np.zeros(4)
+        if self.plan.family == "decoupled":
+            return address_of(decoupled.singular_flags, SINGULAR_SIG), np.zeros(4)
         return address_of(self._case_kernels.wrist_singular, SINGULAR_SIG), self._continuum_thresholds
 
     def continuum_joints(
@@ -207,6 +212,11 @@ class GeometricReduction(Reduction):
         involves its joint, ``CONTINUUM_AMPLITUDE``) gives that step's joint; the first step's before the second's.
         None when no candidate does (almost always). (The wrist family's continua where its wrist is singular are its
         fallback's, ``degenerate``.)"""
+        if self.plan.family == "decoupled" and pose.size:  # (its orientation singular: joint a turns with joint c)
+            flag = self._singular(poses)[0][pose]
+            if error is not None:
+                flag &= error <= tol
+            return np.where(flag, self.plan.joint(self._decoupled_first), -1).astype(np.intp) if flag.any() else None
         if self._case is None or pose.size == 0:  # (the parallel family: its steps have no amplitudes)
             return None
         if self.plan.closed_form and not self._singular(poses)[1].any():  # (a pose's amplitudes: theta* moves nothing)
@@ -270,10 +280,15 @@ class GeometricReduction(Reduction):
             return out
         return [(by, deg & ~free), (shoulder, free)] if (deg & ~free).any() else [(shoulder, free)]
 
+    @cached_property
+    def _decoupled_first(self) -> int:
+        """The decoupled family's first revolute joint (in the solved chain's order)."""
+        return int(np.flatnonzero(self._chain.revolute)[0])
+
     def degenerate(self, poses: Array) -> NDArray[np.bool_] | None:
         """Closed form: poses where a branch's wrist is singular or nearly so (``geometric.WRIST_SINGULAR``): the
-        solver answers them with the fallback sweep."""
-        if not self.plan.closed_form or poses.shape[0] == 0:
+        solver answers them with the fallback sweep (the decoupled family has none: ``continuum_joints``)."""
+        if not self.plan.closed_form or poses.shape[0] == 0 or self.plan.family == "decoupled":
             return None
         return self._singular(poses)[0]
 
@@ -290,6 +305,8 @@ class GeometricReduction(Reduction):
         params = self.kernel_params(poses)
         if self.plan.family == "parallel":
             parallel.run(geometric.parallel_singular, N, 2 * PARALLEL_MIN, params, out)
+        elif self.plan.family == "decoupled":
+            parallel.run(decoupled.singular_flags, N, 2 * PARALLEL_MIN, params, np.zeros(4), out, low)
         else:
             singular = self._case_kernels.wrist_singular
             parallel.run(singular, N, 2 * PARALLEL_MIN, params, self._continuum_thresholds, out, low)

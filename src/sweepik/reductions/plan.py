@@ -8,8 +8,9 @@ A position case applies when its structural condition holds for **every** value 
 (:func:`.position.reduce_chain`) is checked at several theta* values. Distances are judged relative to the
 arm's length scale (``structure.INTERSECT_TOL_REL``), directions with ``structure.PARALLEL_TOL``.
 
-Ranking (``rank``): a closed form before a sweep; a plan without a blind spot (``Plan.conditional``) before
-one with; fewer branches (less work per sample); the forward chain before the reversed; the lower theta*.
+Ranking (``rank``): a closed form before a sweep; a structured position case before ``rrr`` (the quartic); a
+plan without a blind spot (``Plan.conditional``) before one with; fewer branches (less work per sample); the
+forward chain before the reversed; the lower theta*.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from sweepik.model.structure import (
     near_structure,
     structure_of,
 )
+from sweepik.reductions.decoupled import decoupled_applies
 from sweepik.reductions.position import BRANCHES, CASES, motion, reduce_chain
 
 _reduce_chain: Any = reduce_chain
@@ -58,7 +60,7 @@ class Plan:
 
     @property
     def closed_form(self) -> bool:
-        return self.family in ("wrist", "parallel")
+        return self.family in ("wrist", "parallel", "decoupled")
 
     def joint(self, i: int) -> int:
         """Robot index of joint ``i`` of the solved chain."""
@@ -71,6 +73,12 @@ class Plan:
 
     def steps(self) -> list[str]:
         """The subproblem chain, in words (joints numbered from 1 as the robot numbers them)."""
+        if self.family == "decoupled":
+            return [
+                "the revolute joints turn the tool alone (slides do not turn it)",
+                "the first two revolute joints: sp2 on the last one's axis; the last: sp1",
+                "the slides: lines3 (the position is linear in them)",
+            ]
         if self.family == "parallel":
             j = [self.joint(i) + 1 for i in range(6)]
             axes = f"the parallel axes {j[1]}, {j[2]}, {j[3]}"
@@ -96,7 +104,8 @@ class Plan:
             ]
         others = [i for i in range(4) if i != self.free]
         a, b, c = (self.joint(i) + 1 for i in others)
-        place = f"joints {a}, {b}, {c} place the wrist centre ({self.case})"
+        how = "sp5, a quartic" if self.case == "rrr" else self.case
+        place = f"joints {a}, {b}, {c} place the wrist centre ({how})"
         if self.family == "wrist":
             j4, j5, j6 = (self.joint(i) + 1 for i in (3, 4, 5))
             return [place, f"joints {j4}, {j5}: sp2 on joint {j6}'s axis", f"joint {j6}: sp1"]
@@ -229,7 +238,43 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
             return no
         ok, cond = dots(lambda g: float(np.dot(g[0], g[1])))
         return ok, cond, None
+    if case == "rrr":
+        if not (ra and rb and rc) or not all(_sp5_regular(g) for g in geo):
+            return no
+        return True, False, None
     return no
+
+
+def _fixed_target(samples: list[tuple[np.ndarray, ...]], tol: float) -> bool:
+    """The reduced chains of every theta* sample are one and the same (to ``tol``): theta* does not move ``W``."""
+    first = samples[0]
+    return all(all(np.allclose(u, v, rtol=0.0, atol=tol) for u, v in zip(first, g, strict=True)) for g in samples)
+
+
+def _sp5_regular(g: tuple[np.ndarray, ...]) -> bool:
+    """The ``rrr`` case's ``sp5`` fixes the three angles (a quartic, not a continuum) for targets of ``W`` all around:
+    the 2x2 blocks of its ``sp6`` are not both singular at random targets at the reach of the reduced chain. They
+    are where axes a and b are parallel, or b and c (structured cases), or a slide-free chain folds onto one line."""
+    ha, hb, hc, _, ob, oc, w = g
+    pab, pbc, pcw = ob, oc - ob, w - oc
+    reach = float(np.linalg.norm(pab) + np.linalg.norm(pbc) + np.linalg.norm(pcw))
+    if reach == 0.0:
+        return False
+    rng = np.random.default_rng(0)
+    for tp in rng.normal(size=(3, 3)) * reach:
+        # sp6's blocks (``subproblems.revolute.sp6`` with sp5's arguments): theta1 terms of hb . R(ha, t) tp and
+        # (-pab) . R(ha, t) tp, theta3 terms of -hb . R(hc, t) pcw and -pbc . R(hc, t) pcw
+        def terms(h: np.ndarray, k: np.ndarray, p: np.ndarray) -> tuple[float, float]:
+            perp = p - np.dot(k, p) * k
+            return float(np.dot(h, perp)), float(np.dot(h, np.cross(k, p)))
+
+        a1, a2 = terms(hb, ha, tp), terms(-pab, ha, tp)
+        b1, b2 = terms(-hb, hc, pcw), terms(-pbc, hc, pcw)
+        det_a, det_b = a1[0] * a2[1] - a1[1] * a2[0], b1[0] * b2[1] - b1[1] * b2[0]
+        size = max(abs(v) for v in (*a1, *a2, *b1, *b2))
+        if max(abs(det_a), abs(det_b)) <= 1e-9 * size * size:
+            return False
+    return True
 
 
 def _samples(robot: Robot, chain_index: int, prismatic: bool) -> list[float]:
@@ -252,6 +297,10 @@ def _position_plans(robot: Robot, chain: Chain, rev_chain: bool, W: np.ndarray, 
         samples = [_reduced(chain, W, f, x) for x in xs]
         pts = np.cumsum(chain.P[:4], axis=0)
         for case in CASES:
+            if case == "rrr" and family != "wrist" and not (f == 3 and _fixed_target(samples, tol)):
+                # the quartic's roots are no branches a sweep can follow, unless theta* leaves W's problem as it is
+                # (joint 4 turning about the wrist centre: the sweep answering a singular wrist, ``generic._continua``)
+                continue
             ok, cond, rel = _check(case, types, samples, tol)  # type: ignore[arg-type]
             if not ok:
                 continue
@@ -319,8 +368,29 @@ def _meets_as_kernel(chain: Chain, f: int, xs: list[float], rel: list[np.ndarray
     return True
 
 
-def rank(p: Plan) -> tuple[int, int, int, int, int]:
-    return (0 if p.closed_form else 1, int(p.conditional), p.branches, int(p.reversed), p.free)
+#: Closed forms that use no structure of the position (ranked after those that do).
+UNSTRUCTURED = ("rrr", "decoupled")
+
+
+def rank(p: Plan) -> tuple[int, int, int, int, int, int]:
+    return (
+        0 if p.closed_form else 1,
+        int(p.case in UNSTRUCTURED),
+        int(p.conditional),
+        p.branches,
+        int(p.reversed),
+        p.free,
+    )
+
+
+def decoupled_plans(robot: Robot, chain: Chain) -> list[Plan]:
+    """The decoupled family (closed form, :mod:`.decoupled`): three slides and three revolute joints in any order;
+    ``W`` is the tool origin (no point is special)."""
+    ok, cond = decoupled_applies(chain)
+    if not ok:
+        return []
+    W = _t(chain.P.sum(axis=0))
+    return [Plan("decoupled", False, 0, "decoupled", 2, W, (0.0, 0.0, 0.0), conditional=cond)]
 
 
 @lru_cache(maxsize=64)
@@ -352,6 +422,8 @@ def plans(robot: Robot) -> tuple[Plan, ...]:
             W = np.array(st.points[(4, 5)])
             found += _position_plans(robot, chain, rev_chain, W, (0, 1, 2, 3), "pair")
         found += parallel_plans(robot, chain, rev_chain, st)
+        if not rev_chain:
+            found += decoupled_plans(robot, chain)
     return tuple(sorted((p for p in found if continuum_covered(p, found, robot)), key=rank))
 
 

@@ -20,6 +20,9 @@ case         structure                                     subproblem chain (bra
 ``ppr``      a, b prismatic, c revolute                    c: sp4 on the normal of a, b (2); a, b: lines2
 ``ac_par``   a, c revolute and parallel, b prismatic       b: lp4 on the a-height (1); c: sp3 (2); a: sp1
 ``rpp``      a revolute, b, c prismatic                    a: sp4 on the normal of b, c (2); b, c: lines2
+``rrr``      three revolute, no structure (wrist family    a, b, c: sp5, a quartic (4)
+             only: its roots are not branches a sweep
+             could follow)
 ===========  ============================================  ===========================================
 
 Outside a branch's domain (a circle or line that misses its sphere or plane) a step continues with its
@@ -42,7 +45,7 @@ from numba import njit, types
 from numba.extending import overload
 
 from sweepik._jit import ERROR_MODEL, inlined
-from sweepik.subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs
+from sweepik.subproblems import lines2, lines3, lp3, lp4, sp1_cs, sp2_cs, sp3_cs, sp4_cs, sp5
 from sweepik.subproblems.vec import add, cross, dot, norm, rot_cs, scale, sub, unit
 
 __all__ = [
@@ -61,7 +64,7 @@ __all__ = [
 ]
 
 #: Case names, in the order of their integer codes in a family's parameter row.
-CASES = ("ab_par", "bc_par", "ab_int", "bc_int", "ppp", "ppr", "ac_par", "rpp")
+CASES = ("ab_par", "bc_par", "ab_int", "bc_int", "ppp", "ppr", "ac_par", "rpp", "rrr")
 #: Branches of each case: (with the first unknown revolute, with it prismatic) for the cases where it matters.
 BRANCHES = {
     "ab_par": (4, 2),  # indexed by joint c's type
@@ -72,6 +75,7 @@ BRANCHES = {
     "ppr": (2, 2),
     "ac_par": (2, 2),
     "rpp": (2, 2),
+    "rrr": (4, 4),
 }
 
 #: The joint (``a``, ``b`` or ``c``) that each case's two-solution steps turn, for their amplitudes ``(r1, r2)`` of
@@ -86,6 +90,7 @@ STEP_JOINTS = {
     "ppr": (None, "c"),
     "ac_par": (None, "c"),
     "rpp": (None, "a"),
+    "rrr": (None, None),
 }
 #: The joint each case turns last by ``sp1`` (None: none, or a slide solved linearly). Where ``W`` lies on its axis
 #: (``geometric._final_gap`` vanishes) the step no longer involves it: the joint is free as far as ``W`` goes (the
@@ -99,6 +104,7 @@ FINAL_JOINTS = {
     "ppr": None,
     "ac_par": "a",
     "rpp": None,
+    "rrr": None,
 }
 
 
@@ -329,6 +335,29 @@ def _rpp(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     return _rev(ua, va), _pris(qb), _pris(qc), _rev(ub, vb), _pris(qb2), _pris(qc2), 0.0, c2, math.inf, r2
 
 
+@inlined
+def _rrr(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
+    """Case ``rrr`` of ``place``: three revolute joints with no structure (a general 3R positioning chain, Pieper's
+    arm with a spherical wrist and any shoulder). ``R_a^T tp = pab + R_b(pbc + R_c pcw)`` is SP5 with theta1 =
+    -qa: up to four roots of a quartic, position branches 0-3 in the order ``sp5`` gives them; a
+    branch with no root is NaN. Both steps report cosine 0 and infinite amplitude: a root of the quartic is
+    exact or absent, and a double root (two branches meeting) is found by ``trig.trig2_roots`` as one."""
+    t1, t2, t3, n = sp5(scale(-1.0, pab), tp, pbc, pcw, ha, hb, hc)
+    i, j = 2 * b1, 2 * b1 + 1
+    nan = (math.nan, math.nan, math.nan)
+    ma, mb, mc = nan, nan, nan
+    na, nb, nc = nan, nan, nan
+    if i < n and _first(b2):
+        ma, mb, mc = _rev(math.cos(t1[i]), -math.sin(t1[i])), _rev(math.cos(t2[i]), math.sin(t2[i])), _rev(
+            math.cos(t3[i]), math.sin(t3[i])
+        )
+    if j < n and _second(b2):
+        na, nb, nc = _rev(math.cos(t1[j]), -math.sin(t1[j])), _rev(math.cos(t2[j]), math.sin(t2[j])), _rev(
+            math.cos(t3[j]), math.sin(t3[j])
+        )
+    return ma, mb, mc, na, nb, nc, 0.0, 0.0, math.inf, math.inf
+
+
 def place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     """Motions putting ``W`` at ``tp`` on branch ``b1`` of the first step and branch ``b2`` of the second (0, 1,
     ``BOTH`` or ``NEITHER``): ``(ma, mb, mc)`` (see ``motion``) of branch ``2 b1``, those of branch ``2 b1 + 1``
@@ -349,13 +378,13 @@ def place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
 
     For compiled code only (an ``overload``, ``_place``): with ``case`` a constant of the caller's (a literal type,
     as a family kernel made for one arm's case passes it), only that case's chain of subproblems is compiled, not all
-    eight (about 2 s less on a fresh install); with a variable ``case``, every case.
+    nine (about 2 s less on a fresh install); with a variable ``case``, every case.
     """
     raise NotImplementedError("position.place is compiled code's")
 
 
 #: The cases' functions, in the order of ``CASES``.
-_CASE_FUNCTIONS = (_ab_par, _bc_par, _ab_int, _bc_int, _ppp, _ppr, _ac_par, _rpp)
+_CASE_FUNCTIONS = (_ab_par, _bc_par, _ab_int, _bc_int, _ppp, _ppr, _ac_par, _rpp, _rrr)
 
 
 @inlined
@@ -394,6 +423,8 @@ def _place(case, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
             return place(6, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         if case == 7:
             return place(7, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
+        if case == 8:
+            return place(8, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
         return place(-1, b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o)
 
     return every

@@ -130,8 +130,11 @@ def trig2_roots(a0, a1, b1, a2, b2):
         if abs(abs(zi) - 1.0) > UNIT_TOL:
             continue
         t = math.atan2(zi.imag, zi.real)
+        best, best_f = t, math.inf
         for _ in range(NEWTON_STEPS):
             f, df = trig2(a0, a1, b1, a2, b2, t)
+            if abs(f) < best_f:
+                best, best_f = t, abs(f)
             if df == 0.0:
                 break
             step = f / df
@@ -139,7 +142,12 @@ def trig2_roots(a0, a1, b1, a2, b2):
                 break
             t -= step
         f, _ = trig2(a0, a1, b1, a2, b2, t)
-        if abs(f) > ROOT_TOL * scale:
+        if abs(f) < best_f:
+            best, best_f = t, abs(f)
+        # (the angle where |f| is least: next to a double root that rounding turned into a complex pair, f has a
+        # minimum at rounding level and no zero, and Newton steps from it lead away)
+        t = best
+        if best_f > ROOT_TOL * scale:
             continue
         t = math.atan2(math.sin(t), math.cos(t))
         dup = False
