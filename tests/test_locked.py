@@ -96,6 +96,16 @@ def test_panda_with_joint7_locked_closed_form(value: float) -> None:
     _check_locked(robot, 6, value, 1000, seed=10, reference="ikgeo", n_ref=150)
 
 
+@pytest.mark.parametrize("value", [0.3, -1.9])
+def test_panda_with_joint5_locked_quartic_closed_form(value: float) -> None:
+    """Joint 5 held: joints 1-3 meet (a spherical shoulder) and joints 4, 6, 7 form a general 3R chain; the closed
+    form places the shoulder point with them by sp5 (Pieper's quartic, case rrr, on the reversed chain)."""
+    robot = sweepik.load_robot("franka_panda")
+    info = sweepik.analyze(robot, locked={"joint5": value})
+    assert info["chosen"]["closed_form"] and info["chosen"]["case"] == "rrr"
+    _check_locked(robot, 4, value, 600, seed=13, reference="numerical", n_ref=8)
+
+
 @pytest.mark.parametrize("value", [0.0, -1.1])
 def test_iiwa_with_joint3_locked(value: float) -> None:
     robot = sweepik.load_robot("kuka_iiwa14")
