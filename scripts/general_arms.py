@@ -99,9 +99,8 @@ def _check_arm(robot: sweepik.Robot, Q: np.ndarray, ref: dict | None, n_numerica
     out = {"recall": rec, "poses": len(Q), "wrong": wrong, "single_us": 1e6 * np.median(single),
            "batched_us": 1e6 * batched, "misses": misses}  # fmt: skip
     if ref is not None:
-        same = [
-            r is not None and same_solution_set(s.q, r, robot.is_revolute, L) for s, r in zip(sols, ref["ssik"], strict=True)
-        ]
+        rev = robot.is_revolute
+        same = [r is not None and same_solution_set(s.q, r, rev, L) for s, r in zip(sols, ref["ssik"], strict=True)]
         out["ssik_same"] = int(np.sum(same))
         out["ssik_us"] = 1e6 * float(np.median(ref["seconds"]))
     if n_numerical:

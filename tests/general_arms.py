@@ -1,4 +1,4 @@
-"""Random arms without structure (issue 37) and their poses, for tests and ``scripts/general_arms.py`` (not a test file).
+"""Random arms without structure (issue 37) and their poses, for tests and ``scripts/general_arms.py`` (no tests).
 
 ``random_arm(kind, seed)``: a six-joint arm in standard DH, ``a`` in [0.05, 0.4] m, ``d`` in [0.05, 0.3] m, twists
 uniform on the circle, joint offsets random, a random base and tool: ``kind`` "6r" (all revolute), "5r1p" or "4r2p"
@@ -21,7 +21,9 @@ from sweepik.model.robot import Robot
 KINDS = ("6r", "5r1p", "4r2p")
 
 
-def random_arm(kind: str, seed: int) -> Robot:
+def random_arm(kind: str, seed: int, around: NDArray[np.float64] | None = None, width: float = 5.0) -> Robot:
+    """(See the module docstring.) ``around``: limits ``width`` degrees (or ``width`` cm of travel) either side of
+    this configuration instead."""
     rng = np.random.default_rng(37_000 + 101 * KINDS.index(kind) + seed)
     n_pris = KINDS.index(kind)
     prismatic = set(rng.choice(6, n_pris, replace=False).tolist()) if n_pris else set()
@@ -39,6 +41,11 @@ def random_arm(kind: str, seed: int) -> Robot:
                 "limits": [-0.5, 0.5] if kind_i == "prismatic" else [-180.0, 180.0],
             }
         )
+    if around is not None:
+        for j, q in zip(joints, around, strict=True):
+            v = float(np.degrees(q)) if j["type"] == "revolute" else float(q)
+            w = width if j["type"] == "revolute" else width / 100.0
+            j["limits"] = [v - w, v + w]
     data = {
         "name": f"general_{kind}_{seed}",
         "dh_convention": "standard",

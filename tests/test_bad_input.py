@@ -126,8 +126,6 @@ def _robot_corpus() -> dict[str, tuple[bytes, bool]]:
         "negative_length_solve": CARM_TOML.replace("a = 350.0", "a = -350.0").encode(),
         "zero_d_solve": CARM_TOML.replace("d = 402.0", "d = 0.0").encode(),
         "unknown_reduction_solve": _field(CARM_TOML, "default_reduction", '"nope"').encode(),
-        # no default reduction and joints 5, 6 offset (no two axes meeting at either end): outside the catalogue
-        "no_reduction_solve": _offset_last_joint(CARM_TOML.replace('default_reduction = "carm-d1"\n', "")).encode(),
         "huge_alpha_solve": _field(CARM_TOML, "alpha", "45.0", 1).encode(),
     }
     for key in _TEXT_FIELDS:
@@ -710,3 +708,16 @@ def test_absurd_joint_values_refused(value: float, capsys: pytest.CaptureFixture
         CARM.fk(q[[1, 0, 2, 3, 4, 5]])  # an angle too
     code, err = _cli(["fk", "carm", repr(value), "0", "0", "0", "0", "0"], capsys)
     assert code == 2 and "at most 1e+30" in err
+
+
+def test_arm_outside_the_catalogue_is_no_longer_bad_input(tmp_path: Path) -> None:
+    """The C-Arm with its last joint offset (no two axes meeting at either end; once refused as outside the catalogue)
+    is solved by the general method, and gives the configuration back."""
+    path = tmp_path / "offset.toml"
+    path.write_text(_offset_last_joint(CARM_TOML.replace('default_reduction = "carm-d1"\n', "")))
+    robot = sweepik.load_robot(path)
+    assert sweepik.analyze(robot)["chosen"]["family"] == "general"
+    sols = sweepik.solve(robot, robot.fk(Q_GOOD), limits=False)
+    d = sols.q - Q_GOOD
+    d[:, robot.is_revolute] = np.mod(d[:, robot.is_revolute] + np.pi, 2 * np.pi) - np.pi
+    assert sols.q.size and np.abs(d).max(axis=1).min() < 1e-8

@@ -39,7 +39,7 @@ def test_analyze_cli_text_and_json(capsys):
     assert code == 0 and info["chosen"]["chain"] == "reversed" and info["reason"] is None
 
 
-def test_analyze_cli_outside_the_catalogue(capsys, tmp_path: Path):
+def test_analyze_cli_outside_the_catalogue_names_the_general_method(capsys, tmp_path: Path):
     text = (Path(sweepik.__file__).parent / "io" / "robots" / "puma560.toml").read_text()
     # joint 5's axis 30 mm off joint 4's and 6's: no spherical wrist, no two axes meeting at either end
     text = text.replace("alpha = 90.0\nlimits = [-100.0, 100.0]", "a = 0.03\nalpha = 90.0\nlimits = [-100.0, 100.0]")
@@ -50,9 +50,11 @@ def test_analyze_cli_outside_the_catalogue(capsys, tmp_path: Path):
     path = tmp_path / "odd.toml"
     path.write_text(text)
     code, out, _ = run(capsys, "analyze", str(path))
-    assert code == 0 and "no decomposition" in out and "outside sweepik's catalogue" in out
-    code, out, err = run(capsys, "solve", str(path), "--xyz", "0.3", "0.2", "0.4")
-    assert code == 2 and out == "" and "catalogue" in err and len(err.strip().splitlines()) == 1
+    assert code == 0 and "chosen: general method (elimination)" in out and "no structured decomposition" in out
+    code, out, err = run(capsys, "solve", str(path), "--xyz", "0.3", "0.2", "0.4", "--json")
+    assert code == 0 and err == ""
+    code, out, err = run(capsys, "solve", str(path), "--xyz", "0.3", "0.2", "0.4", "--free-joint", "2")
+    assert code == 2 and out == "" and "no decomposition sweeps" in err and len(err.strip().splitlines()) == 1
 
 
 def test_robots_lists_structure_and_decomposition(capsys):

@@ -58,8 +58,9 @@ def test_moved_zeros_give_the_same_plan_set(name: str, seed: int) -> None:
     assert _kinds(other) == _kinds(robot)
 
 
-def test_an_arm_without_structure_is_refused_with_its_structure_named() -> None:
-    """Six revolute axes of which no two meet or stay parallel: no plan, and ``choose`` says what was found."""
+def test_an_arm_without_structure_takes_the_general_method() -> None:
+    """Six revolute axes of which no two meet or stay parallel: no structured plan; ``choose`` gives the general
+    method, and asked to sweep a joint it refuses, naming what it found."""
     rng = np.random.default_rng(7)
     joints = tuple(
         Joint(
@@ -72,5 +73,6 @@ def test_an_arm_without_structure_is_refused_with_its_structure_named() -> None:
     )
     robot = Robot("general_6r", joints, dh_convention="standard", length_unit="m")
     assert plans(robot) == ()
-    with pytest.raises(NoReductionError, match="intersecting or parallel"):
-        choose(robot)
+    assert choose(robot).family == "general"
+    with pytest.raises(NoReductionError, match="no decomposition sweeps"):
+        choose(robot, free_joint=1)

@@ -26,7 +26,7 @@ from functools import lru_cache
 import numpy as np
 
 from sweepik.model.robot import Robot
-from sweepik.reductions import GeometricReduction, Plan, set_plan_check
+from sweepik.reductions import Plan, reduction_for, set_plan_check
 from sweepik.solving import solve_many
 
 __all__ = ["N_CHECK", "N_QUICK", "RECOVER_TOL", "PlanCheck", "check_plan", "checked_choice"]
@@ -81,7 +81,7 @@ def check_configurations(robot: Robot, n: int = N_CHECK) -> np.ndarray:
 def check_plan(robot: Robot, plan: Plan, n: int = N_CHECK) -> PlanCheck:
     """Solve ``FK(q)`` with ``plan`` (limits off) for ``n`` configurations of the check and count those given back."""
     Q = check_configurations(robot, n)
-    batch = solve_many(robot, robot.fk(Q), reduction=GeometricReduction(robot, plan), limits=False)
+    batch = solve_many(robot, robot.fk(Q), reduction=reduction_for(robot, plan), limits=False)
     found = 0
     n_solutions = sum(len(s) for s in batch)
     n_families = sum(len(s.families) for s in batch)

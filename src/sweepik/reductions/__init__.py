@@ -11,6 +11,7 @@ from sweepik.reductions import decompose
 from sweepik.reductions.base import Reduction
 from sweepik.reductions.carm import CArmD1, CArmTheta2
 from sweepik.reductions.decompose import choose
+from sweepik.reductions.general import GeneralReduction
 from sweepik.reductions.generic import GeometricReduction, Plan
 
 __all__ = [
@@ -18,7 +19,9 @@ __all__ = [
     "CArmD1",
     "CArmTheta2",
     "GeometricReduction",
+    "GeneralReduction",
     "Plan",
+    "reduction_for",
     "REDUCTIONS",
     "get_reduction",
     "is_default",
@@ -73,12 +76,19 @@ def _cached(robot: Robot, name: str) -> Reduction:
     return REDUCTIONS[name](robot)
 
 
+def reduction_for(robot: Robot, plan: Plan) -> Reduction:
+    """The reduction that solves ``robot`` with ``plan``: the general method's, or a geometric family's."""
+    if plan.family == "general":
+        return GeneralReduction(robot)
+    return GeometricReduction(robot, plan)
+
+
 @lru_cache(maxsize=64)
 def _automatic(robot: Robot, free_joint: int | None) -> Reduction:
-    red = GeometricReduction(robot, choose(robot, free_joint))
+    red = reduction_for(robot, choose(robot, free_joint))
     if free_joint is None:  # (an arm with a near-structure: a second plan's solutions joined, sweepik.engine.companion)
         comp = decompose.companion_plan(robot)
-        red.companion = None if comp is None else GeometricReduction(robot, comp)
+        red.companion = None if comp is None else reduction_for(robot, comp)
     return red
 
 
@@ -125,7 +135,7 @@ def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduct
 
 
 @lru_cache(maxsize=64)
-def _held_reduction(arm: Robot, plan: Plan, companion: Plan | None) -> GeometricReduction:
-    red = GeometricReduction(arm, plan)
-    red.companion = None if companion is None else GeometricReduction(arm, companion)
+def _held_reduction(arm: Robot, plan: Plan, companion: Plan | None) -> Reduction:
+    red = reduction_for(arm, plan)
+    red.companion = None if companion is None else reduction_for(arm, companion)
     return red

@@ -110,6 +110,8 @@ def _numbered_in_full_arm(info: dict[str, Any], held: HeldJoints) -> dict[str, A
 def plan_line(plan: dict[str, Any]) -> str:
     """One line describing a plan of ``analyze``, e.g. ``closed form, 8 branches`` or ``sweep joint 1 (d1), 4
     branches``."""
+    if plan["family"] == "general":
+        return f"general method (elimination), up to {plan['branches']} solutions"
     if plan["closed_form"]:
         head = "closed form"
     else:

@@ -114,6 +114,9 @@ class Reduction(ABC):
     edge_search: Any = None
     #: No sweep: every branch of ``solve_rest`` (at any theta*) is a candidate (a closed-form decomposition).
     closed_form: bool = False
+    #: A second reduction whose solutions the solver joins to this one's (:mod:`sweepik.engine.companion`): set by the
+    #: automatic decomposition on an arm with a near-structure, None otherwise.
+    companion: Reduction | None = None
     #: Classes of branches whose residuals are identical (they differ in the configuration only, e.g. by a
     #: symmetry of the arm): the engine searches the first of each class and hands its roots to the others.
     twins: tuple[tuple[int, ...], ...] = ()

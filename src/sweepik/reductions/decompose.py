@@ -15,8 +15,10 @@ from typing import Any
 from sweepik.errors import NoReductionError
 from sweepik.model.robot import Robot
 from sweepik.model.structure import near_structure
+from sweepik.reductions.general import general_refusal
 from sweepik.reductions.plan import (
     DEGENERATE_TOL,
+    GENERAL,
     Plan,
     chain_structures,
     near_structures,
@@ -57,13 +59,20 @@ def continuum_everywhere(robot: Robot) -> str | None:
     )
 
 
+def _continuum_refused(robot: Robot) -> bool:
+    """The UR family's closed form applies but was refused for its continuum (``plan.continuum_covered``): at joint
+    5 = 0 the solutions form a continuum that only a sweep can report, and no sweep fits the arm. The general
+    method's elimination is singular there (every value of its eigen-joint a root) and finds no member either, so
+    the arm is refused rather than answered "unreachable" at a reachable pose."""
+    return any(parallel_plans(robot, chain, rev_chain, s) for rev_chain, chain, s in chain_structures(robot))
+
+
 def _missing(robot: Robot) -> str:
     if robot.n_joints != 6:
         return f"robot {robot.name!r} has {robot.n_joints} joints: the decompositions solve 6-joint arms"
     st = robot.structure()
     head = f"robot {robot.name!r} ({st.describe()}) is outside sweepik's catalogue: "
-    # the UR family's closed form, refused for its continuum (continuum_covered)
-    if any(parallel_plans(robot, chain, rev_chain, s) for rev_chain, chain, s in chain_structures(robot)):
+    if _continuum_refused(robot):
         return head + (
             "axes 2-4 are parallel (the UR family), but joint 6's axis can turn parallel to them (its wrist has an "
             "offset): at joint 5 = 0 the solutions form a continuum that only a sweep can report, and no sweep fits "
@@ -142,11 +151,18 @@ def choice(robot: Robot, free_joint: int | None = None, hints: tuple[Plan, ...] 
         options = tuple(p for p in options if not p.closed_form and p.free_joint == free_joint)
         if not options:
             raise NoReductionError(not_sweepable(robot, free_joint))
-    elif not options:
-        raise NoReductionError(_missing(robot))
+    elif not options:  # (no structure to use: the general method, for six joints)
+        why = general_refusal(robot)
+        if _continuum_refused(robot):  # (the general method too would answer "unreachable" on its continuum)
+            raise NoReductionError(_missing(robot))
+        if why is not None:
+            raise NoReductionError(_missing(robot) + f" The general method does not apply either: {why}.")
+        return GENERAL, ()
     else:
         options = tuple(p for p in options if not p.conditional) or options
     near = near_structures(robot)
+    if near and free_joint is None and general_refusal(robot) is None:
+        options = (*options, GENERAL)  # (a decomposition built on a relation that holds only nearly may miss)
     if _plan_check is None or not near or (len(options) == 1 and free_joint is None):
         return options[0], ()
     plan, checks = _plan_check(robot, options, tuple(h for h in hints if h in options))
@@ -205,6 +221,8 @@ def explain(robot: Robot) -> dict[str, Any]:
             f"near-structure ({', '.join(near)}): every plan checked on {best.checked} configurations of the arm; "
             f"this one gave {best.recovered} of them back and {best.solutions} solutions in all, the most"
         )
+    elif plan.family == "general":
+        info["why"] = "no structured decomposition applies to this arm: the general method (elimination) solves it"
     else:
         info["why"] = "the best ranked plan (a closed form before a sweep, no blind spot, fewer branches)"
     return info
@@ -213,6 +231,7 @@ def explain(robot: Robot) -> dict[str, Any]:
 def _plan_dict(robot: Robot, p: Plan) -> dict[str, Any]:
     return {
         "family": p.family,
+        "method": "elimination" if p.family == "general" else "closed form" if p.closed_form else "sweep",
         "closed_form": p.closed_form,
         "free_joint": None if p.closed_form else p.free_joint,
         "free_joint_number": None if p.closed_form else p.free_joint + 1,

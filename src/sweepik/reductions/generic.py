@@ -50,10 +50,6 @@ def _chain_rows(chain: Chain) -> Array:
 class GeometricReduction(Reduction):
     """A reduction from a :class:`Plan`: the family's compiled kernels over the generic parameter row."""
 
-    #: A second reduction whose solutions the solver joins to this one's (:mod:`sweepik.engine.companion`): set by the
-    #: automatic decomposition on an arm with a near-structure, None otherwise.
-    companion: Reduction | None = None
-
     #: Set per instance (the family's pair, its all-branch residual or configurations); declared here so that
     #: ``uses_kernel`` and the engine see this class as their owner.
     kernel: tuple[Any, Any] | None = None
@@ -92,6 +88,7 @@ class GeometricReduction(Reduction):
             if plan.family in ("parallel", "decoupled")
             else geometric.case_kernels(int(row[L["case"]]), plan.free, tuple(bool(r) for r in chain.revolute[:4]))
         )
+        self._kernels: tuple[Any, Any]
         if plan.family == "parallel":
             self._kernels = (geometric.wrist_residual, geometric.parallel_configuration)
             self.kernel_configurations = geometric.parallel_configurations

@@ -36,7 +36,16 @@ from sweepik.reductions.position import BRANCHES, CASES, motion, reduce_chain
 
 _reduce_chain: Any = reduce_chain
 
-__all__ = ["Plan", "plans", "rank", "chain_structures", "near_structures", "parallel_plans", "continuum_covered"]
+__all__ = [
+    "Plan",
+    "GENERAL",
+    "plans",
+    "rank",
+    "chain_structures",
+    "near_structures",
+    "parallel_plans",
+    "continuum_covered",
+]
 
 
 @dataclass(frozen=True)
@@ -60,7 +69,7 @@ class Plan:
 
     @property
     def closed_form(self) -> bool:
-        return self.family in ("wrist", "parallel", "decoupled")
+        return self.family in ("wrist", "parallel", "decoupled", "general")
 
     def joint(self, i: int) -> int:
         """Robot index of joint ``i`` of the solved chain."""
@@ -73,6 +82,13 @@ class Plan:
 
     def steps(self) -> list[str]:
         """The subproblem chain, in words (joints numbered from 1 as the robot numbers them)."""
+        if self.family == "general":
+            return [
+                "elimination: the kinematic equations reduced to a matrix polynomial in one joint's half-angle "
+                "tangent (Raghavan-Roth), its roots the eigenvalues of a generalized eigenproblem (Manocha-Canny)",
+                "the other joints from the eigenvectors and closed forms",
+                "every root polished by Newton steps on the forward kinematics",
+            ]
         if self.family == "decoupled":
             return [
                 "the revolute joints turn the tool alone (slides do not turn it)",
@@ -381,6 +397,11 @@ def rank(p: Plan) -> tuple[int, int, int, int, int, int]:
         int(p.reversed),
         p.free,
     )
+
+
+#: The general method (:mod:`.general`): no structure used; chosen where no structured plan applies, and checked
+#: beside them on an arm with a near-structure.
+GENERAL = Plan("general", False, 0, "general", 16, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
 def decoupled_plans(robot: Robot, chain: Chain) -> list[Plan]:

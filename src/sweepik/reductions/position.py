@@ -348,12 +348,16 @@ def _rrr(b1, b2, tp, ha, hb, hc, ra, rb, rc, pab, pbc, pcw, o):
     ma, mb, mc = nan, nan, nan
     na, nb, nc = nan, nan, nan
     if i < n and _first(b2):
-        ma, mb, mc = _rev(math.cos(t1[i]), -math.sin(t1[i])), _rev(math.cos(t2[i]), math.sin(t2[i])), _rev(
-            math.cos(t3[i]), math.sin(t3[i])
+        ma, mb, mc = (
+            _rev(math.cos(t1[i]), -math.sin(t1[i])),
+            _rev(math.cos(t2[i]), math.sin(t2[i])),
+            _rev(math.cos(t3[i]), math.sin(t3[i])),
         )
     if j < n and _second(b2):
-        na, nb, nc = _rev(math.cos(t1[j]), -math.sin(t1[j])), _rev(math.cos(t2[j]), math.sin(t2[j])), _rev(
-            math.cos(t3[j]), math.sin(t3[j])
+        na, nb, nc = (
+            _rev(math.cos(t1[j]), -math.sin(t1[j])),
+            _rev(math.cos(t2[j]), math.sin(t2[j])),
+            _rev(math.cos(t3[j]), math.sin(t3[j])),
         )
     return ma, mb, mc, na, nb, nc, 0.0, 0.0, math.inf, math.inf
 
