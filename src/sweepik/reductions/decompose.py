@@ -152,9 +152,9 @@ def choice(robot: Robot, free_joint: int | None = None, hints: tuple[Plan, ...] 
         if not options:
             raise NoReductionError(not_sweepable(robot, free_joint))
     elif not options:  # (no structure to use: the general method, for six joints)
-        why = general_refusal(robot)
         if _continuum_refused(robot):  # (the general method too would answer "unreachable" on its continuum)
             raise NoReductionError(_missing(robot))
+        why = general_refusal(robot)
         if why is not None:
             raise NoReductionError(_missing(robot) + f" The general method does not apply either: {why}.")
         return GENERAL, ()

@@ -53,7 +53,10 @@ class GeneralReduction(Reduction):
 
     name = "general"
     closed_form = True
-    blind_spots = "none: every isolated solution is a root of the elimination (continua are not traced)"
+    blind_spots = (
+        "none: every isolated solution is a root of the elimination; a continuum is traced from the members it finds "
+        "(none where its pencil is singular in every arrangement)"
+    )
 
     def __init__(self, robot: Robot) -> None:
         super().__init__(robot, free_joint=0, n_branches=MAX_SOLUTIONS)
