@@ -27,7 +27,7 @@ from sweepik._jit import ERROR_MODEL, inlined
 from sweepik.model.chain import Chain, rotation_about
 from sweepik.reductions.geometric import _P, _REV, _T, _h, _mat, _v
 from sweepik.subproblems import lines3, sp1, sp2
-from sweepik.subproblems.vec import add, orthogonal, rot, scale
+from sweepik.subproblems.vec import add, cross, norm, orthogonal, rot, scale
 
 __all__ = ["decoupled_applies", "configuration", "configurations", "singular_flags", "DEPENDENT_SLIDES"]
 
@@ -130,10 +130,7 @@ def singular_flags(params, thr, out, low, start, stop):
     for i in range(start, stop):
         p = params[i]
         a, _, c, _, _, _ = _joints(p)
-        v = _mat(p, _h(p, c))
-        ha = _h(p, a)
-        n = (ha[1] * v[2] - ha[2] * v[1], ha[2] * v[0] - ha[0] * v[2], ha[0] * v[1] - ha[1] * v[0])
-        out[i] = math.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) < ORIENTATION_SINGULAR
+        out[i] = norm(cross(_h(p, a), _mat(p, _h(p, c)))) < ORIENTATION_SINGULAR
         low[i] = False
 
 
