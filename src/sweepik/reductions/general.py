@@ -13,18 +13,25 @@ where it has fewer). ``solve_rest`` solves each distinct pose it is given once.
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
+from sweepik._jit import ERROR_MODEL
 from sweepik.errors import NoReductionError
 from sweepik.model.robot import Robot
 from sweepik.reductions.base import Array, IntArray, Reduction
+from sweepik.reductions.deflated import FastPath, fast_path, solve_poses
 from sweepik.reductions.elimination import ArmNotSupportedError, GeneralIK
 
 #: At most this many isolated solutions (6R, 5R1P: the degree of the elimination's polynomial).
 MAX_SOLUTIONS = 16
+
+#: The roots of this many distinct poses are kept (the engine asks for rows of the same poses several times).
+_ROOTS_KEPT = 4096
 
 __all__ = ["GeneralReduction", "MAX_SOLUTIONS", "general_refusal"]
 
@@ -39,6 +46,13 @@ def _setup(robot: Robot) -> GeneralIK | str:
         return str(e)
 
 
+@lru_cache(maxsize=64)
+def _fast_path(robot: Robot) -> FastPath | None:
+    """The compiled path of ``robot``'s elimination (:mod:`.deflated`; cached per robot), or None."""
+    setup = _setup(robot)
+    return None if isinstance(setup, str) else fast_path(setup)
+
+
 def general_refusal(robot: Robot) -> str | None:
     """Why the general method cannot solve ``robot`` (not six joints, or no elimination of its chain well posed),
     or None."""
@@ -48,8 +62,32 @@ def general_refusal(robot: Robot) -> str | None:
     return setup if isinstance(setup, str) else None
 
 
+@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
+def _residual(p, x, branch):
+    """``kernels.RESIDUAL_SIG``: nothing is swept (a closed form), NaN."""
+    return math.nan
+
+
+@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
+def _configuration(p, x, branch, out):
+    """``kernels.CONFIGURATION_SIG``: root ``branch`` of the pose, as ``kernel_params`` laid it out (NaN where the
+    pose has fewer)."""
+    for i in range(out.shape[0]):
+        out[i] = p[out.shape[0] * branch + i]
+
+
+@njit(cache=True, nogil=True, error_model=ERROR_MODEL)
+def _configurations(p, x, out):
+    """``kernels.CONFIGURATIONS_SIG``: every root of the pose."""
+    for b in range(out.shape[0]):
+        _configuration(p, x, b, out[b])
+
+
 class GeneralReduction(Reduction):
-    """The general method as a closed-form reduction (see the module docstring)."""
+    """The general method as a closed-form reduction (see the module docstring).
+
+    Its compiled kernels read the roots from the parameter row of a pose (``kernel_params``: the elimination runs
+    there, each distinct pose once), so the engine certifies and settles them like any closed form's branches."""
 
     name = "general"
     closed_form = True
@@ -57,6 +95,8 @@ class GeneralReduction(Reduction):
         "none: every isolated solution is a root of the elimination; a continuum is traced from the members it finds "
         "(none where its pencil is singular in every arrangement)"
     )
+    kernel = (_residual, _configuration)
+    kernel_configurations = _configurations
 
     def __init__(self, robot: Robot) -> None:
         super().__init__(robot, free_joint=0, n_branches=MAX_SOLUTIONS)
@@ -66,34 +106,75 @@ class GeneralReduction(Reduction):
         setup = _setup(robot)
         assert not isinstance(setup, str)
         self._elimination = setup
-        self._last: tuple[Array, Array, IntArray, NDArray[np.bool_]] | None = None
+        self._fast = _fast_path(robot)
+        self._last: tuple[Array, Array, Array] | None = None  # (a copy of the poses, the poses, their rows)
+        self._kept: dict[bytes, Array] = {}
 
-    def _roots(self, poses: Array) -> tuple[Array, IntArray]:
-        """``(unique roots (U, MAX_SOLUTIONS, n) NaN-padded, index of each pose's row (N,))`` of chain poses."""
+    def kernel_params(self, poses: Array) -> Array:
+        """``(N, MAX_SOLUTIONS * n + 1)`` per chain pose: its roots (row-major, NaN-padded), then 1.0 where it is
+        a continuum (``continuum_poses``). Each distinct pose is solved once: the engine asks for rows of the same
+        poses several times, so the rows of the last ``_ROOTS_KEPT`` distinct poses are kept by value."""
         last = self._last
-        if last is not None and last[0] is poses:
-            return last[1], last[2]
+        if last is not None and (last[1] is poses or (last[0].shape == poses.shape and np.array_equal(last[0], poses))):
+            return last[2]
         robot = self.robot
         world = poses
         if not robot.base_is_identity:
             world = robot.T_world_base @ world
         world = world @ robot.T_flange_tool
         flat = np.ascontiguousarray(world.reshape(world.shape[0], 16))
-        unique, inverse = np.unique(flat, axis=0, return_inverse=True)
-        out = np.full((unique.shape[0], MAX_SOLUTIONS, robot.n_joints), np.nan)
-        continuum = np.zeros(unique.shape[0], dtype=bool)
-        for i, row in enumerate(unique):
-            res = self._elimination.solve(row.reshape(4, 4))
-            out[i, : res.q.shape[0]] = res.q[:MAX_SOLUTIONS]
-            continuum[i] = res.continuum
-        inverse = inverse.reshape(-1)
-        self._last = (poses, out, inverse, continuum[inverse])
-        return out, inverse
+        n = robot.n_joints
+        rows = np.empty((flat.shape[0], MAX_SOLUTIONS * n + 1))
+        kept = self._kept
+        keys = [pose.tobytes() for pose in flat]
+        new: dict[bytes, int] = {}
+        for i, key in enumerate(keys):
+            if key not in kept:
+                new.setdefault(key, i)
+        solved = dict(zip(new, self._solve_new(flat[list(new.values())], list(new)), strict=True)) if new else {}
+        for i, key in enumerate(keys):
+            row = solved.get(key)
+            rows[i] = kept[key] if row is None else row
+        self._last = (poses.copy(), poses, rows)
+        return rows
+
+    def _solve_new(self, flat: Array, keys: list[bytes]) -> Array:
+        """The rows of the distinct poses ``flat (U, 16)`` (the world frame of the chain), kept under ``keys`` too: by
+        the compiled path (:mod:`.deflated`) where it answers, by the elimination's full solve elsewhere."""
+        n = self.robot.n_joints
+        width = MAX_SOLUTIONS * n + 1
+        rows = np.full((flat.shape[0], width), np.nan)
+        rows[:, -1] = 0.0
+        todo = np.arange(flat.shape[0])
+        if self._fast is not None:
+            q, count = solve_poses(self._fast, flat.reshape(-1, 4, 4), MAX_SOLUTIONS)
+            rows[:, :-1] = q.reshape(flat.shape[0], -1)
+            todo = np.flatnonzero(count < 0)
+        for i in todo:
+            res = self._elimination.solve(flat[i].reshape(4, 4))
+            q = res.q[:MAX_SOLUTIONS]
+            rows[i, :-1] = np.nan
+            rows[i, : q.size] = q.reshape(-1)
+            rows[i, -1] = float(res.continuum)
+        kept = self._kept
+        for key, row in zip(keys, rows, strict=True):
+            if len(kept) >= _ROOTS_KEPT:
+                kept.pop(next(iter(kept)))
+            kept[key] = row
+        return rows
+
+    def _roots(self, poses: Array) -> Array:
+        """``(N, MAX_SOLUTIONS, n)``: the roots of each chain pose (NaN-padded)."""
+        n = self.robot.n_joints
+        return self.kernel_params(poses)[:, :-1].reshape(-1, MAX_SOLUTIONS, n)
+
+    def continuum_poses(self, poses: Array) -> NDArray[np.bool_]:
+        """The chain poses the elimination finds to be a continuum (see ``continuum_joints``)."""
+        return self.kernel_params(poses)[:, -1] > 0.5
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        roots, index = self._roots(poses)
+        per_pose = self._roots(poses)  # (N, B, n)
         N, M = np.asarray(theta).shape
-        per_pose = roots[index]  # (N, B, n)
         if branch is None:
             return np.broadcast_to(per_pose[:, None], (N, M, *per_pose.shape[1:])).copy()
         b = np.broadcast_to(np.asarray(branch, dtype=np.intp), (N, M))
@@ -105,15 +186,17 @@ class GeneralReduction(Reduction):
         """At a pose the elimination finds to be a continuum (its matrix polynomial singular for every value, or a
         root on a curve of solutions): each candidate's joint that moves most along the continuum (the largest
         entry of the Jacobian's null vector there), for the engine to trace; -1 elsewhere. None: no such pose."""
-        self._roots(poses)
-        last = self._last
-        assert last is not None
-        flagged = last[3][pose] & np.all(np.isfinite(last[1][last[2][pose], np.asarray(branch)]), axis=-1)
+        on = self.continuum_poses(poses)
+        if not on.any():
+            return None
+        branch = np.asarray(branch)
+        roots = self._roots(poses)[pose, branch]
+        flagged = on[pose] & np.all(np.isfinite(roots), axis=-1)
         if error is not None:
             flagged &= error <= tol
         if not flagged.any():
             return None
-        roots = last[1][last[2][pose[flagged]], np.asarray(branch)[flagged]]
+        roots = roots[flagged]
         J = self.robot.jacobian(roots)
         J[:, :3] /= self.robot.length_scale  # (rows: linear velocity first)
         null = np.linalg.svd(J)[2][:, -1, :]
