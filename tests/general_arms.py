@@ -66,3 +66,46 @@ def poses_of(robot: Robot, n: int, n_singular: int, seed: int) -> NDArray[np.flo
     if n_singular:
         Q = np.concatenate([Q, singular_configurations(robot, n_singular, rng)])
     return Q
+
+
+def _rodrigues(k: NDArray[np.float64], t: float) -> NDArray[np.float64]:
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + np.sin(t) * K + (1.0 - np.cos(t)) * (K @ K)
+
+
+def dh_chain(k: int) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(H (6, 3), P (7, 3), R_end)``: the k-th random 6R arm of the elimination's prototype bench (standard DH from
+    ``default_rng(1000 + k)``: twists, ``a`` in [0.05, 0.4] m, ``d`` in [0.05, 0.3] m, offsets; no base or tool) as
+    a product-of-exponentials chain, computed as the prototype did, digit for digit: ssik's derivations of these arms
+    are cached on disk under their exact geometry (``scripts/general_arms.py ssik-refs``)."""
+    rng = np.random.default_rng(1000 + k)
+    alpha = rng.uniform(-np.pi, np.pi, 6)
+    a = rng.uniform(0.05, 0.4, 6)
+    d = rng.uniform(0.05, 0.3, 6)
+    theta0 = rng.uniform(-np.pi, np.pi, 6)
+    F = np.eye(4)
+    H, pts = [], []
+    for i in range(6):
+        H.append(F[:3, 2].copy())
+        pts.append(F[:3, 3].copy())
+        A = np.eye(4)
+        A[:3, :3] = _rodrigues(np.array([0.0, 0.0, 1.0]), theta0[i]) @ _rodrigues(np.array([1.0, 0.0, 0.0]), alpha[i])
+        A[:3, 3] = [a[i] * np.cos(theta0[i]), a[i] * np.sin(theta0[i]), d[i]]
+        F = F @ A
+    P = np.diff(np.array([np.zeros(3), *pts, F[:3, 3]]), axis=0)
+    return np.array(H), P, F[:3, :3].copy()
+
+
+def robot_of_chain(H: NDArray[np.float64], P: NDArray[np.float64], R_end: NDArray[np.float64], name: str) -> Robot:
+    """A 6R arm, metres, limits [-180, 180] deg, written joint by joint (origin + axis) from a product-of-exponentials
+    chain at q = 0: joint i's origin is ``P[i]`` (frames parallel to the base), its axis ``H[i]``, the tool ``P[6]``
+    and ``R_end``."""
+    from sweepik.model.pose import zyz_from_matrix
+
+    joints = [
+        {"name": f"j{i + 1}", "type": "revolute", "origin": {"xyz": P[i].tolist()}, "axis": H[i].tolist(),
+         "limits": [-180.0, 180.0]}
+        for i in range(6)
+    ]  # fmt: skip
+    tool = {"xyz": P[6].tolist(), "zyz": np.degrees(zyz_from_matrix(R_end)).tolist()}
+    return robot_from_dict({"name": name, "length_unit": "m", "joints": joints, "tool": tool})

@@ -151,6 +151,27 @@ def same_solution_set(a: Array, b: Array, revolute: np.ndarray, length_scale: fl
     )
 
 
+#: Two solutions of a multiple root (sweepik: one of multiplicity 2; another solver: two roots split by rounding,
+#: ~sqrt(eps) apart) are the same to this; simple roots to 1e-6.
+MULTIPLE_ROOT_TOL = 1e-4
+
+
+def unmatched_solutions(
+    q: Array, multiplicity: np.ndarray, theirs: Array, revolute: np.ndarray, length_scale: float
+) -> tuple[list[Array], list[Array]]:
+    """The rows of sweepik's solutions ``q`` (with their ``multiplicity``) that ``theirs`` lacks, and the rows of
+    ``theirs`` that ``q`` lacks: simple roots compared to 1e-6, a multiple root of sweepik's to
+    ``MULTIPLE_ROOT_TOL``."""
+    simple, multiple = q[multiplicity == 1], q[multiplicity > 1]
+    rev, L = revolute, length_scale
+    ours = [x for x in simple if not contains(theirs, x, rev, L, 1e-6)]
+    ours += [x for x in multiple if not contains(theirs, x, rev, L, MULTIPLE_ROOT_TOL)]
+    other = [
+        x for x in theirs if not (contains(simple, x, rev, L, 1e-6) or contains(multiple, x, rev, L, MULTIPLE_ROOT_TOL))
+    ]
+    return ours, other
+
+
 # ----------------------------------------------------------------------------------------------------------
 # 1. many-start numerical search
 # ----------------------------------------------------------------------------------------------------------
@@ -567,3 +588,38 @@ def in_metres(robot: Any, name: str) -> Any:
         )
     data = {"name": name, "length_unit": "m", "dh_convention": robot.dh_convention, "gravity": list(robot.gravity)}
     return robot_from_dict({**data, "joints": joints})
+
+
+def ssik_general_native(H: Array, P: Array, R_end: Array) -> Any:
+    """ssik 8.2's general 6R solver (``ikgeo.general_6r``, Raghavan-Roth / Manocha-Canny) on its native C++ path for
+    the 6R chain ``(H, P, R_end)`` in metres: ``solve(T) -> (k, 6)`` (every branch, no limits, no windings), or None
+    (no ssik, or ssik dispatches another solver). Its first call on an arm derives the elimination with SymPy (4-9
+    minutes, cached by ssik in ``~/.cache/ssik`` under the exact geometry). ssik's live ``Manipulator.solve`` is not
+    used for these arms: on random general arms it answers only through its numerical rescue (measured)."""
+    try:
+        import ssik
+        from ssik._native import rr_native_geometry, try_native_solve
+        from ssik.internals import JointSpec, build_kinbody
+    except ImportError:
+        return None
+    specs = []
+    for i in range(6):
+        TL = np.eye(4)
+        TL[:3, 3] = P[i]
+        TR = None
+        if i == 5:
+            TR = np.eye(4)
+            TR[:3, :3], TR[:3, 3] = R_end, P[6]
+        specs.append(JointSpec(TL, H[i], "revolute", TR, name=f"j{i}", limits=(-np.pi, np.pi)))
+    kb = build_kinbody(specs)
+    name = ssik.Manipulator(kb).solver_name
+    if name != "ikgeo.general_6r":
+        return None
+    geometry = rr_native_geometry(kb)
+
+    def solve(T: Array) -> Array:
+        sols = try_native_solve(name, kb, np.asarray(T, dtype=np.float64), rr_geometry=geometry,
+                                enumerate_windings=False, respect_limits="wrap")  # fmt: skip
+        return np.array([s.q for s in (sols or [])], dtype=np.float64).reshape(-1, 6)
+
+    return solve

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from general_arms import poses_of, random_arm
-from oracles import numerical_solutions, pose_errors, same_solution_set
+from pathlib import Path
+
+from general_arms import dh_chain, poses_of, random_arm, robot_of_chain
+from oracles import numerical_solutions, pose_errors, same_solution_set, unmatched_solutions
 from singular import recovered
 
 import sweepik
@@ -19,6 +21,11 @@ from sweepik import NoReductionError
 from sweepik.reductions.decompose import plans
 
 ARMS = [("6r", 0), ("6r", 1), ("5r1p", 0), ("4r2p", 1)]
+#: ssik 8.2's solutions of the random 6R arms ``general_arms.dh_chain(k)`` (its general solver, derived once per arm
+#: with SymPy: ``python scripts/general_arms.py ssik --arms 11 --n 60 --singular 15 --out tests/data/ssik_general.npz``)
+SSIK_REFERENCES = Path(__file__).parent / "data" / "ssik_general.npz"
+#: ... of which the first this many poses per arm are uniform configurations, the rest on the singular set
+SSIK_REGULAR = 60
 
 
 @pytest.mark.parametrize(("kind", "seed"), ARMS)
@@ -49,6 +56,51 @@ def test_random_arm_without_structure_agrees_with_a_numerical_search(kind: str, 
         ours = sweepik.solve(robot, T, limits=False)
         num = numerical_solutions(robot, T, n_starts=400, full_circle=True)
         assert same_solution_set(ours.q, num, robot.is_revolute, robot.length_scale), (ours.q, num)
+
+
+def test_random_6r_arms_agree_with_ssiks_general_solver() -> None:
+    """Every solution of ssik's is one of ours; at uniform configurations the sets are equal; ours that ssik lacks
+    (on the singular set: a double root its eigenvalue filter loses) reproduce the pose and are double roots
+    (multiplicity 2, a singular Jacobian)."""
+    ref = np.load(SSIK_REFERENCES)
+    extra = 0
+    for k in range(int(ref["n_arms"])):
+        H, P, R_end = dh_chain(k)
+        robot = robot_of_chain(H, P, R_end, f"dh_chain_{k}")
+        Q, count = ref[f"Q{k}"], ref[f"count{k}"]
+        theirs = np.split(ref[f"sols{k}"], np.cumsum(count)[:-1])
+        T = robot.fk(Q)
+        batch = sweepik.solve_many(robot, T, limits=False)
+        for i, (ours, r) in enumerate(zip(batch, theirs, strict=True)):
+            only_ours, only_theirs = unmatched_solutions(ours.q, ours.multiplicity, r, robot.is_revolute, 1.0)
+            assert not only_theirs, (k, i, only_theirs)
+            if i < SSIK_REGULAR:
+                assert not only_ours, (k, i, only_ours)
+            for q in only_ours:
+                extra += 1
+                at = int(np.argmin(np.abs(ours.q - q).max(axis=1)))
+                assert ours.multiplicity[at] == 2, (k, i, q)
+                sv = np.linalg.svd(robot.jacobian(q[None])[0], compute_uv=False)
+                assert sv[-1] < 1e-8 * sv[0], (k, i, sv)
+    assert extra <= 4  # (measured: 2 of 825 poses)
+
+
+def test_a_double_root_is_one_solution_of_multiplicity_two() -> None:
+    """At a configuration on the singular set (of a random arm), the generating configuration is a double root of
+    the elimination: it comes back once, of multiplicity 2, and the count with multiplicity is even."""
+    robot = random_arm("6r", 4)
+    Q = poses_of(robot, 0, 30, seed=4)
+    found = 0
+    for q in Q:
+        sv = np.linalg.svd(robot.jacobian(q[None])[0], compute_uv=False)
+        if not sv[-1] < 1e-12 * sv[0]:
+            continue  # (next to the singular set, not on it)
+        sols = sweepik.solve(robot, robot.fk(q), limits=False)
+        at = int(np.argmin(np.abs(np.angle(np.exp(1j * (sols.q - q)))).max(axis=1)))
+        assert sols.multiplicity[at] == 2, (q, sols.multiplicity)
+        assert int(sols.multiplicity.sum()) % 2 == 0
+        found += 1
+    assert found >= 3
 
 
 def test_general_method_applies_limits() -> None:

@@ -331,7 +331,7 @@ def _solve_one(
     one_call = True
     default = (
         free_joint is None
-        and limits is True
+        and (limits is True or limits is False)
         and type(strategy) is str
         and strategy == "precise"
         and type(n_samples) is int
@@ -344,7 +344,7 @@ def _solve_one(
         # (the default options, the default reduction named or not: their checks done once per arm)
         red = _default_reduction(arm)
         if red.uses_kernel:  # (its solutions straight from the one compiled call, where it settles the pose)
-            out = settled(arm, red, P, chain_poses(arm, P), True, N_SAMPLES)
+            out = settled(arm, red, P, chain_poses(arm, P), limits, N_SAMPLES)
             if out is not None:
                 n = out.q.shape[0]
                 return Solutions(

@@ -30,6 +30,8 @@ from sweepik.reductions.elimination import ArmNotSupportedError, GeneralIK
 #: At most this many isolated solutions (6R, 5R1P: the degree of the elimination's polynomial).
 MAX_SOLUTIONS = 16
 
+#: A solution whose Jacobian's smallest to largest singular value is under this can be a double root.
+DOUBLE_ROOT_RCOND = 1e-5
 #: The roots of this many distinct poses are kept (the engine asks for rows of the same poses several times).
 _ROOTS_KEPT = 4096
 
@@ -152,7 +154,7 @@ class GeneralReduction(Reduction):
             todo = np.flatnonzero(count < 0)
         for i in todo:
             res = self._elimination.solve(flat[i].reshape(4, 4))
-            q = res.q[:MAX_SOLUTIONS]
+            q = self._double_root_twice(res.q, res.continuum)[:MAX_SOLUTIONS]
             rows[i, :-1] = np.nan
             rows[i, : q.size] = q.reshape(-1)
             rows[i, -1] = float(res.continuum)
@@ -162,6 +164,22 @@ class GeneralReduction(Reduction):
                 kept.pop(next(iter(kept)))
             kept[key] = row
         return rows
+
+    def _double_root_twice(self, q: Array, continuum: bool) -> Array:
+        """The elimination's solutions ``q (k, n)`` of a pose, a double root given twice: where ``k`` is odd (the
+        real roots of the elimination's polynomial come in an even number, counted with multiplicity) and not a
+        continuum, the solution whose Jacobian is nearest singular is the double one. Its two rows are one branch
+        meeting another to the engine, which reports one solution of multiplicity 2."""
+        if continuum or q.shape[0] % 2 == 0:
+            return q
+        J = self.robot.jacobian(q)
+        J[:, :3] /= self.robot.length_scale  # (rows: linear velocity first)
+        sv = np.linalg.svd(J, compute_uv=False)
+        ratio = sv[:, -1] / sv[:, 0]
+        k = int(np.argmin(ratio))
+        if not ratio[k] < DOUBLE_ROOT_RCOND:
+            return q
+        return np.concatenate([q[: k + 1], q[k:]])
 
     def _roots(self, poses: Array) -> Array:
         """``(N, MAX_SOLUTIONS, n)``: the roots of each chain pose (NaN-padded)."""
