@@ -8,10 +8,10 @@ full measurement (20 + 10 arms, 250 poses each, ssik beside) is ``scripts/genera
 
 from __future__ import annotations
 
-import numpy as np
-import pytest
 from pathlib import Path
 
+import numpy as np
+import pytest
 from general_arms import dh_chain, poses_of, random_arm, robot_of_chain
 from oracles import numerical_solutions, pose_errors, same_solution_set, unmatched_solutions
 from singular import recovered
