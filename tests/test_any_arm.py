@@ -23,6 +23,7 @@ from oracles import (
     same_solution_set,
     ssik_solutions,
 )
+from singular import singular_configurations
 
 import sweepik
 from sweepik import NoReductionError
@@ -456,6 +457,28 @@ def test_parallel_offset_singular_wrist_is_a_family():
 def pose_errors_ok(robot, q, T):
     dp, ang = pose_errors(robot.fk(q), T, robot.length_scale)
     return (dp <= 1e-9) & (ang <= 1e-9)
+
+
+def test_interleaved_slides_turning_dependent_are_a_family():
+    """Three slides interleaved with three revolute joints (the decoupled closed form): where the revolute joints
+    turn the slides' directions into one plane, the travels along their common null direction are a continuum. The
+    configurations of the singular set where that happens come back, as members of a family along a slide whose
+    samples reproduce the pose; the others on the singular set come back too."""
+    rng = np.random.default_rng(7001)
+    robot = _arm(FAMILIES["interleaved_rp"](rng), rng)
+    assert sweepik.analyze(robot)["chosen"]["case"] == "decoupled"
+    Q = singular_configurations(robot, 40, rng)
+    slides = ~robot.is_revolute
+    dependent = np.array(
+        [np.linalg.svd(robot.jacobian(q[None])[0][:3, slides], compute_uv=False)[-1] < 1e-12 for q in Q]
+    )
+    assert dependent.sum() >= 5
+    for q, sols, dep in zip(Q, sweepik.solve_many(robot, robot.fk(Q), limits=False), dependent, strict=True):
+        assert recovers(robot, sols, q), q.tolist()
+        if dep:
+            assert sols.families and all(not robot.is_revolute[f.free_joint] for f in sols.families)
+            for m in (m for fam in sols.families for m in fam.sample(5)):
+                assert np.all(pose_errors_ok(robot, m, robot.fk(q)))
 
 
 def test_slide_parallel_offset_with_a_singular_wrist_is_refused():

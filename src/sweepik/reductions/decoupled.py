@@ -7,10 +7,11 @@ With the angles known, the tool position is linear in the travels: ``t = p0 + su
 rotations of the revolute joints before slide k and ``p0`` the position with every slide at 0 (``lines3``). Two
 branches; a Cartesian gantry carrying any wrist (its axes meeting or not) is one.
 
-Blind spots, each a continuum rather than a miss: joint c's target axis on joint a's (``sp2`` degenerate: qa and
-qc turn together; one member is returned and ``GeometricReduction.continuum_joints`` names joint a for the engine
-to trace), and slide directions that turn dependent (``lines3``: NaN, the plan is ``conditional`` when a revolute
-joint before a slide can make them so).
+Blind spots, each a continuum rather than a miss, each given as one member that ``GeometricReduction.
+continuum_joints`` hands to the engine to trace: joint c's target axis on joint a's (``sp2`` degenerate: qa and qc
+turn together; traced along joint a), and slide directions that turn dependent (a revolute joint before a slide
+turning it into the plane of the others: the travels along their common null direction; traced along the slide
+that moves most).
 
 The kernels read the generic parameter row of :mod:`.geometric` (``LAYOUT``): the chain's axes, segments and joint
 types, the target orientation ``M`` and the target of ``W``, here the tool origin.
@@ -26,14 +27,19 @@ from numba import njit
 from sweepik._jit import ERROR_MODEL, inlined
 from sweepik.model.chain import Chain, rotation_about
 from sweepik.reductions.geometric import _P, _REV, _T, _h, _mat, _v
-from sweepik.subproblems import lines3, sp1, sp2
-from sweepik.subproblems.vec import add, cross, norm, orthogonal, rot, scale
+from sweepik.subproblems import lines2, lines3, sp1, sp2
+from sweepik.subproblems.prismatic import PARALLEL_DET
+from sweepik.subproblems.vec import add, cross, dot, norm, orthogonal, rot, scale
 
 __all__ = ["decoupled_applies", "configuration", "configurations", "singular_flags", "DEPENDENT_SLIDES"]
 
-#: The slides' directions (unit vectors) are independent when ``|det|`` of the three exceeds this at every
-#: orientation the plan checks; below it the travels are ill-determined (a continuum where it vanishes).
-DEPENDENT_SLIDES = 1e-6
+#: The slides' directions (unit vectors) are dependent where ``|det|`` of the three is at most this: the travels are
+#: then a continuum where the tool position is reachable (one member given, ``singular_flags`` marks the pose).
+#: Above it, nearly dependent slides give one isolated solution (``lines3``'s threshold: its travels are then
+#: accurate to rounding / |det|, and the engine polishes them).
+DEPENDENT_SLIDES = PARALLEL_DET
+#: The family applies where ``|det|`` of the slides' directions is above this at random orientations.
+INDEPENDENT_SLIDES = 1e-6
 #: ``|h_a x M h_c|`` below this: joint c's target axis on joint a's (the orientation is singular, a continuum).
 ORIENTATION_SINGULAR = 1e-7
 
@@ -73,9 +79,10 @@ def _before(p, q, i, v):
 
 
 @inlined
-def _solve(p, branch, q):
-    """Branch ``branch`` (0, 1) into ``q (6,)``; NaN outside the orientation's reach or with dependent slides."""
-    a, b, c, k0, k1, k2 = _joints(p)
+def _orientation(p, branch, q):
+    """The revolute joints of branch ``branch`` (0, 1) into ``q (6,)`` (the slides 0); False where the target
+    orientation is out of reach (``q`` all NaN)."""
+    a, b, c, _, _, _ = _joints(p)
     ha, hb, hc = _h(p, a), _h(p, b), _h(p, c)
     v = _mat(p, hc)
     t1a, t2a, t1b, t2b, cos, _ = sp2(v, hc, ha, hb)
@@ -85,7 +92,7 @@ def _solve(p, branch, q):
     elif abs(cos) > 1.0 + 1e-12:
         for i in range(6):
             q[i] = math.nan
-        return
+        return False
     elif branch == 0:
         qa, qb = -t1a, t2a
     else:
@@ -95,6 +102,24 @@ def _solve(p, branch, q):
     for i in range(6):
         q[i] = 0.0
     q[a], q[b], q[c] = qa, qb, qc
+    return True
+
+
+@inlined
+def _slides(p, q):
+    """The slides' directions at the revolute joints of ``q``, in chain order."""
+    _, _, _, k0, k1, k2 = _joints(p)
+    return _before(p, q, k0, _h(p, k0)), _before(p, q, k1, _h(p, k1)), _before(p, q, k2, _h(p, k2))
+
+
+@inlined
+def _solve(p, branch, q):
+    """Branch ``branch`` (0, 1) into ``q (6,)``; NaN outside the orientation's reach. Where the slides' directions
+    are dependent (``|det| <= DEPENDENT_SLIDES``: a continuum along them where the tool position is reachable), the
+    member with the third slide (of the two most independent ones' complement) at 0."""
+    if not _orientation(p, branch, q):
+        return
+    _, _, _, k0, k1, k2 = _joints(p)
     pos = _v(p, _P)
     for i in range(6):
         seg = _v(p, _P + 3 * (i + 1))
@@ -102,8 +127,17 @@ def _solve(p, branch, q):
             seg = rot(_h(p, i), q[i], seg)
         pos = add(pos, _before(p, q, i, seg))
     rest = add(_v(p, _T), scale(-1.0, pos))
-    d0, d1, d2 = lines3(_before(p, q, k0, _h(p, k0)), _before(p, q, k1, _h(p, k1)), _before(p, q, k2, _h(p, k2)), rest)
-    q[k0], q[k1], q[k2] = d0, d1, d2
+    u0, u1, u2 = _slides(p, q)
+    if abs(dot(u0, cross(u1, u2))) > DEPENDENT_SLIDES:
+        q[k0], q[k1], q[k2] = lines3(u0, u1, u2, rest)
+        return
+    n01, n02, n12 = norm(cross(u0, u1)), norm(cross(u0, u2)), norm(cross(u1, u2))
+    if n01 >= n02 and n01 >= n12:
+        q[k0], q[k1] = lines2(u0, u1, rest)
+    elif n02 >= n12:
+        q[k0], q[k2] = lines2(u0, u2, rest)
+    else:
+        q[k1], q[k2] = lines2(u1, u2, rest)
 
 
 @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
@@ -125,13 +159,18 @@ def configurations(p, x, out):
 
 @njit(cache=True, nogil=True, error_model=ERROR_MODEL)
 def singular_flags(params, thr, out, low, start, stop):
-    """``kernels.SINGULAR_SIG``: ``out[i]`` where joint c's target axis lies on joint a's (a continuum); ``low``
-    all False (no step amplitudes)."""
+    """``kernels.SINGULAR_SIG``: ``out[i]`` where joint c's target axis lies on joint a's (a continuum along joint
+    a); ``low[i]`` where a branch's slides are dependent (``DEPENDENT_SLIDES``: a continuum along the slides)."""
+    q = np.empty(6)
     for i in range(start, stop):
         p = params[i]
         a, _, c, _, _, _ = _joints(p)
         out[i] = norm(cross(_h(p, a), _mat(p, _h(p, c)))) < ORIENTATION_SINGULAR
         low[i] = False
+        for branch in range(2):
+            if _orientation(p, branch, q):
+                u0, u1, u2 = _slides(p, q)
+                low[i] |= abs(dot(u0, cross(u1, u2))) <= DEPENDENT_SLIDES
 
 
 def decoupled_applies(chain: Chain) -> tuple[bool, bool]:
@@ -158,6 +197,6 @@ def decoupled_applies(chain: Chain) -> tuple[bool, bool]:
                     R = R @ rotation_about(H[j], q[j])
             cols.append(R @ H[k])
         dets.append(abs(float(np.linalg.det(np.array(cols)))))
-    if min(dets) < DEPENDENT_SLIDES:
+    if min(dets) < INDEPENDENT_SLIDES:
         return False, False
     return True, bool(np.ptp(dets) > 1e-9)

@@ -209,11 +209,8 @@ class GeometricReduction(Reduction):
         involves its joint, ``CONTINUUM_AMPLITUDE``) gives that step's joint; the first step's before the second's.
         None when no candidate does (almost always). (The wrist family's continua where its wrist is singular are its
         fallback's, ``degenerate``.)"""
-        if self.plan.family == "decoupled" and pose.size:  # (its orientation singular: joint a turns with joint c)
-            flag = self._singular(poses)[0][pose]
-            if error is not None:
-                flag &= error <= tol
-            return np.where(flag, self.plan.joint(self._decoupled_first), -1).astype(np.intp) if flag.any() else None
+        if self.plan.family == "decoupled" and pose.size:
+            return self._decoupled_continua(poses, pose, branch, error, tol)
         if self._case is None or pose.size == 0:  # (the parallel family: its steps have no amplitudes)
             return None
         if self.plan.closed_form and not self._singular(poses)[1].any():  # (a pose's amplitudes: theta* moves nothing)
@@ -276,6 +273,31 @@ class GeometricReduction(Reduction):
         if not free.any():
             return out
         return [(by, deg & ~free), (shoulder, free)] if (deg & ~free).any() else [(shoulder, free)]
+
+    def _decoupled_continua(
+        self, poses: Array, pose: IntArray, branch: IntArray, error: Array | None, tol: float
+    ) -> IntArray | None:
+        """``continuum_joints`` of the decoupled family: joint a where the orientation is singular (joint a turns with
+        joint c); where the slides are dependent, the slide moving most along their null direction (the arm's
+        Jacobian's slide columns at the candidate)."""
+        singular, dependent = self._singular(poses)
+        orient, slides = singular[pose], dependent[pose]
+        if error is not None:
+            orient, slides = orient & (error <= tol), slides & (error <= tol)
+        if not (orient.any() or slides.any()):
+            return None
+        out = np.where(orient, self.plan.joint(self._decoupled_first), -1).astype(np.intp)
+        rows = np.flatnonzero(slides & ~orient)
+        if rows.size:
+            zero = np.zeros((rows.size, 1))
+            q = self.solve_rest(poses[pose[rows]], zero, np.asarray(branch)[rows][:, None])[:, 0]
+            ok = np.all(np.isfinite(q), axis=-1)
+            rows, q = rows[ok], q[ok]
+            slide = np.flatnonzero(~self.robot.is_revolute)
+            J = self.robot.jacobian(q)[:, :3, slide]  # (the slides' directions, columns)
+            null = np.linalg.svd(J)[2][:, -1, :]
+            out[rows] = slide[np.argmax(np.abs(null), axis=1)]
+        return out if (out >= 0).any() else None
 
     @cached_property
     def _decoupled_first(self) -> int:
