@@ -98,21 +98,27 @@ def _apply_joint(kind, h, c, val, x, d, inverse):
 
 
 @njit(cache=True, error_model="numpy")
-def _v_side(ops_kind, ops_h, ops_c, ops_slot, n_pre, o, hl, Rt, pt, ref, vals):
-    """The V side of the loop equation at joint values ``vals`` (3: slots e, a, b): the line of joint L moved
-    by the inverse motions of the joints after L, the target T', then the inverse motions of the joints before
-    e (e last), returned as its 14 Raghavan-Roth quantities relative to ``ref`` (a point of e's axis)."""
-    x = o.copy()
-    d = hl.copy()
-    n = ops_kind.shape[0]
-    for j in range(n):
+def _v_moves(ops_kind, ops_h, ops_c, ops_slot, n_pre, Rt, pt, vals, start, stop, x, d):
+    """The point ``x`` and direction ``d`` of the V side moved by its motions ``start .. stop - 1`` (the inverse
+    motions, with the target T' applied before motion ``n_pre``)."""
+    for j in range(start, stop):
         if j == n_pre:
             x = _mv(Rt, x) + pt
             d = _mv(Rt, d)
         x, d = _apply_joint(ops_kind[j], ops_h[j], ops_c[j], vals[ops_slot[j]], x, d, True)
-    if n_pre == n:
+    if stop == ops_kind.shape[0] and n_pre == stop:
         x = _mv(Rt, x) + pt
         d = _mv(Rt, d)
+    return x, d
+
+
+@njit(cache=True, error_model="numpy")
+def _v_side(ops_kind, ops_h, ops_c, ops_slot, n_pre, o, hl, Rt, pt, ref, vals):
+    """The V side of the loop equation at joint values ``vals`` (3: slots e, a, b): the line of joint L moved
+    by the inverse motions of the joints after L, the target T', then the inverse motions of the joints before
+    e (e last), returned as its 14 Raghavan-Roth quantities relative to ``ref`` (a point of e's axis)."""
+    n = ops_kind.shape[0]
+    x, d = _v_moves(ops_kind, ops_h, ops_c, ops_slot, n_pre, Rt, pt, vals, 0, n, o.copy(), hl.copy())
     return _f14(x - ref, d)
 
 
@@ -130,18 +136,23 @@ def _pencil(ops_kind, ops_h, ops_c, ops_slot, n_pre, o, hl, Rt, pt, ref, slot_ki
 
     The V side's 14 functions (minus the E side's constant part q0), multiplied by (1 + x^2) for each revolute
     slot, are polynomials of degree <= 2 in each slot variable: sampled at x in {-1, 0, 1}^3 and interpolated
-    exactly (G = inverse Vandermonde with the (1 + x^2) weights). N (6 x 14) annihilates the E side; the 6
+    exactly (G = inverse Vandermonde with the (1 + x^2) weights); the eigen-joint's motion must be the V side's
+    last (every arrangement's is). N (6 x 14) annihilates the E side; the 6
     resulting equations, also multiplied by x_a, form 12 equations in the 12 monomials x_a^i x_b^j
     (i <= 3, j <= 2)."""
     F = np.empty((3, 3, 3, 14))
-    vals = np.empty(3)
-    for ne in range(3):
-        vals[0] = _slot_value(slot_kind[0], slot_off[0], ne - 1.0)
-        for na in range(3):
-            vals[1] = _slot_value(slot_kind[1], slot_off[1], na - 1.0)
-            for nb in range(3):
-                vals[2] = _slot_value(slot_kind[2], slot_off[2], nb - 1.0)
-                f = _v_side(ops_kind, ops_h, ops_c, ops_slot, n_pre, o, hl, Rt, pt, ref, vals)
+    vals = np.zeros(3)
+    n = ops_kind.shape[0]
+    last = n - 1  # (the eigen-joint's motion is the V side's last: the others' are moved once per (a, b) node)
+    for na in range(3):
+        vals[1] = _slot_value(slot_kind[1], slot_off[1], na - 1.0)
+        for nb in range(3):
+            vals[2] = _slot_value(slot_kind[2], slot_off[2], nb - 1.0)
+            x1, d1 = _v_moves(ops_kind, ops_h, ops_c, ops_slot, n_pre, Rt, pt, vals, 0, last, o.copy(), hl.copy())
+            for ne in range(3):
+                vals[0] = _slot_value(slot_kind[0], slot_off[0], ne - 1.0)
+                x, d = _v_moves(ops_kind, ops_h, ops_c, ops_slot, n_pre, Rt, pt, vals, last, n, x1, d1)
+                f = _f14(x - ref, d)
                 for r in range(14):
                     F[ne, na, nb, r] = f[r] - q0[r]
     # project onto the 6 equations first (cheaper), then interpolate slot by slot
@@ -887,6 +898,7 @@ class _Arrangement:
     G: np.ndarray | None = None  # (3, 3, 3): per slot, node values -> monomial coefficients
 
     def __post_init__(self):
+        assert self.ops_slot[-1] == 0, "the eigen-joint's motion must be the V side's last (_pencil)"
         self.M0R = np.ascontiguousarray(self.M0[:3, :3])
         self.M0p = np.ascontiguousarray(self.M0[:3, 3])
 
