@@ -65,6 +65,15 @@ def test_solve_dask_equals_solve_many(client: Client, carm_poses: tuple[np.ndarr
     assert_same_batch(solve_dask(CARM, lazy, client, out=tmp_path / "b.zarr", chunk_size=40), ref)
 
 
+def test_solve_dask_general_method_arm(client: Client) -> None:
+    """An arm without structure (the general method, issue 37) on the workers, as in process."""
+    from general_arms import poses_of, random_arm
+
+    robot = random_arm("6r", 1)
+    P = robot.fk(poses_of(robot, 40, 8, seed=3))
+    assert_same_batch(solve_dask(robot, P, client, chunk_size=17), solve_many(robot, P))
+
+
 def test_solve_dask_closed_form_arm_with_fallback_family(client: Client, tmp_path: Path) -> None:
     P = test_poses(UR5, 100, UR5_FAMILY_Q, seed=12)
     ref = solve_many(UR5, P)

@@ -8,6 +8,7 @@ full measurement (20 + 10 arms, 250 poses each, ssik beside) is ``scripts/genera
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -101,6 +102,34 @@ def test_a_double_root_is_one_solution_of_multiplicity_two() -> None:
         assert int(sols.multiplicity.sum()) % 2 == 0
         found += 1
     assert found >= 3
+
+
+def test_iter_solve_and_single_poses_equal_the_batch() -> None:
+    """``iter_solve`` in small chunks, and poses solved one at a time, give the batch's solutions."""
+    robot = random_arm("5r1p", 0)
+    T = robot.fk(poses_of(robot, 30, 6, seed=8))
+    batch = sweepik.solve_many(robot, T, limits=False)
+    chunks = list(sweepik.iter_solve(robot, T, limits=False, chunk_size=7))
+    assert len(chunks) == len(T)
+    for k, (a, b) in enumerate(zip(chunks, batch, strict=True)):
+        assert same_solution_set(a.q, b.q, robot.is_revolute, robot.length_scale), k
+        assert list(a.multiplicity) == list(b.multiplicity)
+
+
+def test_design_and_bench_take_an_arm_without_structure() -> None:
+    """``compare_designs`` and ``bench_arms`` measure an arm that only the general method solves."""
+    from sweepik.experiments.bench import bench_arms
+
+    robot = random_arm("6r", 3)
+    twin = dataclasses.replace(random_arm("6r", 3), name="twin")
+    cmp = sweepik.compare_designs([robot, twin], samples=40, workspace_samples=2000)
+    for c in cmp.candidates:  # (the task: poses each candidate reaches within its limits)
+        assert c.ik["reached_share"] == 1.0
+        assert "general" in str(c.decomposition)
+    row = bench_arms([robot], single=20, batch=40, memory=0, repeats=1)["arms"][robot.name]
+    assert row["plan"] == "general method"
+    assert row["sweepik"]["single_us"] > 0 and row["sweepik"]["batched_us"] > 0
+    assert not any("closed form" in m for m in row["misses"])
 
 
 def test_general_method_applies_limits() -> None:

@@ -233,13 +233,15 @@ def format_bench(result: dict[str, Any]) -> str:
 #: Targets of the speed issue per kind of arm: closed forms batched (us per pose); the C-Arm single and batched (us
 #: per pose); every swept arm that ssik solves, against ssik's time on the same poses in the same run: single-pose
 #: median <= 1/3 of ssik's, batched time per pose <= 1/10 of ssik's (ssik has no batch call: its batch is a loop of
-#: single calls). ssik runs at its best (``sweepik.experiments.peers.ssik_solver``: its prebuilt artifact of the arm
-#: when it
-#: ships one, else its C++ backend on the arm's chain with the per-arm precompute done once) and answers what
-#: sweepik's default answers (joint limits applied, one configuration per branch, not every 2 pi winding). ssik
-#: solves 6R arms only: the C-Arm and other arms with a prismatic joint are judged by their absolute targets alone.
+#: single calls); an arm of the general method (issue 37): single <= ssik's, batched <= 1/3. ssik runs at its best
+#: (``sweepik.experiments.peers.ssik_solver``: its prebuilt artifact of the arm when it ships one, else its C++
+#: backend on the arm's chain with the per-arm precompute done once) and answers what sweepik's default answers
+#: (joint limits applied, one configuration per branch, not every 2 pi winding). ssik solves 6R arms only: the C-Arm
+#: and other arms with a prismatic joint are judged by their absolute targets alone.
 ARM_TARGETS = {
     "closed_batched_us": 10.0,
+    "general_single_ratio": 1.0,  # (the general method against ssik's general solver: issue 37)
+    "general_batched_ratio": 1.0 / 3.0,
     "carm_single_us": 150.0,
     "carm_batched_us": 22.0,
     "ssik_single_ratio": 1.0 / 3.0,
@@ -289,11 +291,12 @@ def _side_by_side(
 
 
 def _flags(
-    name: str, closed: bool, cell: dict[str, Any], peers: dict[str, dict[str, Any]], ssik: dict[str, Any]
+    name: str, kind: str, cell: dict[str, Any], peers: dict[str, dict[str, Any]], ssik: dict[str, Any]
 ) -> list[str]:
-    """The targets a row misses (plain words); ``ssik`` is ``sweepik.experiments.peers.ssik_status`` of the arm."""
+    """The targets a row misses (plain words); ``kind``: "closed", "sweep" or "general" (the general method); ``ssik``
+    is ``sweepik.experiments.peers.ssik_status`` of the arm."""
     out = []
-    if closed and cell["batched_us"] > ARM_TARGETS["closed_batched_us"]:
+    if kind == "closed" and cell["batched_us"] > ARM_TARGETS["closed_batched_us"]:
         out.append(f"closed form batched > {ARM_TARGETS['closed_batched_us']:g} us")
     if name == "carm":
         if cell["single_us"] > ARM_TARGETS["carm_single_us"]:
@@ -301,16 +304,20 @@ def _flags(
         if cell["batched_us"] > ARM_TARGETS["carm_batched_us"]:
             out.append(f"batched > {ARM_TARGETS['carm_batched_us']:g} us")
     for peer, t in peers.items():
-        if peer == "ssik" and not closed:
-            continue  # a swept arm has the stricter ratio targets below
+        if peer == "ssik" and kind != "closed":
+            continue  # a swept arm and the general method have ratio targets below
         if t["single_us"] < cell["single_us"] or t["batched_us"] < cell["batched_us"]:
             out.append(f"slower than {peer}")
-    if not closed:
+    if kind != "closed":
         theirs = peers.get("ssik")
         if theirs is not None:
-            single, batched = ARM_TARGETS["ssik_single_ratio"], ARM_TARGETS["ssik_batched_ratio"]
+            single, batched = (
+                (ARM_TARGETS["general_single_ratio"], ARM_TARGETS["general_batched_ratio"])
+                if kind == "general"
+                else (ARM_TARGETS["ssik_single_ratio"], ARM_TARGETS["ssik_batched_ratio"])
+            )
             if cell["single_us"] > single * theirs["single_us"]:
-                out.append(f"single > 1/{1 / single:.0f} of ssik")
+                out.append("single > ssik" if single == 1.0 else f"single > 1/{1 / single:.0f} of ssik")
             if cell["batched_us"] > batched * theirs["batched_us"]:
                 out.append(f"batched > 1/{1 / batched:.0f} of ssik")
         elif ssik.get("why") == "not installed":
@@ -351,7 +358,9 @@ def bench_arms(
             rows[name] = {"plan": "none", "sweepik": None, "peers": {}}
             continue
         closed = bool(plan["closed_form"])
-        row: dict[str, Any] = {"plan": "closed form" if closed else f"sweep joint {plan['free_joint_number']}"}
+        general = plan["family"] == "general"
+        label = "general method" if general else "closed form" if closed else f"sweep joint {plan['free_joint_number']}"
+        row: dict[str, Any] = {"plan": label}
         if locked:
             row["plan"] += " (" + ", ".join(f"{robot.joint_names[j]} locked" for j in locked) + ")"
         variants: dict[str, dict[str, Any]] = {"sweepik": {"reduction": "auto", "locked": locked}}
@@ -375,7 +384,8 @@ def bench_arms(
         if memory and not locked and isinstance(arm, str):  # (the child process loads the arm by name or path)
             row["peak_rss_mib"] = bench_memory(memory, arm)["peak_rss_mib"]
         if single:
-            row["misses"] = _flags(name, closed, fastest, peers, row["ssik"])
+            kind = "general" if general else "closed" if closed else "sweep"
+            row["misses"] = _flags(name, kind, fastest, peers, row["ssik"])
         rows[name] = row
     progress("bench: arms", len(arms), len(arms))
     return {"arms": rows, "single_poses": single, "batch_poses": batch, "memory_poses": memory}
