@@ -14,10 +14,11 @@ the process: the general method keeps the roots of the poses it has seen). Poses
 
 ``ssik`` compares with ssik 8.2's general solver (its native path, ``oracles.ssik_general_native``) on the random 6R
 arms ``general_arms.dh_chain(k)``, k < ``--arms``, whose SymPy derivations ssik keeps in ``~/.cache/ssik`` (4-9
-minutes an arm the first time): per arm, the share of poses with the same solution set (sweepik's double roots, of
-multiplicity 2, match two roots of ssik's within 1e-4), solutions only one side has (and whether they pass an FK
-check), and the median time per pose of ssik, of sweepik single and of sweepik batched,
-in the same run. ``--out``: also write ssik's solutions, for ``tests/test_general.py`` (a compressed ``.npz``).
+minutes an arm the first time): per arm, the share of poses with the same solution set (``oracles.
+unmatched_solutions``: roots next to the singular set compared to 1e-4, others to 1e-6), solutions only one side
+has (and whether they pass an FK check), and the median time per pose of ssik, of sweepik single and of sweepik
+batched, in the same run. ``--out``: also write ssik's solutions, for ``tests/test_general.py`` (a compressed
+``.npz``).
 """
 
 from __future__ import annotations
@@ -130,10 +131,9 @@ def ssik(args: argparse.Namespace) -> None:
             theirs.append(solve_ssik(Tk))
             seconds.append(time.perf_counter() - t)
         ours, single, batched = _timed(robot, T)
-        rev, L = robot.is_revolute, robot.length_scale
         same = only_ours = only_theirs = only_theirs_fk = 0
         for Tk, s, r in zip(T, ours, theirs, strict=True):
-            extra_ours, extra_theirs = unmatched_solutions(s.q, s.multiplicity, r, rev, L)
+            extra_ours, extra_theirs = unmatched_solutions(s.q, s.multiplicity, r, robot)
             same += not (extra_ours or extra_theirs)
             only_ours += len(extra_ours)
             only_theirs += len(extra_theirs)

@@ -151,25 +151,45 @@ def same_solution_set(a: Array, b: Array, revolute: np.ndarray, length_scale: fl
     )
 
 
-#: Two solutions of a multiple root (sweepik: one of multiplicity 2; another solver: two roots split by rounding,
-#: ~sqrt(eps) apart) are the same to this; simple roots to 1e-6.
+#: Two solutions of a multiple root or next to the singular set (sweepik: one of multiplicity 2; another solver: two
+#: roots split by rounding, ~sqrt(eps) apart) are the same to this; other roots to 1e-6.
 MULTIPLE_ROOT_TOL = 1e-4
 
 
 def unmatched_solutions(
-    q: Array, multiplicity: np.ndarray, theirs: Array, revolute: np.ndarray, length_scale: float
+    q: Array, multiplicity: np.ndarray, theirs: Array, robot: Any
 ) -> tuple[list[Array], list[Array]]:
     """The rows of sweepik's solutions ``q`` (with their ``multiplicity``) that ``theirs`` lacks, and the rows of
-    ``theirs`` that ``q`` lacks: simple roots compared to 1e-6, a multiple root of sweepik's to
-    ``MULTIPLE_ROOT_TOL``."""
-    simple, multiple = q[multiplicity == 1], q[multiplicity > 1]
-    rev, L = revolute, length_scale
-    ours = [x for x in simple if not contains(theirs, x, rev, L, 1e-6)]
-    ours += [x for x in multiple if not contains(theirs, x, rev, L, MULTIPLE_ROOT_TOL)]
-    other = [
-        x for x in theirs if not (contains(simple, x, rev, L, 1e-6) or contains(multiple, x, rev, L, MULTIPLE_ROOT_TOL))
-    ]
-    return ours, other
+    ``theirs`` that ``q`` lacks: compared to 1e-6, or to ``MULTIPLE_ROOT_TOL`` where one of the two rows is a
+    multiple root of sweepik's or lies next to the singular set (its Jacobian's singular values' ratio below
+    ``NEAR_SINGULAR``: close roots there are known to ~sqrt(eps) only, and split or merge by rounding)."""
+    rev, L = robot.is_revolute, robot.length_scale
+    theirs = np.asarray(theirs, dtype=np.float64).reshape(-1, robot.n_joints)
+
+    def loose(rows: Array) -> np.ndarray:
+        if rows.shape[0] == 0:
+            return np.zeros(0, dtype=bool)
+        J = robot.jacobian(rows)
+        J[:, :3] /= L
+        sv = np.linalg.svd(J, compute_uv=False)
+        return sv[:, -1] < NEAR_SINGULAR * sv[:, 0]
+
+    ours_loose = loose(q) | (np.asarray(multiplicity) > 1)
+    theirs_loose = loose(theirs)
+    only_ours = [
+        x for x, lx in zip(q, ours_loose, strict=True)
+        if not (contains(theirs, x, rev, L, 1e-6) or contains(theirs if lx else theirs[theirs_loose], x, rev, L,
+                                                                   MULTIPLE_ROOT_TOL))
+    ]  # fmt: skip
+    only_theirs = [
+        x for x, lx in zip(theirs, theirs_loose, strict=True)
+        if not (contains(q, x, rev, L, 1e-6) or contains(q if lx else q[ours_loose], x, rev, L, MULTIPLE_ROOT_TOL))
+    ]  # fmt: skip
+    return only_ours, only_theirs
+
+
+#: ... (see ``unmatched_solutions``)
+NEAR_SINGULAR = 1e-5
 
 
 # ----------------------------------------------------------------------------------------------------------

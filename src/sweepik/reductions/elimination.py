@@ -359,10 +359,8 @@ def _ratios_std(M, x, b0):
     variables read from it: (theta-like 2 atan x_a, x_a, 2 atan x_b, x_b, null residual)."""
     S = M[2] * (x * x) + M[1] * x + M[0]
     v, res = _null_vector(S, b0)
-    V = v.reshape(4, 3)
     # x_a: rows i+1 ~ x_a rows i ; x_b: columns j+1 ~ x_b columns j
-    ta, xa = _proj_ratio(V[1:4, :].copy().ravel(), V[0:3, :].copy().ravel())
-    tb, xb = _proj_ratio(V[:, 1:3].copy().ravel(), V[:, 0:2].copy().ravel())
+    ta, xa, tb, xb = _slot_ratios(v)
     return ta, xa, tb, xb, res
 
 
@@ -645,67 +643,136 @@ def _candidates_std(
     fk_tol,
 ):
     """Back-substitute and polish every candidate root (std construction) in one compiled loop. Returns
-    (solutions (k, 6), pivot ratio of J at each, number of essentially-real candidates that failed)."""
+    (solutions (k, 6), pivot ratio of J at each, number of essentially-real candidates that failed).
+
+    A candidate that does not polish and is real or nearly (``|Im x| < PAIR_IMAG``) may be one of two roots with
+    nearly the same eigen-joint value (a near-double eigenvalue, often a complex pair by rounding) but different
+    other joints: ``S(x)`` then has a two-dimensional null space, whose one vector from inverse iteration mixes the
+    two roots. It is tried again from the two monomial vectors of that space (``_pair_vectors``)."""
     n = xs.shape[0]
-    out = np.empty((n, 6))
-    prs = np.empty(n)
+    out = np.empty((2 * n, 6))
+    prs = np.empty(2 * n)
     k = 0
     nfail = 0
-    vals = np.empty(3)
+    args = (ops_kind, ops_h, ops_c, ops_slot, n_pre, o, hl, Rt, pt, ref, q0, pinvQ, E_kind, E_idx, slots_idx, L_idx)
+    chain = (Ha, Pa, reva, Rend_a, RTa, reversed_, H, P, rev, R_end, RT, pT, fk_tol)
     for i in range(n):
         x = xs[i]
         if slot_kind[0] == 0 and abs(x) > 1e6:  # a prismatic length of 1e6 arm sizes: a root at infinity
             continue
-        vals[0] = phi + 2.0 * math.atan(x) if slot_kind[0] == 1 else x
         ta, xa, tb, xb, res = _ratios_std(M, x, b0)
-        if slot_kind[1] == 1:
-            vals[1] = slot_off[1] + ta
-        else:
-            vals[1] = slot_off[1] + (xa if np.isfinite(xa) else 1e6)
-        if slot_kind[2] == 1:
-            vals[2] = slot_off[2] + tb
-        else:
-            vals[2] = slot_off[2] + (xb if np.isfinite(xb) else 1e6)
-        q = _complete(
-            vals,
-            ops_kind,
-            ops_h,
-            ops_c,
-            ops_slot,
-            n_pre,
-            o,
-            hl,
-            Rt,
-            pt,
-            ref,
-            q0,
-            pinvQ,
-            E_kind,
-            E_idx,
-            slots_idx,
-            L_idx,
-            Ha,
-            Pa,
-            reva,
-            Rend_a,
-            RTa,
-        )
-        if reversed_:
-            q = q[::-1].copy()
-        qp, nr, ok, pr = _polish(H, P, rev, R_end, q, RT, pT, 60, 1e-17)
+        qp, ok, pr = _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain)
         if ok:
-            dp, dr = _poses_err(H, P, rev, R_end, qp, RT, pT)
-            ok = dp < fk_tol and dr < fk_tol
-        if ok:
-            for j in range(6):
-                if rev[j]:
-                    qp[j] = math.pi - ((math.pi - qp[j]) % (2.0 * math.pi))
-            out[k] = qp
-            prs[k] = pr
+            out[k], prs[k] = qp, pr
             k += 1
-        elif ims[i] < 1e-9:
+            continue
+        found = False
+        if ims[i] < PAIR_IMAG:
+            S = M[2] * (x * x) + M[1] * x + M[0]
+            for v in _pair_vectors(S):
+                if v.shape[0] == 0:
+                    continue
+                ta, xa, tb, xb = _slot_ratios(v)
+                qp, ok, pr = _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain)
+                if ok:
+                    out[k], prs[k] = qp, pr
+                    k += 1
+                    found = True
+        if not found and ims[i] < PAIR_IMAG:
             nfail += 1
     return out[:k].copy(), prs[:k].copy(), nfail
+
+
+#: A candidate eigenvalue with ``|Im x| / (1 + |x|^2)`` below this that does not polish is tried as one of a close
+#: pair of roots (``_candidates_std``).
+PAIR_IMAG = 1e-6
+
+
+@njit(cache=True, error_model="numpy")
+def _slot_ratios(v):
+    """The slot variables read from a monomial vector ``v`` (12: ``x_a^i x_b^j``, i <= 3, j <= 2): ``(2 atan x_a,
+    x_a, 2 atan x_b, x_b)``."""
+    V = v.reshape(4, 3)
+    ta, xa = _proj_ratio(V[1:4, :].copy().ravel(), V[0:3, :].copy().ravel())
+    tb, xb = _proj_ratio(V[:, 1:3].copy().ravel(), V[:, 0:2].copy().ravel())
+    return ta, xa, tb, xb
+
+
+@njit(cache=True, error_model="numpy")
+def _pair_vectors(S):
+    """The two monomial vectors in the two-dimensional near-null space of ``S`` (12x12): the combinations
+    ``alpha A + beta B`` of its two last right singular vectors whose 4x3 reshape has rank one. Every 2x2 minor of
+    that reshape is a quadratic form in ``(alpha, beta)`` vanishing at both; their common factor is the dominant
+    singular vector of the minors' coefficients. Two vectors (an empty one where the factor has complex roots)."""
+    _, _, Vt = np.linalg.svd(S)
+    A = Vt[11].copy().reshape(4, 3)
+    B = Vt[10].copy().reshape(4, 3)
+    C = np.empty((18, 3))
+    r = 0
+    for i0 in range(4):
+        for i1 in range(i0 + 1, 4):
+            for j0 in range(3):
+                for j1 in range(j0 + 1, 3):
+                    if r < 18:
+                        # det [[A00 + t B00, A01 + t B01], [A10 + t B10, A11 + t B11]] in (alpha, beta) = (1, t)
+                        a00, a01, a10, a11 = A[i0, j0], A[i0, j1], A[i1, j0], A[i1, j1]
+                        b00, b01, b10, b11 = B[i0, j0], B[i0, j1], B[i1, j0], B[i1, j1]
+                        C[r, 0] = a00 * a11 - a01 * a10
+                        C[r, 1] = a00 * b11 + b00 * a11 - a01 * b10 - b01 * a10
+                        C[r, 2] = b00 * b11 - b01 * b10
+                        r += 1
+    _, _, W = np.linalg.svd(C)
+    c0, c1, c2 = W[0, 0], W[0, 1], W[0, 2]  # c0 + c1 t + c2 t^2 (t = beta / alpha)
+    empty = np.zeros(0)
+    disc = c1 * c1 - 4.0 * c0 * c2
+    if disc < 0.0:
+        return empty, empty
+    sq = math.sqrt(disc)
+    # homogeneous roots (alpha, beta), stable for either coefficient small
+    if abs(c2) >= abs(c0):
+        q = -0.5 * (c1 + math.copysign(sq, c1))
+        r1 = (c2, q) if q != 0.0 else (1.0, 0.0)  # t = q / c2
+        r2 = (q, c0) if q != 0.0 else (0.0, 1.0)  # t = c0 / q
+    else:
+        q = -0.5 * (c1 + math.copysign(sq, c1))
+        r1 = (q, c0) if q != 0.0 else (0.0, 1.0)
+        r2 = (c2, q) if q != 0.0 else (1.0, 0.0)
+    v1 = (r1[0] * A + r1[1] * B).ravel()
+    v2 = (r2[0] * A + r2[1] * B).ravel()
+    return v1 / np.sqrt(np.sum(v1 * v1)), v2 / np.sqrt(np.sum(v2 * v2))
+
+
+@njit(cache=True, error_model="numpy")
+def _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain):
+    """The configuration of the eigen-joint's value ``x`` and the other slots' ``(2 atan x_a, x_a, 2 atan x_b, x_b)``:
+    completed, polished on the full chain and FK-checked: ``(q, ok, pivot ratio of J)``."""
+    ops_kind, ops_h, ops_c, ops_slot, n_pre, o, hl, Rt, pt, ref, q0, pinvQ, E_kind, E_idx, slots_idx, L_idx = args
+    Ha, Pa, reva, Rend_a, RTa, reversed_, H, P, rev, R_end, RT, pT, fk_tol = chain
+    vals = np.empty(3)
+    vals[0] = phi + 2.0 * math.atan(x) if slot_kind[0] == 1 else x
+    if slot_kind[1] == 1:
+        vals[1] = slot_off[1] + ta
+    else:
+        vals[1] = slot_off[1] + (xa if np.isfinite(xa) else 1e6)
+    if slot_kind[2] == 1:
+        vals[2] = slot_off[2] + tb
+    else:
+        vals[2] = slot_off[2] + (xb if np.isfinite(xb) else 1e6)
+    q = _complete(
+        vals, ops_kind, ops_h, ops_c, ops_slot, n_pre, o, hl, Rt, pt, ref, q0, pinvQ, E_kind, E_idx, slots_idx, L_idx,
+        Ha, Pa, reva, Rend_a, RTa,
+    )  # fmt: skip
+    if reversed_:
+        q = q[::-1].copy()
+    qp, nr, ok, pr = _polish(H, P, rev, R_end, q, RT, pT, 60, 1e-17)
+    if ok:
+        dp, dr = _poses_err(H, P, rev, R_end, qp, RT, pT)
+        ok = dp < fk_tol and dr < fk_tol
+    if ok:
+        for j in range(6):
+            if rev[j]:
+                qp[j] = math.pi - ((math.pi - qp[j]) % (2.0 * math.pi))
+    return qp, ok, pr
 
 
 @njit(cache=True, error_model="numpy")
