@@ -14,6 +14,7 @@ where it has fewer). ``solve_rest`` solves each distinct pose it is given once.
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from functools import lru_cache
 
 import numpy as np
@@ -110,7 +111,7 @@ class GeneralReduction(Reduction):
         self._elimination = setup
         self._fast = _fast_path(robot)
         self._last: tuple[Array, Array, Array] | None = None  # (a copy of the poses, the poses, their rows)
-        self._kept: dict[bytes, Array] = {}
+        self._kept: OrderedDict[bytes, Array] = OrderedDict()
 
     def kernel_params(self, poses: Array) -> Array:
         """``(N, MAX_SOLUTIONS * n + 1)`` per chain pose: its roots (row-major, NaN-padded), then 1.0 where it is
@@ -127,16 +128,15 @@ class GeneralReduction(Reduction):
         flat = np.ascontiguousarray(world.reshape(world.shape[0], 16))
         n = robot.n_joints
         rows = np.empty((flat.shape[0], MAX_SOLUTIONS * n + 1))
-        kept = self._kept
         keys = [pose.tobytes() for pose in flat]
+        got = [self._kept.get(key) for key in keys]  # (read once: another thread's chunk may evict them)
         new: dict[bytes, int] = {}
-        for i, key in enumerate(keys):
-            if key not in kept:
+        for i, (key, row) in enumerate(zip(keys, got, strict=True)):
+            if row is None:
                 new.setdefault(key, i)
         solved = dict(zip(new, self._solve_new(flat[list(new.values())], list(new)), strict=True)) if new else {}
-        for i, key in enumerate(keys):
-            row = solved.get(key)
-            rows[i] = kept[key] if row is None else row
+        for i, (key, row) in enumerate(zip(keys, got, strict=True)):
+            rows[i] = solved[key] if row is None else row
         self._last = (poses.copy(), poses, rows)
         return rows
 
@@ -160,8 +160,11 @@ class GeneralReduction(Reduction):
             rows[i, -1] = float(res.continuum)
         kept = self._kept
         for key, row in zip(keys, rows, strict=True):
-            if len(kept) >= _ROOTS_KEPT:
-                kept.pop(next(iter(kept)))
+            while len(kept) >= _ROOTS_KEPT:
+                try:
+                    kept.popitem(last=False)  # (one call: safe beside another thread's chunk)
+                except KeyError:
+                    break
             kept[key] = row
         return rows
 
