@@ -87,6 +87,18 @@ def test_random_6r_arms_agree_with_ssiks_general_solver() -> None:
     assert extra <= 8  # (measured: 2 of 825 poses)
 
 
+def test_two_close_roots_on_the_singular_set_both_come_back() -> None:
+    """A configuration next to the singular set whose partner root lies 2.5e-4 rad away, with nearly the same
+    eigen-joint value (its pair of eigenvalues turns complex, Im 1e-9, when the pose is rounded on its way through
+    the arm's base and tool): both roots come back (from the two-dimensional null space of S(x)), as ssik's do."""
+    H, P, R_end = dh_chain(7)
+    robot = robot_of_chain(H, P, R_end, "dh_chain_7")
+    q = poses_of(robot, 200, 50, seed=7)[245]
+    sols = sweepik.solve(robot, robot.fk(q), limits=False)
+    d = np.abs(np.angle(np.exp(1j * (sols.q - q)))).max(axis=1)
+    assert len(sols) == 4 and np.sort(d)[0] < 1e-6 and 1e-5 < np.sort(d)[1] < 1e-3, d
+
+
 def test_a_double_root_is_one_solution_of_multiplicity_two() -> None:
     """At a configuration on the singular set (of a random arm), the generating configuration is a double root of
     the elimination: it comes back once, of multiplicity 2, and the count with multiplicity is even."""

@@ -661,23 +661,25 @@ def _candidates_std(
         if slot_kind[0] == 0 and abs(x) > 1e6:  # a prismatic length of 1e6 arm sizes: a root at infinity
             continue
         ta, xa, tb, xb, res = _ratios_std(M, x, b0)
-        qp, ok, pr = _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain)
-        if ok:
-            out[k], prs[k] = qp, pr
-            k += 1
-            continue
         found = False
-        if ims[i] < PAIR_IMAG:
-            S = M[2] * (x * x) + M[1] * x + M[0]
-            for v in _pair_vectors(S):
+        pair = (np.zeros(0), np.zeros(0))
+        for attempt in range(3):  # (one call site of _root_at: it is large, and compiled code inlines it)
+            if attempt > 0:
+                if not ims[i] < PAIR_IMAG:
+                    break
+                if attempt == 1:
+                    pair = _pair_vectors(M[2] * (x * x) + M[1] * x + M[0])
+                v = pair[attempt - 1]
                 if v.shape[0] == 0:
                     continue
                 ta, xa, tb, xb = _slot_ratios(v)
-                qp, ok, pr = _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain)
-                if ok:
-                    out[k], prs[k] = qp, pr
-                    k += 1
-                    found = True
+            qp, ok, pr = _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain)
+            if ok:
+                out[k], prs[k] = qp, pr
+                k += 1
+                found = True
+                if attempt == 0:
+                    break
         if not found and ims[i] < PAIR_IMAG:
             nfail += 1
     return out[:k].copy(), prs[:k].copy(), nfail
