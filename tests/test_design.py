@@ -50,7 +50,8 @@ def test_carm_against_swapped(carm_pair: object) -> None:
     assert carm.effort["per_joint"][4]["max"] < 1e-9 and carm.effort["per_joint"][5]["max"] < 1e-9
     verdict = {v["criterion"]: v["winner"] for v in cmp.verdicts}  # type: ignore[attr-defined]
     assert verdict["joint 5 (pitch5 / theta5) holding effort, max"] == "carm"
-    assert verdict["IK time per pose"] == "carm_swapped"
+    # (speed is a benchmark's to judge, not a test's: a loaded machine can make the two a tie, None)
+    assert verdict["IK time per pose"] in ("carm_swapped", None)
 
 
 def test_json_is_plain(carm_pair: object) -> None:
