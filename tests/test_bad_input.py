@@ -721,3 +721,62 @@ def test_arm_outside_the_catalogue_is_no_longer_bad_input(tmp_path: Path) -> Non
     d = sols.q - Q_GOOD
     d[:, robot.is_revolute] = np.mod(d[:, robot.is_revolute] + np.pi, 2 * np.pi) - np.pi
     assert sols.q.size and np.abs(d).max(axis=1).min() < 1e-8
+
+
+# ------------------------------------------------------------------ the small helpers
+
+
+@pytest.mark.parametrize(
+    ("xyz", "zyz"),
+    [
+        ([0.1, float("nan"), 0.3], [0.0, 0.0, 0.0]),
+        ([0.1, 0.2, 0.3], [0.0, float("inf"), 0.0]),
+        ([0.1, 0.2], [0.0, 0.0, 0.0]),
+        ([0.1, 0.2, 0.3], [0.0, 0.0, 0.0, 0.0]),
+        ([[0.1, 0.2, 0.3]] * 2, [[0.0, 0.0, 0.0]] * 3),
+        ("0.1 0.2 0.3", [0.0, 0.0, 0.0]),
+    ],
+)
+def test_pose_from_xyz_zyz_refuses_bad_values(xyz: object, zyz: object) -> None:
+    with pytest.raises(sweepik.SweepikError):
+        sweepik.pose_from_xyz_zyz(xyz, zyz)
+
+
+def test_zyz_from_matrix_refuses_what_is_not_a_rotation() -> None:
+    for bad in (np.diag([1.0, 1.0, -1.0]), 2.0 * np.eye(3), np.ones((3, 3)), np.eye(3)[:2], np.full((3, 3), np.nan)):
+        with pytest.raises(sweepik.SweepikError):
+            sweepik.zyz_from_matrix(bad)
+    R = sweepik.matrix_from_zyz([0.1, 0.2, 0.3])
+    np.testing.assert_allclose(sweepik.zyz_from_matrix(R), [0.1, 0.2, 0.3], atol=1e-12)
+    np.testing.assert_allclose(sweepik.zyz_from_matrix(np.stack([R, R])), [[0.1, 0.2, 0.3]] * 2, atol=1e-12)
+
+
+def test_pose_errors_refuse_wrong_shapes() -> None:
+    T = np.eye(4)
+    for a, b in ((np.eye(3), T), (T, np.zeros((4, 3))), (np.stack([T] * 2), np.stack([T] * 3)), ("T", T)):
+        with pytest.raises(sweepik.SweepikError):
+            sweepik.pose_error_paper(a, b)
+        with pytest.raises(sweepik.SweepikError):
+            sweepik.pose_error_geodesic(a, b)
+    assert sweepik.pose_error_paper(np.stack([T] * 2), T).shape == (2,)  # broadcasting still works
+
+
+def test_wrap_angle_refuses_strings_and_family_sample_a_negative_count() -> None:
+    with pytest.raises(sweepik.SweepikError):
+        sweepik.wrap_angle("3.5")
+    assert float(sweepik.wrap_angle(3 * np.pi)) == pytest.approx(np.pi)
+    robot = sweepik.load_robot("puma560")
+    q = np.array([0.2, -0.3, 0.4, 0.5, 0.0, 0.1])
+    fam = sweepik.solve(robot, robot.fk(q), limits=False).families[0]
+    for bad in (-3, 0, 2.5, "5", True):
+        with pytest.raises(sweepik.SweepikError):
+            fam.sample(bad)  # type: ignore[arg-type]
+    assert fam.sample(3).shape == (3, 6)
+
+
+def test_solve_many_of_an_empty_array_of_positions_is_refused() -> None:
+    with pytest.raises(sweepik.ShapeError, match=r"\(0, 3\)"):
+        sweepik.solve_many(CARM, np.zeros((0, 3)))
+    with pytest.raises(sweepik.ShapeError):
+        list(sweepik.iter_solve(CARM, np.zeros((0, 4))))
+    assert len(sweepik.solve_many(CARM, np.zeros((0, 4, 4)))) == 0 and len(sweepik.solve_many(CARM, [])) == 0

@@ -84,3 +84,125 @@ def test_family_member_at_an_angle_past_pi() -> None:
     on = [f for f in sols.families if f.free_joint == 3 and np.max(joint_distance(robot, f.at(q[3]), q)) <= 1e-9]
     assert on, "the generating configuration should be a member, named by its own joint 4"
     np.testing.assert_allclose(joint_distance(robot, on[0].at(q[3] - 2.0 * np.pi), q), 0.0, atol=1e-9)
+
+
+# ------------------------------------------------------------------ choosing a solution: metrics, windings, filter
+
+
+def _brute_windings(robot: sweepik.Robot, q: np.ndarray) -> np.ndarray:
+    """Every configuration equal to ``q`` modulo 2 pi on the revolute joints and inside the limits, by trying
+    every combination of -2..2 turns (the arms tested turn at most +-360 degrees)."""
+    import itertools
+
+    out = []
+    for turns in itertools.product(range(-2, 3), repeat=robot.n_joints):
+        c = q + 2 * np.pi * np.asarray(turns) * robot.is_revolute
+        if all(t == 0 or robot.is_revolute[j] for j, t in enumerate(turns)) and np.all(
+            (c >= robot.lower - 1e-9) & (c <= robot.upper + 1e-9)
+        ):
+            out.append(c)
+    return np.array(out)
+
+
+@pytest.mark.parametrize("name", ["ur5", "doosan_m0609", "kinova_jaco2", "xarm6"])
+def test_windings_are_every_turn_inside_the_limits(name: str) -> None:
+    """``windings=True``: the rows are exactly the base solutions' windings found by brute force (every
+    combination of whole turns inside the limits), each row's ``winding_of`` a base row equal to it modulo 2 pi,
+    every row passing FK; solve_many gives the same rows."""
+    robot = sweepik.load_robot(name)
+    rng = np.random.default_rng(7)
+    q = robot.lower + rng.random((4, 6)) * (robot.upper - robot.lower)
+    T = robot.fk(q)
+    batch = sweepik.solve_many(robot, T, windings=True)
+    for k in range(len(q)):
+        base = sweepik.solve(robot, T[k])
+        wound = sweepik.solve(robot, T[k], windings=True)
+        np.testing.assert_array_equal(wound.q[: len(base)], base.q)
+        np.testing.assert_array_equal(batch[k].q, wound.q)
+        np.testing.assert_array_equal(batch[k].winding_of, wound.winding_of)
+        expect = np.concatenate([_brute_windings(robot, b) for b in base.q])
+        gap = np.max(np.abs(wound.q[:, None, :] - expect[None, :, :]), axis=-1)
+        assert len(wound) == len(expect) and np.all(gap.min(axis=0) <= 1e-9) and np.all(gap.min(axis=1) <= 1e-9)
+        assert np.max(joint_distance(robot, wound.q, base.q[wound.winding_of])) <= 1e-12
+        assert np.all(robot.within_limits(wound.q))
+        assert np.max(np.abs(robot.fk(wound.q) - T[k])) <= 1e-9
+        assert np.any(np.all(np.abs(wound.q - q[k]) <= 1e-8, axis=1))  # the generating q itself, not modulo 2 pi
+
+
+@pytest.mark.parametrize("metric", ["linf", "weighted"])
+def test_nearest_with_a_tolerance_against_brute_force(metric: str) -> None:
+    """``nearest(q_ref, metric, tol)`` on a UR (+-360 degrees, windings listed): the row a brute-force minimum over
+    every winding picks (raw joint values: a winding a turn away is far), or None when that minimum exceeds tol."""
+    robot = sweepik.load_robot("ur10")
+    rng = np.random.default_rng(3)
+    for _ in range(12):
+        q = robot.lower + rng.random(6) * (robot.upper - robot.lower)
+        sols = sweepik.solve(robot, robot.fk(q), windings=True)
+        ref = q + rng.normal(0.0, 0.15, 6)
+        d = np.abs(sols.q - ref)
+        dist = d.max(axis=1) if metric == "linf" else np.linalg.norm(d, axis=1)
+        best = int(np.argmin(dist))
+        np.testing.assert_array_equal(sols.nearest(ref, metric=metric), sols.q[best])
+        np.testing.assert_allclose(sols.distances(ref, metric=metric), dist, rtol=0, atol=1e-12)
+        tol = float(dist[best])
+        assert sols.nearest(ref, metric=metric, tol=tol * 1.001) is not None
+        assert sols.nearest(ref, metric=metric, tol=tol * 0.999) is None
+
+
+def test_linf_picks_the_small_step_where_the_sum_picks_a_flip() -> None:
+    """The planner's case (ssik #330): from a reference, one solution moves every joint a little, another moves
+    one joint a lot and the others not at all; L-infinity takes the first, the Euclidean norm may take the second.
+    Checked as a property of the two metrics on every pair of a pose's solutions."""
+    robot = sweepik.load_robot("ur5")
+    q = np.array([0.3, -1.1, 1.4, -0.6, 1.2, 0.4])
+    sols = sweepik.solve(robot, robot.fk(q))
+    ref = q + 0.05
+    linf = sols.distances(ref, metric="linf")
+    assert np.isclose(linf.min(), 0.05)
+    np.testing.assert_allclose(sols.nearest(ref, metric="linf"), q, atol=1e-9)
+    assert np.all(sols.distances(ref) >= linf - 1e-15)  # the norm bounds the largest move
+
+
+def test_filter_keeps_what_the_function_accepts() -> None:
+    robot = sweepik.load_robot("ur5")
+    q = np.array([0.3, -1.1, 1.4, -0.6, 1.2, 0.4])
+    sols = sweepik.solve(robot, robot.fk(q), windings=True)
+    kept = sols.filter(lambda c: c[1] < 0)  # e.g. the elbow above the table
+    assert len(kept) == int(np.sum(sols.q[:, 1] < 0)) and np.all(kept.q[:, 1] < 0)
+    assert np.max(joint_distance(robot, kept.q, kept.q[kept.winding_of])) <= 1e-12  # bases renumbered
+    none = sols.filter(lambda c: False)
+    assert len(none) == 0 and not none and "filter" in (none.reason or "")
+    assert none.nearest(q) is None
+    with pytest.raises(sweepik.SweepikError, match="function"):
+        sols.filter("collision")  # type: ignore[arg-type]
+
+
+def test_choice_options_are_checked() -> None:
+    robot = sweepik.load_robot("ur5")
+    sols = sweepik.solve(robot, robot.fk(np.full(6, 0.3)))
+    for bad in ({"metric": "l1"}, {"metric": None}, {"tol": -1.0}, {"tol": float("nan")}, {"tol": "1"}):
+        with pytest.raises(sweepik.SweepikError):
+            sols.nearest(np.zeros(6), **bad)
+    with pytest.raises(sweepik.SweepikError, match="windings"):
+        sweepik.solve(robot, robot.fk(np.zeros(6)), windings="yes")  # type: ignore[arg-type]
+
+
+def test_follow_path_with_a_linf_tolerance_never_steps_farther() -> None:
+    """``follow_path(metric="linf", tol=...)``: every point taken lies within ``tol`` (largest joint move) of the
+    point taken before it, the others are NaN rows; a tolerance no step reaches changes nothing. A path through the
+    wrist singularity of a UR and back, coarse enough that some steps are large."""
+    from sweepik.trajectory import follow_path
+
+    robot = sweepik.load_robot("ur5")
+    q = np.array([0.3, -1.1, 1.4, -0.6, 0.4, 0.4])
+    s = np.concatenate([np.linspace(0.0, 1.0, 9), np.linspace(1.0, 0.0, 9)[1:]])
+    path = q + s[:, None] * np.array([0.9, 0.4, -0.5, 0.7, -0.8, 1.9])
+    free = follow_path(robot, robot.fk(path), q_start=q, metric="linf")
+    assert free.found.all()
+    same = follow_path(robot, robot.fk(path), q_start=q, metric="linf", tol=10.0)
+    np.testing.assert_array_equal(same.q, free.q)
+    tol = 0.3
+    tight = follow_path(robot, robot.fk(path), q_start=q, metric="linf", tol=tol)
+    assert tight.found[0] and not tight.found.all()
+    taken = tight.q[tight.found]
+    assert np.max(joint_distance(robot, taken[1:], taken[:-1])) <= tol + 1e-12

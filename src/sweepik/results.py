@@ -11,6 +11,8 @@ rows ``offsets[i]:offsets[i + 1]``.
 from __future__ import annotations
 
 import bisect
+import dataclasses
+import numbers
 import operator
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -20,8 +22,8 @@ from typing import TYPE_CHECKING, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sweepik.errors import SweepikError
-from sweepik.model.validate import check_configuration
+from sweepik.errors import ShapeError, SweepikError, UnknownOptionError
+from sweepik.model.validate import check_choice, check_configuration, check_int, short_repr
 
 if TYPE_CHECKING:
     from sweepik.model.origin_axis import HeldJoints
@@ -32,29 +34,70 @@ Array = NDArray[np.float64]
 #: How a :class:`Family` computes its members: ``(reduction, chain_pose, branch, theta, lo, hi) -> q``.
 MemberFunction = Callable[["Reduction", Array, int, Array, float, float], Array]
 
+#: Most members ``Family.sample`` gives in one call (a bigger grid is a loop over calls).
+MAX_FAMILY_SAMPLES = 10_000_000
 #: Tolerance when asking a family for a member just outside its interval (relative to the interval length).
 _FAMILY_EDGE_TOL = 1e-9
 
 
-def joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
-    """Per-joint absolute differences ``(..., n)``: revolute ones wrapped modulo 2 pi (radians)."""
+def joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike, wrap: bool = True) -> Array:
+    """Per-joint absolute differences ``(..., n)``: revolute ones wrapped modulo 2 pi (radians), unless ``wrap`` is
+    False (2 pi windings then count as far apart as they are)."""
     d = np.asarray(q, dtype=np.float64) - np.asarray(q_ref, dtype=np.float64)
+    if not wrap:
+        return np.abs(d)
     wrapped = np.abs(np.pi - np.mod(np.pi - d, 2.0 * np.pi))
     return np.where(robot.is_revolute, wrapped, np.abs(d))
 
 
-def weighted_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike) -> Array:
-    """Distance ``(...)`` between configurations ``q (..., n)`` and ``q_ref (n,)``, dimensionless: the one metric
-    of joint space in sweepik (``Solutions.nearest``, ``follow_path``).
+def weighted_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike, wrap: bool = True) -> Array:
+    """Distance ``(...)`` between configurations ``q (..., n)`` and ``q_ref (n,)``, dimensionless: the default
+    metric of joint space in sweepik (``Solutions.nearest``, ``follow_path``; ``metric="weighted"``).
 
     Angles are compared modulo 2 pi (radians); prismatic differences are divided by the paper's weight
-    (100 mm per radian, eq. 6c, in the robot's length unit), then the Euclidean norm is taken.
+    (100 mm per radian, eq. 6c, in the robot's length unit), then the Euclidean norm is taken. ``wrap``: see
+    :func:`joint_distance`.
     """
+    return np.asarray(np.linalg.norm(_scaled_joint_distance(robot, q, q_ref, wrap), axis=-1))
+
+
+def linf_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike, wrap: bool = True) -> Array:
+    """The largest joint move ``(...)`` from ``q_ref (n,)`` to ``q (..., n)`` (``metric="linf"``): angles modulo
+    2 pi in radians, prismatic moves in units of the paper's weight (100 mm count as 1 radian). A planner's seed
+    metric: a tolerance on it bounds every joint's step, where a summed metric lets one joint flip by pi while the
+    others stay. ``wrap``: see :func:`joint_distance`."""
+    return np.asarray(np.max(_scaled_joint_distance(robot, q, q_ref, wrap), axis=-1))
+
+
+def _scaled_joint_distance(robot: Robot, q: ArrayLike, q_ref: ArrayLike, wrap: bool) -> Array:
+    """``joint_distance`` with prismatic joints divided by the paper's weight (dimensionless)."""
     from sweepik.model.units import orientation_weight  # local import keeps this module's imports light
 
-    d = joint_distance(robot, q, q_ref)
     scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
-    return np.asarray(np.linalg.norm(d * scale, axis=-1))
+    return joint_distance(robot, q, q_ref, wrap) * scale
+
+
+#: A joint-space distance: ``metric(robot, q (..., n), q_ref (n,), wrap) -> (...)``.
+DistanceFunction = Callable[["Robot", ArrayLike, ArrayLike, bool], Array]
+#: The joint-space metrics of ``Solutions.nearest``, ``Solutions.distances`` and ``follow_path``.
+METRICS: dict[str, DistanceFunction] = {
+    "weighted": weighted_joint_distance,
+    "linf": linf_joint_distance,
+}
+
+
+def joint_metric(metric: object) -> DistanceFunction:
+    """The distance function named ``metric`` (a key of ``METRICS``); UnknownOptionError for another value."""
+    return METRICS[check_choice(metric, "metric", tuple(METRICS))]
+
+
+def check_tolerance(tol: object, what: str = "tol") -> float | None:
+    """``tol`` as a float >= 0 (None stays None); UnknownOptionError naming anything else."""
+    if tol is None:
+        return None
+    if isinstance(tol, bool) or not isinstance(tol, numbers.Real) or not np.isfinite(float(tol)) or tol < 0:
+        raise UnknownOptionError(f"{what} must be a finite number >= 0, got {tol!r}")
+    return float(tol)
 
 
 #: Members sampled along a self-motion family before the nearest one is refined (golden section).
@@ -64,15 +107,16 @@ _NEAREST_MINIMA = 4
 _GOLDEN_ITERS = 60
 
 
-def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, float]:
-    """Member of ``fam`` nearest ``ref`` (weighted distance): dense sampling, then a golden-section search around
+def _nearest_on_family(robot: Robot, fam: Family, ref: Array, metric: DistanceFunction) -> tuple[Array, float]:
+    # (families are not wound: their members are compared modulo 2 pi)
+    """Member of ``fam`` nearest ``ref`` by ``metric``: dense sampling, then a golden-section search around
     each local minimum of the samples (``_NEAREST_MINIMA`` at most, the lowest first), the best kept. Every local
     minimum, not only the lowest sample: the nearest member can lie next to another sample of the same distance,
     e.g. across the seam of a family that turns theta* through a whole circle (both ends are the same member)."""
     lo, hi = fam.interval
     grid = np.linspace(lo, hi, _FAMILY_SAMPLES)
     members = fam.at(grid)
-    d = weighted_joint_distance(robot, members, ref)
+    d = metric(robot, members, ref, True)
     d = np.where(np.all(np.isfinite(members), axis=-1), d, np.inf)
     left = np.concatenate([[np.inf], d[:-1]])
     right = np.concatenate([d[1:], [np.inf]])
@@ -82,7 +126,7 @@ def _nearest_on_family(robot: Robot, fam: Family, ref: Array) -> tuple[Array, fl
     best, bd = members[i0], float(d[i0])
 
     def dist(t: float) -> float:
-        return float(weighted_joint_distance(robot, fam.at(t), ref))
+        return float(metric(robot, fam.at(t), ref, True))
 
     g = (np.sqrt(5.0) - 1.0) / 2.0
     for i in minima.tolist():
@@ -147,8 +191,9 @@ class Family:
         return q.reshape(*th.shape, -1)
 
     def sample(self, count: int = 50) -> Array:
-        """``(count, n)`` member configurations evenly spaced over the interval."""
-        return self.at(np.linspace(self.interval[0], self.interval[1], count))
+        """``(count, n)`` member configurations evenly spaced over the interval (``count`` an integer >= 1)."""
+        k = check_int(count, "count", 1, MAX_FAMILY_SAMPLES)
+        return self.at(np.linspace(self.interval[0], self.interval[1], k))
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,6 +212,11 @@ class Solutions:
         families: self-motion continua (empty for almost every pose).
         reason: why there is no solution, when ``q`` and ``families`` are empty; else ``None``.
         pose: the target ``(4, 4)``.
+        winding_of: ``(k,)`` int, for each row the row of the solution it is a 2 pi winding of (``solve(...,
+            windings=True)`` adds a row for every other value of the revolute joints, modulo 2 pi, inside their
+            limits); a row's own index when it is not a winding. The windings come after every base row.
+        wound: the windings were listed; distances (``nearest``) then compare revolute values as they are, not
+            modulo 2 pi, so that the winding nearest a reference is chosen.
     """
 
     q: Array
@@ -178,6 +228,12 @@ class Solutions:
     reason: str | None
     pose: Array
     robot: Robot = field(repr=False)
+    winding_of: NDArray[np.intp] = field(default=None, repr=False)  # type: ignore[assignment]
+    wound: bool = field(default=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.winding_of is None:
+            object.__setattr__(self, "winding_of", np.arange(self.q.shape[0], dtype=np.intp))
 
     def __len__(self) -> int:
         return int(self.q.shape[0])
@@ -191,32 +247,105 @@ class Solutions:
     def __bool__(self) -> bool:
         return len(self) > 0 or bool(self.families)
 
-    def distances(self, q_ref: ArrayLike) -> Array:
-        """``(k,)`` distance of each solution to ``q_ref``: :func:`weighted_joint_distance` (angles modulo 2 pi in
-        radians, prismatic joints in units of 100 mm per radian)."""
-        ref = check_configuration(q_ref, self.robot.n_joints, "q_ref")
-        return weighted_joint_distance(self.robot, self.q, ref)
+    def distances(self, q_ref: ArrayLike, metric: str = "weighted") -> Array:
+        """``(k,)`` distance of each solution to ``q_ref (n,)`` by ``metric``: ``"weighted"``
+        (:func:`weighted_joint_distance`, the Euclidean norm) or ``"linf"`` (:func:`linf_joint_distance`, the
+        largest joint move); angles modulo 2 pi in radians, prismatic joints in units of 100 mm per radian."""
+        fn = joint_metric(metric)
+        return fn(self.robot, self.q, self._reference(q_ref), not self.wound)
 
-    def nearest(self, q_ref: ArrayLike) -> Array:
-        """The solution ``(n,)`` closest to ``q_ref`` by :func:`weighted_joint_distance` (the metric
-        ``follow_path`` uses too). Family members count: the nearest member is searched along each family.
-        Raises SweepikError when there is no solution."""
+    def _reference(self, q_ref: ArrayLike) -> Array:
         ref = check_configuration(q_ref, self.robot.n_joints, "q_ref")
         if ref.ndim != 1:
-            raise SweepikError(f"q_ref must have shape ({self.robot.n_joints},), got {ref.shape}")
+            raise ShapeError(f"q_ref must have shape ({self.robot.n_joints},), got {ref.shape}")
+        return ref
+
+    def nearest(self, q_ref: ArrayLike, metric: str = "weighted", tol: float | None = None) -> Array | None:
+        """The solution ``(n,)`` closest to ``q_ref`` by ``metric`` (see :meth:`distances`; ``follow_path`` uses
+        the same), or None when no solution lies within ``tol`` of it (any distance when ``tol`` is None) or there
+        is no solution. Family members count: the nearest member is searched along each family.
+
+        >>> import numpy as np
+        >>> from sweepik import load_robot, solve
+        >>> arm = load_robot("ur5")
+        >>> q = np.array([0.1, -1.2, 1.3, -0.4, 1.1, 0.3])
+        >>> sols = solve(arm, arm.fk(q))
+        >>> bool(np.allclose(sols.nearest(q + 0.01, metric="linf", tol=0.05), q))
+        True
+        >>> sols.nearest(q + 1.0, metric="linf", tol=0.05) is None
+        True
+        """
+        fn = joint_metric(metric)
+        limit = check_tolerance(tol)
+        ref = self._reference(q_ref)
         best: Array | None = None
         best_d = np.inf
         if len(self):
-            d = self.distances(ref)
+            d = fn(self.robot, self.q, ref, not self.wound)
             i = int(np.argmin(d))
             best, best_d = self.q[i], float(d[i])
         for fam in self.families:
-            member, dm = _nearest_on_family(self.robot, fam, ref)
+            member, dm = _nearest_on_family(self.robot, fam, ref, fn)
             if dm < best_d:
                 best, best_d = member, dm
-        if best is None:
-            raise SweepikError(f"no solution to choose from ({self.reason})")
+        if best is None or (limit is not None and best_d > limit):
+            return None
         return best.copy()
+
+    def filter(self, keep: Callable[[Array], object]) -> Solutions:
+        """The solutions for which ``keep(q)`` is true (``q (n,)``, e.g. a collision check), as a new
+        :class:`Solutions` (rows in the same order; families kept as they are: ``keep`` sees isolated solutions
+        only, sample a family with :meth:`Family.sample` to check its members). When every solution is dropped,
+        ``reason`` says so."""
+        if not callable(keep):
+            raise UnknownOptionError(f"filter takes a function q -> bool, got {short_repr(keep)}")
+        mask = np.array([bool(keep(q.copy())) for q in self.q], dtype=bool).reshape(len(self))
+        if len(self) and not np.any(mask) and not self.families:
+            return self.kept(mask, reason=f"filtered out: the filter rejected all {len(self)} solution(s)")
+        return self.kept(mask)
+
+    def kept(self, rows: NDArray[np.bool_] | NDArray[np.intp], **changes: object) -> Solutions:
+        """A new :class:`Solutions` of the rows ``rows`` (a bool mask, or row indices: repeats allowed), each
+        column taken alike; ``winding_of`` renumbered (a row whose base is not kept becomes its own base);
+        ``changes``: other fields to replace (as ``dataclasses.replace``)."""
+        index = np.nonzero(rows)[0] if np.asarray(rows).dtype == np.bool_ else np.asarray(rows, dtype=np.intp)
+        fields: dict[str, object] = {
+            "q": self.q[index],
+            "error": self.error[index],
+            "error_geodesic": self.error_geodesic[index],
+            "within_limits": self.within_limits[index],
+            "multiplicity": self.multiplicity[index],
+            "winding_of": _renumbered(self.winding_of, index),
+        }
+        return dataclasses.replace(self, **{**fields, **changes})
+
+    def __repr__(self) -> str:
+        parts = [f"{len(self)} solution(s)"]
+        if self.families:
+            parts.append(f"{len(self.families)} self-motion famil{'y' if len(self.families) == 1 else 'ies'}")
+        if len(self) and np.any(self.multiplicity > 1):
+            parts.append(f"{int(np.sum(self.multiplicity > 1))} multiple root(s)")
+        if len(self) and not np.all(self.within_limits):
+            parts.append(f"{int(np.sum(~self.within_limits))} outside the limits")
+        if len(self) and np.any(self.winding_of != np.arange(len(self))):
+            parts.append(f"{int(np.sum(self.winding_of != np.arange(len(self))))} winding(s)")
+        head = f"Solutions({self.robot.name}: {', '.join(parts)}"
+        if not self:
+            return f"{head}; {self.reason})"
+        if not len(self):
+            return head + ")"
+        worst = float(np.max(self.error))
+        rows = np.array2string(self.q, precision=4, suppress_small=True, max_line_width=120, threshold=60)
+        return f"{head}, J <= {worst:.1e} {self.robot.length_unit})\n{rows}"
+
+
+def _renumbered(winding_of: NDArray[np.intp], index: NDArray[np.intp]) -> NDArray[np.intp]:
+    """``winding_of`` of the rows ``index`` (in that order): each row's base as a new row number (its first place
+    in ``index``), or the row itself when its base is not among them."""
+    first = np.full(winding_of.shape[0], -1, dtype=np.intp)
+    first[index[::-1]] = np.arange(index.size - 1, -1, -1)  # (the earliest place of each old row wins)
+    base = first[winding_of[index]]
+    return np.where(base >= 0, base, np.arange(index.size)).astype(np.intp)
 
 
 UNREACHABLE = "unreachable: no configuration of the arm reaches this pose"
@@ -247,6 +376,8 @@ class Block:
     families: dict[int, tuple[Family, ...]]
     n_reachable: NDArray[np.intp]
     empty_reason: str | None = None
+    #: per row, the row (within its pose's rows) of the solution it is a 2 pi winding of; None: no windings
+    winding_of: NDArray[np.intp] | None = None
 
     @property
     def n(self) -> int:
@@ -275,6 +406,8 @@ class Block:
             reason=self.reason(i),
             pose=take(self.poses[i]),
             robot=self.robot,
+            winding_of=None if self.winding_of is None else take(self.winding_of[s:e]),
+            wound=self.winding_of is not None,
         )
 
     def __iter__(self) -> Iterator[Solutions]:
@@ -289,8 +422,8 @@ class SolutionBatch(Sequence[Solutions]):
 
     * ``offsets (N + 1,)``: pose ``i``'s solutions are rows ``offsets[i]:offsets[i + 1]``; ``counts (N,)``;
     * ``pose_index (K,)``: the pose of each row;
-    * ``q (K, n)``, ``error (K,)``, ``error_geodesic (K,)``, ``within_limits (K,)``, ``multiplicity (K,)``: as in
-      :class:`Solutions`;
+    * ``q (K, n)``, ``error (K,)``, ``error_geodesic (K,)``, ``within_limits (K,)``, ``multiplicity (K,)``,
+      ``winding_of (K,)``: as in :class:`Solutions`;
     * ``n_reachable (N,)``: each pose's solutions before the joint limits were applied;
     * ``families``: ``{pose index: families}`` for the few poses that have self-motion families;
     * ``reason(i)``: why pose ``i`` has no solution (None if it has some).
@@ -391,6 +524,16 @@ class SolutionBatch(Sequence[Solutions]):
     @cached_property
     def multiplicity(self) -> NDArray[np.intp]:
         return self._stack("multiplicity", (0,), np.intp)
+
+    @cached_property
+    def winding_of(self) -> NDArray[np.intp]:
+        """``(K,)`` as :attr:`Solutions.winding_of`: the row, among its pose's rows, that each row winds."""
+        parts = [
+            np.arange(b.q.shape[0]) - np.repeat(b.bounds[:-1], np.diff(b.bounds)) if b.winding_of is None
+            else b.winding_of
+            for b in self._blocks
+        ]  # fmt: skip
+        return np.concatenate(parts).astype(np.intp) if parts else np.zeros(0, dtype=np.intp)
 
     @cached_property
     def n_reachable(self) -> NDArray[np.intp]:

@@ -18,6 +18,7 @@ from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.sweep import N_SAMPLES
+from sweepik.engine.windings import wound_block, wound_solutions
 from sweepik.errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from sweepik.model.origin_axis import HeldJoints, hold_joints
 from sweepik.model.robot import Robot
@@ -91,6 +92,7 @@ def solve_many(
     n_samples: int = N_SAMPLES,
     chunk_size: int = CHUNK,
     locked: Mapping[Any, float] | None = None,
+    windings: bool = False,
 ) -> SolutionBatch:
     """All IK solutions of each pose in ``poses (N, 4, 4)`` (world frame, robot's length unit).
 
@@ -103,10 +105,8 @@ def solve_many(
     and errors: see :func:`solve`; :func:`iter_solve` yields the same results without holding them all.
     """
     _check_strategy(strategy)
-    arr = as_float_array(poses, "poses")
-    P = np.zeros((0, 4, 4)) if arr.size == 0 else check_poses(arr, "poses")
-    if P.ndim != 3:
-        raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
+    P = _pose_batch(poses)
+    check_bool(windings, "windings")
     held = held_joints(robot, locked)
     arm = robot if held is None else held.arm
     red, strat, lim, ns, cs = prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
@@ -114,7 +114,7 @@ def solve_many(
     blocks = parallel.in_order(
         lambda s: solve_chunk(arm, red, P[s : s + cs], strat, lim, ns), range(0, len(P), cs), share
     )
-    return SolutionBatch(robot, [_expanded(b, held) for b in blocks])
+    return SolutionBatch(robot, [_finished(b, held, windings) for b in blocks])
 
 
 def _chunking(red: Reduction, n: int, chunk_size: int) -> tuple[int, bool]:
@@ -144,6 +144,7 @@ def iter_solve(
     chunk_size: int = CHUNK,
     progress: Progress | None = None,
     locked: Mapping[Any, float] | None = None,
+    windings: bool = False,
 ) -> Iterator[Solutions]:
     """The solutions of each pose in ``poses (N, 4, 4)``, yielded one pose after the other as
     :func:`solve_many` computes them, a chunk of poses at a time: only a few chunks' results are alive at once
@@ -154,16 +155,14 @@ def iter_solve(
     total)``, if given, is called with stage ``"solve"`` before the first chunk and after each one.
     """
     _check_strategy(strategy)
-    arr = as_float_array(poses, "poses")
-    P = np.zeros((0, 4, 4)) if arr.size == 0 else check_poses(arr, "poses")
-    if P.ndim != 3:
-        raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
+    P = _pose_batch(poses)
+    check_bool(windings, "windings")
     if progress is not None and not callable(progress):
         raise UnknownOptionError(f"progress must be callable or None, got {type(progress).__name__}")
     held = held_joints(robot, locked)
     arm = robot if held is None else held.arm
     prepared = prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
-    return _iter_checked(arm, P, *prepared, progress, held)
+    return _iter_checked(arm, P, *prepared, progress, held, windings)
 
 
 class Prepared(NamedTuple):
@@ -276,6 +275,34 @@ def _expanded(block: Block, held: HeldJoints | None) -> Block:
     return dataclasses.replace(block, robot=held.robot, q=held.expand(block.q), families=families)
 
 
+def _finished(block: Block, held: HeldJoints | None, windings: bool) -> Block:
+    """``block`` of the solved arm as the caller's: full length (``_expanded``), with the 2 pi windings of every
+    solution when asked (``engine.windings``; held joints keep their values)."""
+    out = _expanded(block, held)
+    return wound_block(out, _free_mask(out.robot, held)) if windings else out
+
+
+def _free_mask(robot: Robot, held: HeldJoints | None) -> NDArray[np.bool_] | None:
+    """Joints that may wind: all but the held ones."""
+    if held is None:
+        return None
+    mask = np.zeros(robot.n_joints, dtype=bool)
+    mask[list(held.free)] = True
+    return mask
+
+
+def _pose_batch(poses: ArrayLike) -> Array:
+    """``poses`` checked as ``(N, 4, 4)``; an empty batch is ``[]`` or ``(0, 4, 4)`` (a ShapeError for another
+    empty shape, such as ``(0, 3)``: positions are not poses)."""
+    arr = as_float_array(poses, "poses")
+    if arr.size == 0 and arr.shape not in ((0,), (0, 4, 4)):
+        raise ShapeError(f"poses must have shape (N, 4, 4), got an empty array of shape {arr.shape}")
+    P = np.zeros((0, 4, 4)) if arr.size == 0 else check_poses(arr, "poses")
+    if P.ndim != 3:
+        raise ShapeError(f"poses must have shape (N, 4, 4), got {P.shape}")
+    return P
+
+
 def _free_joint_index(robot: Robot, free_joint: object, reduction: object) -> int | None:
     """``free_joint`` (an index from 0, or a joint name) as an index; None if not given."""
     if free_joint is None:
@@ -302,6 +329,7 @@ def _iter_checked(
     chunk_size: int,
     progress: Progress | None = None,
     held: HeldJoints | None = None,
+    windings: bool = False,
 ) -> Iterator[Solutions]:
     total = P.shape[0]
     if progress is not None:
@@ -312,7 +340,7 @@ def _iter_checked(
         lambda s: solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples), starts, share
     )
     for s, block in zip(starts, blocks, strict=True):
-        yield from _expanded(block, held)
+        yield from _finished(block, held, windings)
         if progress is not None:
             progress("solve", min(s + chunk_size, total), total)
 
@@ -384,6 +412,7 @@ def solve(
     limits: bool = True,
     n_samples: int = N_SAMPLES,
     locked: Mapping[Any, float] | None = None,
+    windings: bool = False,
 ) -> Solutions:
     """All IK solutions of one pose ``(4, 4)`` (world frame, robot's length unit).
 
@@ -408,6 +437,9 @@ def solve(
             in place; ``free_joint`` and families name joints of the full arm. ``sweepik.analyze`` tells which
             joint to lock gives a closed form or a sweep. LockedJointError for an unknown joint, a value outside
             its limits, or other than six joints left.
+        windings: also list every 2 pi winding of each solution inside the joint limits (an arm whose joints turn
+            through more than a turn, such as a UR's +-360 degrees): one row each, after the base solutions,
+            ``Solutions.winding_of`` naming the base row it winds. Held joints are not wound.
 
     Raises:
         SweepikError subclasses: a pose that is not a rigid transform or not real numbers (ShapeError,
@@ -426,4 +458,6 @@ def solve(
     P = check_poses(pose, "pose")
     if P.shape != (4, 4):
         raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
-    return _solve_one(robot, P[None], reduction, strategy, limits, n_samples, free_joint, locked)
+    wind = check_bool(windings, "windings")
+    sol = _solve_one(robot, P[None], reduction, strategy, limits, n_samples, free_joint, locked)
+    return wound_solutions(sol, _free_mask(robot, held_joints(robot, locked))) if wind else sol

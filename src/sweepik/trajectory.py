@@ -28,7 +28,7 @@ import numpy as np
 from numpy.lib import format as npy_format
 from numpy.typing import ArrayLike, NDArray
 
-from sweepik.errors import PoseFileError, ShapeError, UnknownOptionError
+from sweepik.errors import PoseFileError, ShapeError, SweepikError, UnknownOptionError
 from sweepik.model.pose import pose_error_paper, pose_from_xyz_zyz
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
@@ -42,7 +42,7 @@ from sweepik.model.validate import (
     short_repr,
 )
 from sweepik.reductions import Reduction
-from sweepik.results import Solutions, joint_distance, weighted_joint_distance
+from sweepik.results import Solutions, check_tolerance, joint_distance, joint_metric, weighted_joint_distance
 from sweepik.solving import Progress, iter_solve
 
 __all__ = [
@@ -108,14 +108,21 @@ class PathResult:
         return float(np.mean(self.found)) if self.found.size else 0.0
 
 
-def _choose(robot: Robot, sols: Solutions, ref: Array | None, weight: float) -> tuple[Array, float] | None:
-    """The solution of ``sols`` nearest ``ref`` (:meth:`Solutions.nearest`; the first one when ``ref`` is None)
-    and its error J."""
+def _choose(
+    robot: Robot, sols: Solutions, ref: Array | None, weight: float, metric: str, tol: float | None
+) -> tuple[Array, float] | None:
+    """The solution of ``sols`` nearest ``ref`` by ``metric`` within ``tol`` (:meth:`Solutions.nearest`; the first
+    one when ``ref`` is None) and its error J; None when there is none."""
     if len(sols) and ref is None:
         return sols.q[0].copy(), float(sols.error[0])
     if not sols:
         return None
-    best = sols.nearest(ref) if ref is not None else sols.families[0].at(sols.families[0].interval[0])
+    if ref is None:
+        best: Array | None = sols.families[0].at(sols.families[0].interval[0])
+    else:
+        best = sols.nearest(ref, metric=metric, tol=tol)
+    if best is None:
+        return None
     return best, float(pose_error_paper(robot.fk(best), sols.pose, weight))
 
 
@@ -130,14 +137,19 @@ def follow_path(
     limits: bool = True,
     progress: Progress | None = None,
     locked: Mapping[Any, float] | None = None,
+    metric: str = "weighted",
+    tol: float | None = None,
 ) -> PathResult:
     """Joint path along ``poses (N, 4, 4)`` (world frame, robot's length unit), keeping to one IK branch.
 
     Every pose is solved for all its solutions; the first point takes the solution nearest ``q_start``
     (``(n,)``, radians / length unit), or the first solution reported when ``q_start`` is None; every later
     point takes the solution nearest the previous chosen configuration (see :func:`weighted_joint_distance`;
-    members of self-motion families count). A pose without solution gets a NaN row and the next point is
-    compared with the last configuration found. The poses are solved a chunk at a time (:func:`iter_solve`), so
+    members of self-motion families count). ``metric``: ``"weighted"`` (the Euclidean norm, the default) or
+    ``"linf"`` (the largest joint move), see :meth:`Solutions.nearest`; with ``tol``, a point whose nearest
+    solution is farther than ``tol`` from the previous configuration is not taken (a NaN row: the branch cannot
+    be kept there without a jump). A pose without solution gets a NaN row and the next point is compared with the
+    last configuration found. The poses are solved a chunk at a time (:func:`iter_solve`), so
     memory grows with the path's joint rows only; ``progress("path", done, total)`` follows the solves.
     ``reduction``, ``free_joint``, ``strategy``, ``limits`` and ``locked`` are passed to :func:`iter_solve` (see
     :func:`solve`); with ``locked``, configurations are full length (``q_start`` too).
@@ -150,6 +162,8 @@ def follow_path(
     >>> bool(np.allclose(res.q, q, atol=1e-8)), res.branch_switches
     (True, 0)
     """
+    joint_metric(metric)
+    check_tolerance(tol)
     P = check_poses(poses, "poses")
     if P.ndim != 3 or P.shape[0] == 0:
         raise ShapeError(f"poses must have shape (N, 4, 4) with N >= 1, got {P.shape}")
@@ -174,7 +188,7 @@ def follow_path(
     n_solutions = np.zeros(N, dtype=np.intp)
     for k, s in enumerate(sols):
         n_solutions[k] = len(s)
-        pick = _choose(robot, s, ref, weight)
+        pick = _choose(robot, s, ref, weight, metric, tol)
         if pick is not None:
             q[k], err[k] = pick
             ref = q[k]
@@ -208,7 +222,15 @@ def _poses_from_rows(rows: Array, where: str) -> Array:
         raise PoseFileError(f"{where}: expected 16 or 6 numbers per row, got {width}. Layouts: {_POSE_LAYOUTS}")
     if rows.shape[1] == 16:
         return rows.reshape(-1, 4, 4)
-    return pose_from_xyz_zyz(rows[:, :3], np.radians(rows[:, 3:]))
+    return _pose_of_xyz_zyz_deg(rows[:, :3], rows[:, 3:], where)
+
+
+def _pose_of_xyz_zyz_deg(xyz: Array, zyz_deg: Array, where: str) -> Array:
+    """``pose_from_xyz_zyz`` of a file's numbers (Z-Y-Z in degrees); a bad value raises its error naming ``where``."""
+    try:
+        return pose_from_xyz_zyz(xyz, np.radians(zyz_deg))
+    except SweepikError as exc:
+        raise type(exc)(f"{where}: {exc}") from None
 
 
 def _is_number(text: str) -> bool:
@@ -321,7 +343,7 @@ def _json_item(item: Any, i: int, where: str) -> Array:
             raise PoseFileError(f"{where}: pose {i} is an object without 'xyz' and 'zyz_deg' keys: {keys}")
         xyz = _json_vector(item["xyz"], 3, f"{where}: pose {i}: 'xyz'")
         zyz = _json_vector(item["zyz_deg"], 3, f"{where}: pose {i}: 'zyz_deg'")
-        return pose_from_xyz_zyz(np.array(xyz), np.radians(zyz))
+        return _pose_of_xyz_zyz_deg(np.array(xyz), np.array(zyz), f"{where}: pose {i}")
     if not isinstance(item, list):
         raise PoseFileError(f"{where}: pose {i} is neither a 4x4 list of numbers nor an xyz/zyz_deg object")
     if len(item) != 4:

@@ -124,7 +124,8 @@ def _duration(seconds: float) -> str:
 
 def _store_poses(args: argparse.Namespace) -> Any:
     """The poses of ``--poses``: a ``.npy`` file by path (memory-mapped by solve_dask), others read whole."""
-    others = [f"--{x}" for x in ("xyz", "matrix", "nearest") if getattr(args, x) is not None]
+    others = [f"--{x}" for x in ("xyz", "matrix", "nearest", "tol") if getattr(args, x, None) is not None]
+    others += ["--windings"] if getattr(args, "windings", False) else []
     if others:
         raise CliInputError(f"--out solves the poses of --poses FILE; {', '.join(others)} cannot go with it")
     if args.poses is None:

@@ -36,7 +36,7 @@ from sweepik.io.robot_file import bundled_robots
 from sweepik.model.pose import pose_from_xyz_zyz
 from sweepik.model.robot import Robot
 from sweepik.reductions import REDUCTIONS
-from sweepik.results import Solutions
+from sweepik.results import METRICS, Solutions, check_tolerance
 from sweepik.solving import STRATEGIES, iter_solve
 
 Array = NDArray[np.float64]
@@ -81,6 +81,31 @@ def _add_ik_options(p: argparse.ArgumentParser) -> None:
     _add_robot_options(p, lock=True)
 
 
+def _add_choice_options(p: argparse.ArgumentParser) -> None:
+    """--metric and --tol: how the nearest solution is chosen (``Solutions.nearest``)."""
+    p.add_argument(
+        "--metric",
+        choices=tuple(METRICS),
+        default="weighted",
+        help="joint distance for choosing the nearest solution: weighted (Euclidean, default) or linf (largest joint "
+        "move); prismatic joints count 100 mm as 1 radian",
+    )
+    p.add_argument(
+        "--tol",
+        type=float,
+        metavar="T",
+        help="no solution is chosen farther than T from the reference (degrees, or radians with --rad)",
+    )
+
+
+def _choice_tol(args: argparse.Namespace) -> float | None:
+    """``--tol`` in radians (the metric's unit), checked."""
+    if args.tol is None:
+        return None
+    tol = check_tolerance(args.tol, "--tol")
+    return tol if args.rad else float(np.radians(tol))
+
+
 def add_solve_parser(sub: _SubParsers) -> None:
     p = _subparser(
         sub,
@@ -98,6 +123,12 @@ def add_solve_parser(sub: _SubParsers) -> None:
     p.add_argument("--matrix", nargs=16, metavar="M", help="the pose as 16 numbers, row-major")
     p.add_argument("--poses", metavar="FILE", help="many poses: CSV, NPY or JSON (see docs/cli.md)")
     p.add_argument("--nearest", nargs="+", metavar="Q", help="also report the solution nearest this configuration")
+    _add_choice_options(p)
+    p.add_argument(
+        "--windings",
+        action="store_true",
+        help="also list every 2 pi winding of each solution inside the joint limits (e.g. a UR's +-360 deg)",
+    )
     _add_ik_options(p)
     _add_json(p, ": per pose, solutions q (radians / length unit), errors, families")
     _add_precision(p)
@@ -123,7 +154,14 @@ def _display(robot: Robot, q: Array, rad: bool) -> Array:
     return q if rad else np.where(robot.is_revolute, np.degrees(q), q)
 
 
-def _solution_json(robot: Robot, sol: Solutions, nearest: Array | None) -> dict[str, Any]:
+def _nearest_of(sol: Solutions, nearest: Array, args: argparse.Namespace) -> Array | None:
+    return sol.nearest(nearest, metric=args.metric, tol=_choice_tol(args))
+
+
+def _solution_json(
+    robot: Robot, sol: Solutions, nearest: Array | None, args: argparse.Namespace | None = None
+) -> dict[str, Any]:
+    """One pose's JSON object (``args``: the command's options; None: no --windings, no --nearest)."""
     out: dict[str, Any] = {
         "q": sol.q.tolist(),
         "error_J": sol.error.tolist(),
@@ -135,8 +173,11 @@ def _solution_json(robot: Robot, sol: Solutions, nearest: Array | None) -> dict[
         ],
         "reason": sol.reason,
     }
-    if nearest is not None and sol:
-        out["nearest"] = sol.nearest(nearest).tolist()
+    if args is not None and args.windings:
+        out["winding_of"] = sol.winding_of.tolist()
+    if args is not None and nearest is not None:
+        qn = _nearest_of(sol, nearest, args)
+        out["nearest"] = None if qn is None else qn.tolist()
     return out
 
 
@@ -156,6 +197,8 @@ def _print_solutions(
     rows = []
     for i, (q, e, ok, m) in enumerate(zip(sol.q, sol.error, sol.within_limits, sol.multiplicity, strict=True)):
         row = [str(i + 1), *(f"{v:.{dec}f}" for v in _display(robot, q, args.rad)), f"{e:.2e}"]
+        if args.windings:
+            row.append("" if sol.winding_of[i] == i else str(int(sol.winding_of[i]) + 1))
         if args.no_limits:
             row.append("yes" if ok else "no")
         if show_mult:
@@ -174,8 +217,11 @@ def _print_solutions(
     if sol.families:
         _print_families(robot, sol, args)
     if nearest is not None:
-        qn = sol.nearest(nearest)
-        print("  nearest: " + "  ".join(f"{v:.{dec}f}" for v in _display(robot, qn, args.rad)))
+        qn = _nearest_of(sol, nearest, args)
+        if qn is None:
+            print(f"  nearest: none within --tol {args.tol:g} ({args.metric} metric)")
+        else:
+            print("  nearest: " + "  ".join(f"{v:.{dec}f}" for v in _display(robot, qn, args.rad)))
 
 
 def _print_families(robot: Robot, sol: Solutions, args: argparse.Namespace) -> None:
@@ -208,11 +254,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if wants_store(args):  # many poses on Dask into a store: cli_batch
         return cmd_solve_store(args, robot, _ik_kwargs(args, robot))
     nearest = None if args.nearest is None else _config_from_cli(robot, args.nearest, args.rad)
+    _choice_tol(args)  # (checked before solving)
     poses = _poses_from_args(args)
     # the output streaming to the terminal shows the progress by itself: no progress line mixed into it
     progress = _Progress(enabled=not _isatty(sys.stdout))
     try:
-        sols = iter_solve(robot, poses, progress=progress, **_ik_kwargs(args, robot))
+        sols = iter_solve(robot, poses, progress=progress, windings=args.windings, **_ik_kwargs(args, robot))
         if args.json:
             head = {
                 "robot": robot.name,
@@ -220,11 +267,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
                 "units": "radians and " + robot.length_unit,
                 "strategy": args.strategy,
             }
-            _print_json_stream(head, "poses", (_solution_json(robot, s, nearest) for s in sols))
+            _print_json_stream(head, "poses", (_solution_json(robot, s, nearest, args) for s in sols))
             return 0
         units = _joint_units(robot, args.rad)
         header = ["#", *(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))]
         header.append(f"J [{robot.length_unit}]")
+        if args.windings:
+            header.append("winds #")
         if args.no_limits:
             header.append("in limits")
         for k, sol in enumerate(sols):
@@ -252,6 +301,7 @@ def add_path_parser(sub: _SubParsers) -> None:
         "--start", nargs="+", metavar="Q", help="start configuration (degrees, or radians with --rad; length unit)"
     )
     p.add_argument("-o", "--output", metavar="FILE", help="write the joint path here (.csv or .json)")
+    _add_choice_options(p)
     _add_ik_options(p)
     _add_json(p, ": summary (points, max joint step, branch switches, errors) and the path")
 
@@ -273,7 +323,9 @@ def cmd_path(args: argparse.Namespace) -> int:
     poses = load_poses(path)
     progress = _Progress()
     try:
-        res = follow_path(robot, poses, start, progress=progress, **_ik_kwargs(args, robot))
+        res = follow_path(
+            robot, poses, start, progress=progress, metric=args.metric, tol=_choice_tol(args), **_ik_kwargs(args, robot)
+        )
     finally:
         progress.close()
     if args.output:

@@ -95,7 +95,7 @@ def trace_cut_continua(
             again = tuple(f for f, o in zip(found, new, strict=True) if not o)
             found = [f for f, o in zip(found, new, strict=True) if o]
             if again and len(sol):  # ... and its seeds are members of it (at a fold, or where it meets itself)
-                sol = _kept_rows(sol, off_families(robot, [(sol.q, again)])[0])
+                sol = sol.kept(off_families(robot, [(sol.q, again)])[0])
         if found:
             fams.setdefault(i, []).extend(found)
         swept = [f for f in sol.families if not isinstance(f.reduction, Traced)]
@@ -106,18 +106,6 @@ def trace_cut_continua(
                 sol, families=known + tuple(f for f, o in zip(swept, uncovered, strict=True) if o.any())
             )
         fallback[i] = sol
-
-
-def _kept_rows(sol: Solutions, keep: NDArray[np.bool_]) -> Solutions:
-    """``sol`` with the solutions ``keep`` only."""
-    return dataclasses.replace(
-        sol,
-        q=sol.q[keep],
-        error=sol.error[keep],
-        error_geodesic=sol.error_geodesic[keep],
-        within_limits=sol.within_limits[keep],
-        multiplicity=sol.multiplicity[keep],
-    )
 
 
 def add_crossing_families(

@@ -17,6 +17,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from sweepik.errors import ShapeError
+from sweepik.model.validate import as_float_array, check_finite, check_rotations
+
 __all__ = [
     "GIMBAL_TOL",
     "zyz_from_matrix",
@@ -45,22 +48,63 @@ Array = NDArray[np.float64]
 _EXACT_GIMBAL = 1e-12
 
 
+def _floats(x: ArrayLike, what: str) -> Array:
+    """``x`` as a float64 array (an array that already is one passes as it is; others: ``as_float_array``)."""
+    if isinstance(x, np.ndarray) and x.dtype == np.float64:
+        return x
+    return as_float_array(x, what)
+
+
+def _trailing(x: ArrayLike, what: str, shape: tuple[int, ...], finite: bool = True) -> Array:
+    """``x`` as floats whose last dimensions are ``shape`` (ShapeError otherwise), finite if asked."""
+    arr = _floats(x, what)
+    if arr.shape[arr.ndim - len(shape) :] != shape or arr.ndim < len(shape):
+        want = ", ".join(str(k) for k in shape)
+        raise ShapeError(f"{what} must have shape (..., {want}), got {arr.shape}")
+    if finite:
+        check_finite(arr, what)
+    return arr
+
+
+def _pose_pair(T: ArrayLike, T_desired: ArrayLike) -> tuple[Array, Array]:
+    """Two stacks of poses ``(..., 4, 4)`` that broadcast together (ShapeError otherwise; values not checked)."""
+    a = _trailing(T, "T", (4, 4), finite=False)
+    b = _trailing(T_desired, "T_desired", (4, 4), finite=False)
+    if a.shape != b.shape:
+        try:
+            np.broadcast_shapes(a.shape, b.shape)
+        except ValueError:
+            raise ShapeError(f"T {a.shape} and T_desired {b.shape} do not broadcast together") from None
+    return a, b
+
+
 def wrap_angle(x: ArrayLike) -> Array:
     """Wrap angles (radians) into (-pi, pi]."""
-    x = np.asarray(x, dtype=np.float64)
+    x = _floats(x, "angles")
     return np.pi - np.mod(np.pi - x, 2.0 * np.pi)
 
 
 def zyz_from_matrix(R: ArrayLike) -> Array:
     """Z-Y-Z Euler angles ``(..., 3)`` = (alpha, beta, gamma) in radians of rotations ``(..., 3, 3)``.
 
-    Also accepts poses ``(..., 4, 4)`` (the rotation block is used).
+    Also accepts poses ``(..., 4, 4)`` (the rotation block is used). A matrix that is not a rotation (not
+    orthonormal with det +1, to 1e-6), or not finite, is refused (a SweepikError).
 
     >>> import numpy as np
     >>> np.round(zyz_from_matrix(matrix_from_zyz([0.1, 0.2, 0.3])), 12).tolist()
     [0.1, 0.2, 0.3]
     """
-    R = np.asarray(R, dtype=np.float64)[..., :3, :3]
+    arr = _floats(R, "R")
+    if arr.ndim < 2 or arr.shape[-2:] not in ((3, 3), (4, 4)):
+        raise ShapeError(f"R must have shape (..., 3, 3) or (..., 4, 4), got {arr.shape}")
+    check_finite(arr, "R")
+    check_rotations(arr[..., :3, :3], "R")
+    return _zyz(arr)
+
+
+def _zyz(R: Array) -> Array:
+    """``zyz_from_matrix`` without its checks."""
+    R = R[..., :3, :3]
     r13, r23, r33 = R[..., 0, 2], R[..., 1, 2], R[..., 2, 2]
     r31, r32 = R[..., 2, 0], R[..., 2, 1]
     sb = np.hypot(r31, r32)
@@ -98,8 +142,15 @@ def matrix_from_zyz(angles: ArrayLike) -> Array:
 
 
 def pose_from_xyz_zyz(xyz: ArrayLike, zyz: ArrayLike) -> Array:
-    """Pose ``(..., 4, 4)`` from a position ``(..., 3)`` (length unit) and Z-Y-Z angles ``(..., 3)`` (radians)."""
-    return _pose(xyz, matrix_from_zyz(zyz))
+    """Pose ``(..., 4, 4)`` from a position ``(..., 3)`` (length unit) and Z-Y-Z angles ``(..., 3)`` (radians);
+    ShapeError / NonFiniteError for other lengths, NaN or infinite values."""
+    p = _trailing(xyz, "xyz", (3,))
+    a = _trailing(zyz, "zyz", (3,))
+    try:
+        np.broadcast_shapes(p.shape[:-1], a.shape[:-1])
+    except ValueError:
+        raise ShapeError(f"xyz {p.shape} and zyz {a.shape} do not broadcast together") from None
+    return _pose(p, matrix_from_zyz(a))
 
 
 def _pose(xyz: ArrayLike, R: Array) -> Array:
@@ -115,7 +166,7 @@ def _pose(xyz: ArrayLike, R: Array) -> Array:
 
 def xyz_zyz_from_pose(T: ArrayLike) -> tuple[Array, Array]:
     """Split poses ``(..., 4, 4)`` into positions ``(..., 3)`` and Z-Y-Z angles ``(..., 3)`` (radians)."""
-    T = np.asarray(T, dtype=np.float64)
+    T = _trailing(T, "T", (4, 4))
     return T[..., :3, 3].copy(), zyz_from_matrix(T)
 
 
@@ -175,13 +226,12 @@ def pose_error_paper(T: ArrayLike, T_desired: ArrayLike, weight: float = 100.0) 
     100 mm). Where either pose is within ``GIMBAL_TOL`` of a gimbal case, alpha and gamma are not separately
     defined: there the decomposition of ``T`` nearest ``T_desired`` is used, i.e. the alpha difference is
     zero and the gamma difference is the wrapped difference of ``alpha + gamma`` (``alpha - gamma`` at
-    beta = pi).
+    beta = pi). ShapeError for poses not ``(..., 4, 4)`` or that do not broadcast together.
     """
-    T = np.asarray(T, dtype=np.float64)
-    Td = np.asarray(T_desired, dtype=np.float64)
+    T, Td = _pose_pair(T, T_desired)
     jp = np.linalg.norm(T[..., :3, 3] - Td[..., :3, 3], axis=-1)
-    e = zyz_from_matrix(T)
-    ed = zyz_from_matrix(Td)
+    e = _zyz(T)
+    ed = _zyz(Td)
     da = wrap_angle(e[..., 0] - ed[..., 0])
     db = e[..., 1] - ed[..., 1]
     dg = wrap_angle(e[..., 2] - ed[..., 2])
@@ -197,8 +247,7 @@ def pose_error_paper(T: ArrayLike, T_desired: ArrayLike, weight: float = 100.0) 
 
 def pose_error_geodesic(T: ArrayLike, T_desired: ArrayLike, weight: float = 100.0) -> Array:
     """Position distance plus ``weight`` times the rotation angle of ``R_desired^T R`` (length unit)."""
-    T = np.asarray(T, dtype=np.float64)
-    Td = np.asarray(T_desired, dtype=np.float64)
+    T, Td = _pose_pair(T, T_desired)
     jp = np.linalg.norm(T[..., :3, 3] - Td[..., :3, 3], axis=-1)
     dR = np.swapaxes(Td[..., :3, :3], -1, -2) @ T[..., :3, :3]
     return np.asarray(jp + weight * rotation_angle(dR))

@@ -167,18 +167,24 @@ def check_poses(T: ArrayLike, what: str = "pose") -> NDArray[np.float64]:
         raise InvalidPoseError(
             f"{what} translation must be at most {MAX_TRANSLATION:g} in magnitude (length unit){where}, got {t}"
         )
-    dev, det = _gram_deviation_det(arr[..., :3, :3])
+    check_rotations(arr[..., :3, :3], what, "pose")
+    return arr
+
+
+def check_rotations(R: NDArray[np.float64], what: str, item: str = "rotation") -> None:
+    """InvalidPoseError unless every rotation ``R (..., 3, 3)`` (finite) is orthonormal with det +1 within
+    ``ORTHONORMAL_TOL``; the message names the first bad ``item`` of a stack."""
+    dev, det = _gram_deviation_det(R)
     bad = (dev > ORTHONORMAL_TOL) | (np.abs(det - 1.0) > ORTHONORMAL_TOL)
     if np.any(bad):
         idx = np.argwhere(np.atleast_1d(bad))[0]
-        where = f" (pose {tuple(int(i) for i in idx)})" if arr.ndim > 2 else ""
+        where = f" ({item} {tuple(int(i) for i in idx)})" if R.ndim > 2 else ""
         worst = float(np.atleast_1d(dev)[tuple(idx)])
         d = float(np.atleast_1d(det)[tuple(idx)])
         raise InvalidPoseError(
             f"{what} rotation must be orthonormal with det +1 (tolerance {ORTHONORMAL_TOL:g}){where}: "
             f"max |R^T R - I| = {worst:.3g}, det = {d:.6g}"
         )
-    return arr
 
 
 def _gram_deviation_det(R: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
