@@ -76,3 +76,34 @@ def test_an_arm_without_structure_takes_the_general_method() -> None:
     assert choose(robot).family == "general"
     with pytest.raises(NoReductionError, match="no decomposition sweeps"):
         choose(robot, free_joint=1)
+
+
+def _origin(x: float, y: float, z: float) -> tuple[tuple[float, ...], ...]:
+    T = np.eye(4)
+    T[:3, 3] = (x, y, z)
+    return tuple(tuple(float(v) for v in row) for row in T)
+
+
+def test_an_arm_whose_jacobian_is_never_full_rank_is_refused_as_a_continuum() -> None:
+    """Three vertical axes and a horizontal slide, then a wrist that cannot lift the tool: the tool's height is fixed
+    by its orientation, so every pose it reaches is a continuum; no structural relation names it (no two axes
+    coincide), the Jacobian's rank does, and the refusal says so instead of "outside the catalogue"."""
+    z, x = (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)
+    spec = [("revolute", (0, 0, 0.1), z), ("revolute", (0.3, 0, 0), z), ("prismatic", (0.2, 0, 0), x),
+            ("revolute", (0.1, 0.05, 0), z), ("revolute", (0, 0, 0.1), x), ("revolute", (0, 0, 0.1), z)]  # fmt: skip
+    joints = tuple(
+        Joint(
+            type=t,
+            lower=0.0 if t == "prismatic" else -3.0,
+            upper=0.3 if t == "prismatic" else 3.0,
+            origin=_origin(*o),
+            axis=a,
+            name=f"j{i + 1}",
+        )  # fmt: skip
+        for i, (t, o, a) in enumerate(spec)
+    )
+    arm = Robot(name="flat", joints=joints, dh_convention="none", length_unit="m")
+    with pytest.raises(NoReductionError, match="every pose is a continuum"):
+        choose(arm)
+    q = np.array([0.3, -0.2, 0.1, 0.4, 0.5, 0.6])
+    assert np.linalg.svd(arm.jacobian(q), compute_uv=False)[-1] < 1e-12  # (the premise)

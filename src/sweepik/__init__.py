@@ -14,6 +14,7 @@ from sweepik import plan_check as _plan_check  # registers the automatic decompo
 from sweepik.errors import (
     InvalidPoseError,
     LockedJointError,
+    MjcfError,
     NonFiniteError,
     NoReductionError,
     PoseFileError,
@@ -48,6 +49,7 @@ if _TYPE_CHECKING:
     from sweepik.distributed import solve_dask
     from sweepik.experiments.design import DesignComparison, compare_designs
     from sweepik.experiments.workspace import WorkspaceVolume, workspace_volume
+    from sweepik.io.mjcf import read_mjcf
     from sweepik.io.urdf import read_urdf, urdf_text
 
     __version__: str
@@ -61,6 +63,7 @@ _LAZY = {
     "DesignComparison": "sweepik.experiments.design",
     "solve_dask": "sweepik.distributed",
     "read_urdf": "sweepik.io.urdf",
+    "read_mjcf": "sweepik.io.mjcf",
     "urdf_text": "sweepik.io.urdf",
     "workspace_volume": "sweepik.experiments.workspace",
     "WorkspaceVolume": "sweepik.experiments.workspace",
@@ -121,6 +124,7 @@ __all__ = [
     "robot_from_dict",
     "robot_to_toml",
     "read_urdf",
+    "read_mjcf",
     "urdf_text",
     # solving
     "solve",
@@ -153,6 +157,7 @@ __all__ = [
     "RobotDefinitionError",
     "RobotFileError",
     "UrdfError",
+    "MjcfError",
     "UnknownRobotError",
     "ShapeError",
     "NonFiniteError",

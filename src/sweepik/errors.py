@@ -2,8 +2,8 @@
 
 Grouped by area:
 
-- the model (robots, robot files, URDF): :class:`RobotDefinitionError`, :class:`RobotFileError`, :class:`UrdfError`,
-  :class:`UnknownRobotError`;
+- the model (robots, robot files, URDF, MJCF, catalogues): :class:`RobotDefinitionError`, :class:`RobotFileError`,
+  :class:`UrdfError`, :class:`MjcfError`, :class:`UnknownRobotError`;
 - the decomposition: :class:`NoReductionError`;
 - input to a call (arrays, poses, options, files of poses, locked joints): :class:`ShapeError`,
   :class:`NonFiniteError`, :class:`InvalidPoseError`, :class:`UnknownOptionError`, :class:`LockedJointError`,
@@ -18,6 +18,7 @@ __all__ = [
     "RobotDefinitionError",
     "RobotFileError",
     "UrdfError",
+    "MjcfError",
     "UnknownRobotError",
     "ShapeError",
     "NonFiniteError",
@@ -51,6 +52,11 @@ class UrdfError(RobotFileError):
     joint bounds of :mod:`sweepik.io.urdf`, a broken tree (missing link, cycle, two roots, duplicate names), a bad
     number, or a chain sweepik cannot model (mimic, floating or planar joints on it); the message names the file,
     and the joint or link where there is one."""
+
+
+class MjcfError(RobotFileError):
+    """An MJCF file is refused: MuJoCo cannot read it, the ``mujoco`` package is missing, a name is not in it, or
+    the chain has a joint sweepik cannot model (ball, free) or a slide without a range."""
 
 
 class UnknownRobotError(SweepikError, LookupError):

@@ -52,6 +52,7 @@ Bounds (a file outside them raises :class:`~sweepik.errors.RobotFileError` namin
 
 from __future__ import annotations
 
+import difflib
 import tomllib
 from importlib import resources
 from os import PathLike
@@ -267,26 +268,34 @@ def _gravity(data: dict[str, Any], source: str) -> tuple[float, float, float]:
 
 
 def load_robot(name_or_path: str | Path | Robot, base_link: str | None = None, tip_link: str | None = None) -> Robot:
-    """Load a bundled robot by name (e.g. ``"carm"``), a robot file (TOML) or a URDF file (``.urdf``) by path.
+    """Load a robot: a bundled one by name (e.g. ``"carm"``, any case), a robot file (TOML), a URDF (``.urdf``) or an
+    MJCF file (``.xml`` / ``.mjcf``, read by MuJoCo: the ``mjcf`` extra) by path, or an arm of the catalogues people
+    use by its name there (:mod:`sweepik.io.catalogues`): a robot_descriptions name (``"ur10e_description"``,
+    ``"ur5e_mj_description"``) whose description is in robot_descriptions' cache, or an example-robot-data name
+    (``"example-robot-data:ur5"``, or a bare one no bundled arm has, such as ``"panda"``).
 
-    ``base_link`` and ``tip_link`` choose the chain of a URDF (see :func:`sweepik.io.urdf.read_urdf`: by default its
-    root link and the child link of its last moving joint, when the moving joints form one chain); they are
-    refused for other robots. A path is taken as a file when it ends in ``.toml`` or ``.urdf`` or exists (an existing
-    file of another extension whose text starts with ``<`` is read as URDF). Every problem with the file raises a
-    :class:`~sweepik.errors.RobotFileError` naming it (a directory, no permission, larger than
+    ``base_link`` and ``tip_link`` choose the chain of a URDF or MJCF (see :func:`sweepik.io.urdf.read_urdf` and
+    :func:`sweepik.io.mjcf.read_mjcf`: by default its root and the last moving joint's link, when the moving joints
+    form one chain; an MJCF tip may be a site); they are refused for other robots. A path is taken as a file when it
+    ends in ``.toml``, ``.urdf``, ``.xml`` or ``.mjcf`` or exists (an existing file of another extension whose text
+    starts with ``<`` is read as URDF, or as MJCF when it starts with ``<mujoco``). Every problem with the file
+    raises a :class:`~sweepik.errors.RobotFileError` naming it (a directory, no permission, larger than
     ``MAX_ROBOT_FILE_BYTES``, not UTF-8, not TOML, nested too deeply, a field out of the bounds in the module
     docstring); an unknown name or a missing file raises :class:`~sweepik.errors.UnknownRobotError` listing the
-    bundled robots.
+    bundled robots and the names closest to the one given; a catalogue name whose file is not here (not installed,
+    not downloaded) says what would fetch it.
 
     >>> load_robot("carm").n_joints
     6
+    >>> load_robot("UR5").name
+    'ur5'
     """
-    urdf_links = base_link is not None or tip_link is not None
     for what, link in (("base_link", base_link), ("tip_link", tip_link)):
         if link is not None and not isinstance(link, str):
             raise UnknownOptionError(f"{what} must be a link name (a string), got {type(link).__name__}")
+    links = {"base_link": base_link, "tip_link": tip_link}
     if isinstance(name_or_path, Robot):
-        if urdf_links:
+        if base_link is not None or tip_link is not None:
             raise UnknownOptionError("base_link/tip_link choose the chain of a URDF file, not of a loaded Robot")
         return name_or_path
     bundled = bundled_robots()
@@ -296,31 +305,73 @@ def load_robot(name_or_path: str | Path | Robot, base_link: str | None = None, t
             f"{type(name_or_path).__name__} {short_repr(name_or_path, 40)}; bundled robots: {', '.join(bundled)}"
         )
     path = as_path(name_or_path, RobotFileError, "robot file")
-    if path.suffix.lower() == ".urdf" or (urdf_links and str(path) not in bundled and path.suffix.lower() != ".toml"):
-        from sweepik.io.urdf import read_urdf  # the XML parser is loaded only for URDF files
-
-        return read_urdf(path, base_link=base_link, tip_link=tip_link)
-    if urdf_links:
-        raise UnknownOptionError(
-            f"base_link/tip_link choose the chain of a URDF file; {str(path)!r} is a "
-            + ("bundled robot" if str(path) in bundled else "TOML robot file")
-        )
-    if str(path) in bundled:
-        res = resources.files("sweepik.io") / "robots" / f"{path}.toml"
-        return _parse(res.read_text(encoding="utf-8"), f"{path}.toml (bundled)")
+    suffix = path.suffix.lower()
+    if suffix in _XML_SUFFIXES:
+        return _read_xml(path, suffix, **links)
+    name = _bundled_name(str(path), bundled) if suffix != ".toml" else None
+    if name is not None:
+        if base_link is not None or tip_link is not None:
+            raise UnknownOptionError(
+                f"base_link/tip_link choose the chain of a URDF or MJCF file; {name!r} is a bundled robot"
+            )
+        res = resources.files("sweepik.io") / "robots" / f"{name}.toml"
+        return _parse(res.read_text(encoding="utf-8"), f"{name}.toml (bundled)")
     st = file_status(path, RobotFileError, "robot file")
     if st is None:
-        if path.suffix.lower() == ".toml":
+        if suffix == ".toml":
             raise UnknownRobotError(f"robot file {str(path)!r} does not exist; bundled robots: {', '.join(bundled)}")
-        raise UnknownRobotError(
-            f"unknown robot {str(path)!r}: not a bundled robot nor a file; bundled robots: {', '.join(bundled)}"
-        )
+        return _from_catalogue(str(path), bundled, **links)
     blob = read_file_bytes(path, MAX_ROBOT_FILE_BYTES, RobotFileError, "robot file")
-    if path.suffix.lower() != ".toml" and blob.lstrip()[:1] == b"<":
+    if suffix != ".toml" and blob.lstrip()[:1] == b"<":
+        return _read_xml(path, ".mjcf" if blob.lstrip()[:7] == b"<mujoco" else ".urdf", **links)
+    if base_link is not None or tip_link is not None:
+        raise UnknownOptionError(
+            f"base_link/tip_link choose the chain of a URDF or MJCF file; {str(path)!r} is a TOML robot file"
+        )
+    return _parse(decode_text(blob, path, RobotFileError, "robot file (TOML)"), str(path))
+
+
+#: File suffixes read as XML robots: URDF, and MJCF (MuJoCo's ``.xml``).
+_XML_SUFFIXES = (".urdf", ".xml", ".mjcf")
+
+
+def _read_xml(path: Path, suffix: str, base_link: str | None, tip_link: str | None) -> Robot:
+    """A URDF (``.urdf``) or MJCF (``.xml``, ``.mjcf``) file's chain; the XML readers are loaded only for them."""
+    if suffix == ".urdf":
         from sweepik.io.urdf import read_urdf
 
-        return read_urdf(path)
-    return _parse(decode_text(blob, path, RobotFileError, "robot file (TOML)"), str(path))
+        return read_urdf(path, base_link=base_link, tip_link=tip_link)
+    from sweepik.io.mjcf import read_mjcf
+
+    return read_mjcf(path, base_link=base_link, tip_link=tip_link)
+
+
+def _bundled_name(name: str, bundled: list[str]) -> str | None:
+    """The bundled robot ``name`` names, compared without case (``"UR5"`` is ``"ur5"``); None if none."""
+    if name in bundled:
+        return name
+    folded = {b.casefold(): b for b in bundled}
+    return folded.get(name.casefold())
+
+
+def _from_catalogue(name: str, bundled: list[str], base_link: str | None, tip_link: str | None) -> Robot:
+    """A catalogue's arm (``catalogues.find_in_catalogues``), or UnknownRobotError with the closest names."""
+    from sweepik.io.catalogues import catalogue_names, find_in_catalogues
+
+    entry = find_in_catalogues(name)
+    if entry is None:
+        known = list(dict.fromkeys([*bundled, *catalogue_names()]))
+        close = [k for k in (f"{name}_description", f"{name}_mj_description") if k in known]
+        close += [c for c in difflib.get_close_matches(name.casefold(), known, n=3, cutoff=0.6) if c not in close]
+        hint = f" Did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
+        raise UnknownRobotError(
+            f"unknown robot {name!r}: not a bundled robot nor a file, nor a robot_descriptions or example-robot-data "
+            f"name.{hint} Bundled robots: {', '.join(bundled)}"
+        )
+    if not entry.path.is_file():
+        raise UnknownRobotError(f"{name!r}: {entry.origin} should hold {entry.path}, which is not there")
+    tip = tip_link if tip_link is not None else entry.tip_link
+    return _read_xml(entry.path, "." + entry.format, base_link, tip)
 
 
 def _parse(raw: str, source: str) -> Robot:

@@ -51,11 +51,43 @@ def continuum_everywhere(robot: Robot) -> str | None:
             "joints locked, lock another joint"
         )
     if not coaxial:
-        return None
+        return _rank_deficient(robot)
     return (
         f"robot {robot.name!r}: every pose is a continuum (or nearly one): joints {', '.join(coaxial)} turn about one "
         "line (joints numbered from 1 in this arm), so only the sum of their angles is fixed by a pose; with joints "
         "locked, lock another joint or another value"
+    )
+
+
+#: Configurations (spread over the joint ranges by a fixed sequence) at which ``_rank_deficient`` looks at the
+#: Jacobian, and the ratio of its smallest to largest singular value (rows and slide columns scaled by the arm's
+#: size) below which the arm counts as moving its tool in fewer than six directions there.
+RANK_SAMPLES = 4
+RANK_TOL = 1e-9
+
+
+def _rank_deficient(robot: Robot) -> str | None:
+    """Why every pose is a continuum when the arm's six joints move the tool in at most five directions at every
+    configuration (a relation the structural checks do not name, e.g. three vertical axes and a horizontal slide
+    with a wrist that cannot lift: the height is fixed by the orientation), or None. Seen at ``RANK_SAMPLES``
+    configurations: a generic one of rank six shows the arm is not degenerate."""
+    if robot.n_joints != 6:
+        return None
+    import numpy as np  # (only here: the structural checks need no arrays)
+
+    u = (np.arange(1, RANK_SAMPLES + 1)[:, None] * (np.sqrt([2, 3, 5, 7, 11, 13]) % 1.0)) % 1.0
+    q = robot.lower + (0.1 + 0.8 * u) * (robot.upper - robot.lower)
+    L = robot.length_scale
+    J = robot.jacobian(q)
+    J = J * np.where(robot.is_revolute, 1.0, L)[None, None, :]
+    J[:, :3, :] /= L
+    sv = np.linalg.svd(J, compute_uv=False)
+    if np.any(sv[:, -1] > RANK_TOL * sv[:, 0]):
+        return None
+    return (
+        f"robot {robot.name!r}: every pose is a continuum: its six joints move the tool in at most five independent "
+        f"directions at every configuration (the Jacobian's rank is below 6 at {RANK_SAMPLES} configurations spread "
+        "over the joint ranges), so every pose it reaches is reached along a curve of configurations"
     )
 
 
