@@ -291,3 +291,49 @@ def test_interrupt_is_one_line_and_status_130(
     code, out, err = run(capsys, "fk", "carm", "0", "0", "0", "0", "0", "0")
     assert code == 130 and out == "first pose\n"
     assert err.strip().splitlines() == ["sweepik: interrupted"]
+
+
+# --------------------------------------------------------------------------------------------------
+# a newcomer's first commands (issue 38)
+# --------------------------------------------------------------------------------------------------
+
+
+def test_seven_joints_without_lock_names_the_cli_option(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "solve", "franka_panda", "--xyz", "0.31", "0", "0.59", "--zyz", "0", "180", "-135")
+    assert_one_line_error(code, out, err, "--lock NAME=VALUE", "sweepik analyze franka_panda")
+    assert "locked={" not in err
+
+
+def test_solve_says_its_decomposition_and_the_readme_panda_example_has_a_solution(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, out, err = run(
+        capsys, "solve", "franka_panda", "--xyz", "0.31", "0", "0.59", "--zyz", "0", "180", "-135", "--lock",
+        "joint7=45",
+    )  # fmt: skip
+    assert code == 0 and err == ""
+    assert out.splitlines()[0] == "decomposition: closed form, 8 branches, reversed chain"
+    assert "1 solution(s)" in out
+    code, out, err = run(capsys, "solve", "ur5", "--xyz", "0.3", "0.2", "0.4", "-v")
+    assert code == 0 and "solution(s) in" in err and "decomposition: closed form, 8 branches" in out
+
+
+def test_nearest_with_metric_and_tol_and_windings(capsys: pytest.CaptureFixture[str]) -> None:
+    base = ["solve", "ur5", "--xyz", "0.3", "0.2", "0.4", "--zyz", "0", "180", "0", "--nearest", "0", "-90", "90",
+            "0", "90", "0", "--metric", "linf"]  # fmt: skip
+    code, out, _ = run(capsys, *base, "--tol", "30")
+    assert code == 0 and "nearest: none within --tol 30 (linf metric)" in out
+    code, out, _ = run(capsys, *base, "--tol", "300", "--windings", "--json")
+    pose = json.loads(out)["poses"][0]
+    assert len(pose["q"]) == len(pose["winding_of"]) > 8 and pose["nearest"] is not None
+    code, out, err = run(capsys, *base, "--tol", "-1")
+    assert_one_line_error(code, out, err, "--tol")
+
+
+def test_robots_shows_origin_axis_joints_and_the_lock_table(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    path = tmp_path / "ur5.urdf"
+    path.write_text(sweepik.urdf_text(load_robot("ur5")))
+    code, out, _ = run(capsys, "robots", str(path))
+    assert code == 0 and "origin + axis joints" in out and "origin xyz [m]" in out and "axis" in out
+    code, out, _ = run(capsys, "robots", "franka_panda")
+    assert code == 0 and "lock a joint first" in out and "lock joint" in out and "closed form" in out

@@ -81,6 +81,7 @@ def test_solve_json_streamed_is_bit_identical_to_solve_many(
         "joint_names": CARM.joint_names,
         "units": "radians and mm",
         "strategy": "precise",
+        "decomposition": "reduction carm-d1 (the robot file's default)",
         "poses": [cli_solve._solution_json(CARM, s, None) for s in sols],
     }
     assert out == json.dumps(doc, indent=2, allow_nan=False) + "\n"
@@ -399,11 +400,12 @@ def test_multiplicity_column_only_where_a_root_is_multiple(capsys: pytest.Captur
         return out.splitlines()
 
     double = table(Q_DOUBLE)
-    assert double[1].split()[-1] == "multiplicity"
-    assert sorted(ln.split()[-1] for ln in double[2:4]) == ["1", "2"]
+    assert double[0].startswith("decomposition: ")
+    assert double[2].split()[-1] == "multiplicity"
+    assert sorted(ln.split()[-1] for ln in double[3:5]) == ["1", "2"]
     regular = table(Q_REGULAR[0])
     assert "multiplicity" not in "\n".join(regular)
-    assert regular[1].split()[-1] == "[mm]"  # the last column is J
+    assert regular[2].split()[-1] == "[mm]"  # the last column is J
 
 
 def test_format_table_with_known_numeric_columns_is_unchanged() -> None:

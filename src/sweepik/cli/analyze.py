@@ -39,7 +39,7 @@ def add_analyze_parser(sub: _SubParsers) -> None:
     _add_json(p)
 
 
-def _print_locks(robot: Any, locks: list[dict[str, Any]]) -> None:
+def print_locks(robot: Any, locks: list[dict[str, Any]]) -> None:
     """The table of a 7-joint arm: for each joint, what locking it (at 0 and at a generic value) leaves."""
     print(f"{robot.n_joints} joints: solve with one locked (--lock NAME=VALUE); what each lock leaves:")
     rows = []
@@ -74,7 +74,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
             f"joints {', '.join(map(str, info['arm_joints']))} of the arm; theta* below by the arm's numbers)"
         )
     if "locks" in info:
-        _print_locks(robot, info["locks"])
+        print_locks(robot, info["locks"])
         return 0
     if info.get("near_structure"):
         print(f"near-structure (holds nearly, not exactly: a general arm there): {', '.join(info['near_structure'])}")

@@ -35,13 +35,13 @@ from numpy.typing import NDArray
 from sweepik import __version__
 from sweepik.errors import SweepikError
 from sweepik.io.robot_file import bundled_robots
-from sweepik.model.pose import GIMBAL_TOL, zyz_from_matrix
+from sweepik.model.pose import GIMBAL_TOL, rpy_from_matrix, zyz_from_matrix
 from sweepik.model.robot import Robot
 from sweepik.reductions.analysis import analyze
 
 __all__ = ["main", "build_parser"]
 
-from sweepik.cli.analyze import add_analyze_parser, cmd_analyze, plan_line
+from sweepik.cli.analyze import add_analyze_parser, cmd_analyze, plan_line, print_locks
 from sweepik.cli.batch import EXIT_INTERRUPTED, add_sample_parser, cmd_sample
 from sweepik.cli.common import (
     DEFAULT_ROBOT,
@@ -200,27 +200,16 @@ def _cmd_robots(args: argparse.Namespace) -> int:
         unit = robot.length_unit
         print(f"{robot.name}: {robot.description}" if robot.description else robot.name)
         extra = f", default reduction {robot.default_reduction}" if robot.default_reduction else ""
-        print(f"  {robot.n_joints} joints, {robot.dh_convention} DH, lengths in {unit}, angles in deg{extra}")
+        form = "origin + axis joints" if robot.dh_convention == "none" else f"{robot.dh_convention} DH"
+        print(f"  {robot.n_joints} joints, {form}, lengths in {unit}, angles in deg{extra}")
         info = analyze(robot)
         print(f"  structure {info['structure']}")
         chosen = info["chosen"]
-        print(f"  decomposition: {plan_line(chosen) if chosen else 'none in the catalogue'}")
-        a_label = "a_{i-1}" if robot.dh_convention == "modified" else "a_i"
-        al_label = "alpha_{i-1}" if robot.dh_convention == "modified" else "alpha_i"
-        header = [
-            "joint",
-            "type",
-            f"{a_label} [{unit}]",
-            f"{al_label} [deg]",
-            f"d_i [{unit}]",
-            "theta_i [deg]",
-            "limits",
-        ]
-        rows = []
-        for row, rev in zip(robot.dh_table(), robot.is_revolute, strict=True):
-            num = [_num(float(row[k]), dec) for k in ("a", "alpha_deg", "d", "theta_deg", "lower", "upper")]
-            lim_unit = "deg" if rev else unit
-            rows.append([str(row["joint"]), str(row["type"]), *num[:4], f"[{num[4]}, {num[5]}] {lim_unit}"])
+        if "locks" in info:
+            print("  decomposition: lock a joint first (--lock NAME=VALUE; the table below)")
+        else:
+            print(f"  decomposition: {plan_line(chosen) if chosen else 'none in the catalogue'}")
+        header, rows = _joint_table(robot, dec)
         print(_format_table(header, rows))
         for label, T in (
             ("base T_world_base", robot.T_world_base),
@@ -229,7 +218,38 @@ def _cmd_robots(args: argparse.Namespace) -> int:
             if not np.array_equal(T, np.eye(4)):
                 print(f"  {label}:")
                 print(_format_matrix(T, dec, indent="    "))
+        if "locks" in info:
+            print_locks(robot, info["locks"])
     return 0
+
+
+def _joint_table(robot: Robot, dec: int) -> tuple[list[str], list[list[str]]]:
+    """The joints as a table: DH rows, or for an arm in origin + axis form (URDF, MJCF) each joint's origin
+    (position, roll-pitch-yaw) in the previous joint's frame and its axis."""
+    unit = robot.length_unit
+    limits = [
+        f"[{_num(float(np.degrees(lo) if rev else lo), dec)}, {_num(float(np.degrees(hi) if rev else hi), dec)}] "
+        + ("deg" if rev else unit)
+        for (lo, hi), rev in zip(robot.limits, robot.is_revolute, strict=True)
+    ]
+    if robot.dh_convention == "none":
+        header = ["joint", "type", f"origin xyz [{unit}]", "origin rpy [deg]", "axis", "limits"]
+        rows = []
+        for j, lim in zip(robot.joints, limits, strict=True):
+            T = np.array(j.origin, dtype=np.float64)
+            xyz = " ".join(_num(float(v), dec) for v in T[:3, 3])
+            rpy = " ".join(_num(float(v), dec) for v in np.degrees(rpy_from_matrix(T)))
+            axis = " ".join(_num(float(v), dec) for v in j.axis)
+            rows.append([str(j.name), j.type, xyz, rpy, axis, lim])
+        return header, rows
+    a_label = "a_{i-1}" if robot.dh_convention == "modified" else "a_i"
+    al_label = "alpha_{i-1}" if robot.dh_convention == "modified" else "alpha_i"
+    header = ["joint", "type", f"{a_label} [{unit}]", f"{al_label} [deg]", f"d_i [{unit}]", "theta_i [deg]", "limits"]
+    rows = []
+    for row, lim in zip(robot.dh_table(), limits, strict=True):
+        num = [_num(float(row[k]), dec) for k in ("a", "alpha_deg", "d", "theta_deg")]
+        rows.append([str(row["joint"]), str(row["type"]), *num, lim])
+    return header, rows
 
 
 # --------------------------------------------------------------------------------------------------

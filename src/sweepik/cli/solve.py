@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +37,7 @@ from sweepik.io.robot_file import bundled_robots
 from sweepik.model.pose import pose_from_xyz_zyz
 from sweepik.model.robot import Robot
 from sweepik.reductions import REDUCTIONS
+from sweepik.reductions.analysis import analyze, plan_line
 from sweepik.results import METRICS, Solutions, check_tolerance
 from sweepik.solving import STRATEGIES, iter_solve
 
@@ -52,13 +54,33 @@ def _ik_kwargs(args: argparse.Namespace, robot: Robot) -> dict[str, Any]:
                 f"--free-joint takes a joint number from 1 to {robot.n_joints} (or a joint name), got {free}"
             )
         free = number - 1  # the API numbers joints from 0
+    locked = _locked_from_args(robot, args)
+    left = robot.n_joints - len(locked or {})
+    if left > 6:
+        raise CliInputError(
+            f"robot {robot.name!r} has {robot.n_joints} joints; sweepik solves six: hold {left - 6} more with --lock "
+            f"NAME=VALUE (e.g. --lock {robot.joint_names[-1]}=30, degrees or the length unit; 'sweepik analyze "
+            f"{robot.name}' tells which lock gives a closed form or a sweep)"
+        )
     return {
         "reduction": args.reduction,
         "free_joint": free,
         "strategy": args.strategy,
         "limits": not args.no_limits,
-        "locked": _locked_from_args(robot, args),
+        "locked": locked,
     }
+
+
+def _decomposition_line(robot: Robot, kw: dict[str, Any]) -> str:
+    """How ``solve`` decomposes the arm with these options, in words (``analyze``'s chosen plan)."""
+    named = kw["reduction"] if kw["reduction"] is not None else robot.default_reduction
+    if named not in (None, "auto"):
+        return f"reduction {named}" + (" (the robot file's default)" if kw["reduction"] is None else "")
+    if kw["free_joint"] is not None:
+        free = kw["free_joint"]
+        return f"sweep joint {free + 1 if isinstance(free, int) else free} (--free-joint)"
+    info = analyze(robot, locked=kw["locked"])
+    return plan_line(info["chosen"]) if info["chosen"] else "none (" + str(info["reason"]) + ")"
 
 
 def _add_ik_options(p: argparse.ArgumentParser) -> None:
@@ -258,14 +280,18 @@ def cmd_solve(args: argparse.Namespace) -> int:
     poses = _poses_from_args(args)
     # the output streaming to the terminal shows the progress by itself: no progress line mixed into it
     progress = _Progress(enabled=not _isatty(sys.stdout))
+    kw = _ik_kwargs(args, robot)
+    start = time.perf_counter()
     try:
-        sols = iter_solve(robot, poses, progress=progress, windings=args.windings, **_ik_kwargs(args, robot))
+        sols = iter_solve(robot, poses, progress=progress, windings=args.windings, **kw)
+        how = _decomposition_line(robot, kw)
         if args.json:
             head = {
                 "robot": robot.name,
                 "joint_names": robot.joint_names,
                 "units": "radians and " + robot.length_unit,
                 "strategy": args.strategy,
+                "decomposition": how,
             }
             _print_json_stream(head, "poses", (_solution_json(robot, s, nearest, args) for s in sols))
             return 0
@@ -276,12 +302,22 @@ def cmd_solve(args: argparse.Namespace) -> int:
             header.append("winds #")
         if args.no_limits:
             header.append("in limits")
+        print(f"decomposition: {how}")
+        count = 0
         for k, sol in enumerate(sols):
             if poses.shape[0] > 1:
                 print(f"pose {k + 1}:")
             _print_solutions(robot, sol, args, header, nearest)
+            count += len(sol)
     finally:
         progress.close()
+    if getattr(args, "verbose", False):
+        spent = time.perf_counter() - start
+        print(
+            f"{poses.shape[0]} pose(s), {count} solution(s) in {spent:.3f} s ({1e6 * spent / poses.shape[0]:.0f} us "
+            f"per pose, printing included; the first solve of an arm in a process compiles and loads its kernels)",
+            file=sys.stderr,
+        )
     return 0
 
 
