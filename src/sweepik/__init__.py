@@ -51,6 +51,7 @@ if _TYPE_CHECKING:
     from sweepik.experiments.workspace import WorkspaceVolume, workspace_volume
     from sweepik.io.mjcf import read_mjcf
     from sweepik.io.urdf import read_urdf, urdf_text
+    from sweepik.viewer.app import view
 
     __version__: str
 
@@ -64,6 +65,7 @@ _LAZY = {
     "solve_dask": "sweepik.distributed",
     "read_urdf": "sweepik.io.urdf",
     "read_mjcf": "sweepik.io.mjcf",
+    "view": "sweepik.viewer.app",
     "urdf_text": "sweepik.io.urdf",
     "workspace_volume": "sweepik.experiments.workspace",
     "WorkspaceVolume": "sweepik.experiments.workspace",
@@ -133,6 +135,7 @@ __all__ = [
     "solve_dask",
     "load_solutions",
     "analyze",
+    "view",
     # results
     "Solutions",
     "SolutionBatch",

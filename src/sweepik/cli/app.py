@@ -70,6 +70,7 @@ from sweepik.cli.convert import add_convert_parser, cmd_convert
 from sweepik.cli.design import add_design_parser, cmd_design
 from sweepik.cli.solve import add_path_parser, add_solve_parser, cmd_path, cmd_solve
 from sweepik.cli.verify import add_bench_parser, add_verify_parser, cmd_bench, cmd_verify
+from sweepik.cli.view import add_view_parser, cmd_view
 
 
 def _add_fk_parser(sub: _SubParsers) -> None:
@@ -271,6 +272,7 @@ _COMMANDS: dict[str, tuple[_AddParser, _Run]] = {
     "convert": (add_convert_parser, cmd_convert),
     "sample": (add_sample_parser, cmd_sample),
     "design": (add_design_parser, cmd_design),
+    "view": (add_view_parser, cmd_view),
 }
 
 
