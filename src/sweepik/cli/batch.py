@@ -15,6 +15,7 @@ from sweepik.cli.common import (
     DEFAULT_ROBOT,
     PROGRESS_EVERY_S,
     CliInputError,
+    _add_json,
     _add_robot_options,
     _check_output_path,
     _count,
@@ -226,18 +227,49 @@ def add_sample_parser(sub: _SubParsers) -> None:
     p = _subparser(
         sub,
         "sample",
-        help="random in-limit configurations and their poses (.npy), e.g. for 'solve --out'",
+        help="random in-limit configurations and their poses (.npy or .csv), e.g. for 'solve --poses'",
         description=(
             "Draw N configurations uniformly inside the joint limits and write their tool poses (N, 4, 4) to "
-            "--out (.npy) and the configurations (N, n_joints; radians and the robot's length unit) next to it, "
-            f"as <name>.q.npy (or --q-out). ROBOT is a bundled robot or a robot file (default: {DEFAULT_ROBOT})."
+            "--out (.npy, or .csv: one pose per row, 16 numbers row-major) and the configurations (N, n_joints; "
+            "radians and the robot's length unit) next to it, as <name>.q.npy / <name>.q.csv (or --q-out). ROBOT "
+            f"is a bundled robot or a robot file (default: {DEFAULT_ROBOT})."
         ),
     )
     p.add_argument("values", nargs="+", metavar="[ROBOT] N", help="robot (optional), then the number of poses")
-    p.add_argument("--out", required=True, metavar="FILE", help="poses file to write (.npy)")
-    p.add_argument("--q-out", metavar="FILE", help="configurations file to write (.npy; default: <out>.q.npy)")
+    p.add_argument("--out", required=True, metavar="FILE", help="poses file to write (.npy or .csv)")
+    p.add_argument("--q-out", metavar="FILE", help="configurations file to write (default: <out>.q.npy / .q.csv)")
     p.add_argument("--seed", type=_nonnegative_int, metavar="S", help="random seed (default: a fresh one, printed)")
     _add_robot_options(p)
+    _add_json(p, ": the files written, the seed")
+
+
+class _SampleWriter:
+    """Rows written block by block into ``path``: a memory-mapped ``.npy`` of ``shape``, or CSV text (a pose as its
+    16 numbers row-major, as ``load_poses`` reads them; a configuration as its n values), 17 significant digits."""
+
+    def __init__(self, path: str, shape: tuple[int, ...]) -> None:
+        self.path, self.shape = path, shape
+        self.csv = path.lower().endswith(".csv")
+
+    def __enter__(self) -> _SampleWriter:
+        if self.csv:
+            self.fh: Any = open(self.path, "w", encoding="utf-8")  # noqa: SIM115 - closed in __exit__
+        else:
+            self.fh = np.lib.format.open_memmap(self.path, mode="w+", dtype=np.float64, shape=self.shape)
+        return self
+
+    def write(self, start: int, rows: np.ndarray) -> None:
+        if self.csv:
+            np.savetxt(self.fh, rows.reshape(len(rows), -1), delimiter=",", fmt="%.17g")
+        else:
+            self.fh[start : start + len(rows)] = rows
+
+    def __exit__(self, *exc: object) -> None:
+        if self.csv:
+            self.fh.close()
+        else:
+            self.fh.flush()
+            del self.fh
 
 
 def cmd_sample(args: argparse.Namespace) -> int:
@@ -251,26 +283,28 @@ def cmd_sample(args: argparse.Namespace) -> int:
     except argparse.ArgumentTypeError as exc:
         raise CliInputError(f"N (number of poses): {exc}") from None
     out = args.out
-    q_out = args.q_out or (out[: -len(".npy")] if out.lower().endswith(".npy") else out) + ".q.npy"
-    _check_output_path(out, suffixes=(".npy",))
-    _check_output_path(q_out, suffixes=(".npy",))
+    suffix = ".csv" if out.lower().endswith(".csv") else ".npy"
+    stem = out[: -len(suffix)] if out.lower().endswith(suffix) else out
+    q_out = args.q_out or stem + ".q" + suffix
+    _check_output_path(out, suffixes=(".npy", ".csv"))
+    _check_output_path(q_out, suffixes=(".npy", ".csv"))
     if Path(out).resolve() == Path(q_out).resolve():
         raise CliInputError(f"--out and --q-out name the same file {out!r}")
     robot = _load_robot(name, args)
     seed = args.seed if args.seed is not None else int(np.random.SeedSequence().entropy % 2**63)  # type: ignore[operator]
     rng = np.random.default_rng(seed)
     random_configurations(robot, 0, rng)  # refuses a robot without finite limits before any file is written
-    poses = np.lib.format.open_memmap(out, mode="w+", dtype=np.float64, shape=(n, 4, 4))
-    qs = np.lib.format.open_memmap(q_out, mode="w+", dtype=np.float64, shape=(n, robot.n_joints))
-    for s in range(0, n, SAMPLE_BLOCK):
-        q = random_configurations(robot, min(SAMPLE_BLOCK, n - s), rng)
-        qs[s : s + len(q)] = q
-        poses[s : s + len(q)] = robot.fk(q)
-    poses.flush()
-    qs.flush()
-    del poses, qs
-    print(
+    with _SampleWriter(out, (n, 4, 4)) as poses, _SampleWriter(q_out, (n, robot.n_joints)) as qs:
+        for s in range(0, n, SAMPLE_BLOCK):
+            q = random_configurations(robot, min(SAMPLE_BLOCK, n - s), rng)
+            qs.write(s, q)
+            poses.write(s, robot.fk(q))
+    text = (
         f"sampled {n:,} configurations of {robot.name} inside its joint limits (seed {seed}): poses (N, 4, 4) -> "
         f"{out}, configurations (N, {robot.n_joints}; radians, {robot.length_unit}) -> {q_out}"
     )
+    if args.json:
+        _print_json({"robot": robot.name, "n": n, "seed": seed, "poses": out, "configurations": q_out})
+    else:
+        print(text)
     return 0

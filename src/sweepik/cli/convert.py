@@ -7,10 +7,12 @@ from pathlib import Path
 
 from sweepik.cli.common import (
     CliInputError,
+    _add_json,
     _add_robot_options,
     _check_output_path,
     _load_robot,
     _locked_from_args,
+    _print_json,
     _subparser,
     _SubParsers,
 )
@@ -38,6 +40,7 @@ def add_convert_parser(sub: _SubParsers) -> None:
     p.add_argument("-o", "--output", metavar="FILE", required=True, help="the file to write (.toml or .urdf)")
     p.add_argument("--rad", action="store_true", help="--lock values of revolute joints in radians")
     _add_robot_options(p, lock=True)
+    _add_json(p, ": the file written")
 
 
 def cmd_convert(args: argparse.Namespace) -> int:
@@ -56,5 +59,8 @@ def cmd_convert(args: argparse.Namespace) -> int:
     else:
         text = robot_to_toml(robot)
     Path(args.output).write_text(text, encoding="utf-8")
-    print(f"wrote {robot.name!r} ({robot.n_joints} joints) to {args.output}")
+    if args.json:
+        _print_json({"robot": robot.name, "n_joints": robot.n_joints, "output": args.output})
+    else:
+        print(f"wrote {robot.name!r} ({robot.n_joints} joints) to {args.output}")
     return 0
