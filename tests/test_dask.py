@@ -317,3 +317,49 @@ def test_store_of_a_run_that_cannot_connect_is_removed(tmp_path: Path, monkeypat
     with pytest.raises(sweepik_errors.SweepikError, match="cannot reach"):
         solve_dask(CARM, P, "tcp://127.0.0.1:9", out=tmp_path / "s.zarr", chunk_size=10)
     assert not (tmp_path / "s.zarr").exists()
+
+
+def test_the_local_cluster_is_kept_for_the_next_call(carm_poses: tuple[np.ndarray, Any]) -> None:
+    """``client=None`` starts a local cluster once per process: a second call uses the same one (its client is the
+    same object), a call with another size replaces it, and ``close_local_cluster`` stops it."""
+    from sweepik import distributed
+
+    P, _ = carm_poses
+    distributed.close_local_cluster()
+    try:
+        first = solve_dask(CARM, P[:50], n_workers=1)
+        kept = distributed._LOCAL[0][2]
+        second = solve_dask(CARM, P[50:100], n_workers=1)
+        assert distributed._LOCAL[0][2] is kept and len(distributed._LOCAL) == 1
+        assert_same_batch(first, solve_many(CARM, P[:50]))
+        assert_same_batch(second, solve_many(CARM, P[50:100]))
+    finally:
+        distributed.close_local_cluster()
+    assert distributed._LOCAL == []
+
+
+SCRIPT = """
+import numpy as np
+import sweepik
+arm = sweepik.load_robot("carm")
+q = arm.lower + np.random.default_rng(1).random((40, 6)) * (arm.upper - arm.lower)
+{body}
+"""
+
+
+@pytest.mark.parametrize("guarded", [False, True])
+def test_a_plain_script_gets_one_clear_error_or_works(guarded: bool, tmp_path: Path) -> None:
+    """A script calling ``solve_dask`` at its top level: the local workers re-run it as they start; the call fails
+    with one SweepikError saying to guard it (one traceback, the script's own, not one per worker). Guarded, the
+    same script solves."""
+    call = "batch = sweepik.solve_dask(arm, arm.fk(q), n_workers=2)\nprint('solved', len(batch))"
+    body = call if not guarded else "if __name__ == '__main__':\n    " + call.replace("\n", "\n    ")
+    script = tmp_path / "script.py"
+    script.write_text(SCRIPT.format(body=body))
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=WAIT_S, cwd=tmp_path)
+    if guarded:
+        assert proc.returncode == 0 and "solved 40" in proc.stdout, proc.stderr[-2000:]
+    else:
+        assert proc.returncode != 0
+        assert proc.stderr.count("Traceback") == 1, proc.stderr[-3000:]
+        assert 'if __name__ == "__main__":' in proc.stderr.splitlines()[-1]
