@@ -337,3 +337,35 @@ def test_robots_shows_origin_axis_joints_and_the_lock_table(capsys: pytest.Captu
     assert code == 0 and "origin + axis joints" in out and "origin xyz [m]" in out and "axis" in out
     code, out, _ = run(capsys, "robots", "franka_panda")
     assert code == 0 and "lock a joint first" in out and "lock joint" in out and "closed form" in out
+
+
+def test_first_run_says_it_compiles_on_a_terminal_only(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from sweepik.cli import app
+
+    monkeypatch.setattr(app, "_kernels_cached", lambda: False)
+    code, out, err = run(capsys, "solve", "ur5", "--xyz", "0.3", "0.2", "0.4")
+    assert code == 0 and "compiling" not in err  # (not a terminal: nothing said)
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    code, out, err = run(capsys, "solve", "ur5", "--xyz", "0.3", "0.2", "0.4")
+    assert code == 0 and "compiling the solver's kernels" in err and "compiling" not in out
+    code, out, err = run(capsys, "robots", "ur5")
+    assert code == 0 and "compiling" not in err  # (no kernels needed)
+
+
+def test_paper_strategy_says_when_the_precise_one_finds_more(capsys: pytest.CaptureFixture[str]) -> None:
+    """At a C-Arm pose with a double root (two solutions merging), the paper's 10 mm sweep returns one; the output
+    says that the precise strategy finds two, in text and in JSON."""
+    q_double = np.array([300.0, 0.0, np.pi / 4, np.pi / 4, np.radians(2.0), 0.0])
+    T = load_robot("carm").fk(q_double)
+    m = [repr(float(v)) for v in T.ravel()]
+    precise = sweepik.solve(load_robot("carm"), T)
+    paper = sweepik.solve(load_robot("carm"), T, strategy="paper")
+    assert len(paper) < len(precise)  # (the premise)
+    code, out, _ = run(capsys, "solve", "--matrix", *m, "--strategy", "paper")
+    assert code == 0 and f"the precise strategy finds {len(precise)} solution(s)" in out
+    code, out, _ = run(capsys, "solve", "--matrix", *m, "--strategy", "paper", "--json")
+    assert json.loads(out)["poses"][0]["precise_strategy_finds"] == len(precise)
+    code, out, _ = run(capsys, "solve", "--matrix", *m)
+    assert "note:" not in out

@@ -278,8 +278,8 @@ def _main_script() -> str | None:
 def _unguarded_message(script: str) -> str:
     return (
         f"solve_dask starts its local Dask workers as new Python processes, and each of them re-runs your script "
-        f"{script!r} as it starts; its call to solve_dask outside `if __name__ == \"__main__\":` then starts more. "
-        "Put the script's work under `if __name__ == \"__main__\":`, or pass a running dask.distributed Client "
+        f'{script!r} as it starts; its call to solve_dask outside `if __name__ == "__main__":` then starts more. '
+        'Put the script\'s work under `if __name__ == "__main__":`, or pass a running dask.distributed Client '
         "(or a scheduler address) as client"
     )
 

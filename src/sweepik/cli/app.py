@@ -276,6 +276,35 @@ _COMMANDS: dict[str, tuple[_AddParser, _Run]] = {
 }
 
 
+#: Commands that run the compiled solver (their first run in a fresh install compiles its kernels).
+_SOLVING = {"solve", "path", "verify", "bench", "design", "view"}
+
+
+def _compile_notice(command: str) -> None:
+    """On a terminal, before a solving command's first run in a fresh install (no compiled kernel in Numba's cache
+    yet), say that the kernels are being compiled, once (a silent half minute looks like a hang)."""
+    if command not in _SOLVING or not sys.stderr.isatty() or _kernels_cached():
+        return
+    print(
+        f"{PROG}: compiling the solver's kernels for this machine (once: about 30 s, up to two minutes for an arm "
+        "without structure; later runs load them from Numba's cache)",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+def _kernels_cached() -> bool:
+    """Some compiled kernel of sweepik is in Numba's disk cache (``$NUMBA_CACHE_DIR``, the package's
+    ``__pycache__`` folders, or Numba's per-user folder when the package's is not writable)."""
+    from pathlib import Path
+
+    import sweepik
+
+    places = [Path(os.environ["NUMBA_CACHE_DIR"])] if os.environ.get("NUMBA_CACHE_DIR") else []
+    places += [Path(sweepik.__file__).parent, Path.home() / ".cache" / "numba"]
+    return any(next(p.rglob("*.nbi"), None) is not None for p in places if p.is_dir())
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse, but a usage error is one line (``sweepik: error: ...``, naming the command) and exit status 2."""
 
@@ -351,6 +380,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.verbose:
         logging.basicConfig(level=logging.INFO, format=f"{PROG}: %(message)s")
     _, run = _COMMANDS[args.command]
+    _compile_notice(args.command)
     try:
         return run(args)
     except SweepikError as exc:
