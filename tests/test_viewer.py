@@ -78,6 +78,48 @@ def test_viewer_gives_a_family_its_slider_and_refuses_bad_input() -> None:
         _viewer(carm, poses=np.ones((2, 4, 4)))
 
 
+def _primitives_urdf() -> str:
+    """A 6R arm whose first links carry primitive visuals (a box, a cylinder: no mesh files)."""
+    joints = [("0 0 0.1", "0 0 1"), ("0 0 0.2", "0 1 0"), ("0.3 0 0", "0 1 0"), ("0.25 0 0", "1 0 0"),
+              ("0 0 0", "0 1 0"), ("0.05 0 0", "1 0 0")]  # fmt: skip
+    links = ['<link name="base"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>',
+             '<link name="l1"><visual><origin xyz="0 0 0.1"/><geometry><cylinder radius="0.03" length="0.2"/>'
+             "</geometry></visual></link>",
+             '<link name="l2"><visual><origin xyz="0.15 0 0"/><geometry><box size="0.3 0.04 0.04"/></geometry>'
+             "</visual></link>",
+             *(f'<link name="l{k}"/>' for k in range(3, 7))]  # fmt: skip
+    body = [
+        f'<joint name="j{k + 1}" type="revolute"><parent link="{"base" if k == 0 else f"l{k}"}"/>'
+        f'<child link="l{k + 1}"/><origin xyz="{xyz}"/><axis xyz="{axis}"/>'
+        '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        for k, (xyz, axis) in enumerate(joints)
+    ]
+    return '<robot name="prim">' + "".join(links + body) + "</robot>"
+
+
+def test_a_urdf_with_visual_geometry_draws_the_chosen_solution_with_it(tmp_path: Path) -> None:
+    """The URDF's own visuals (here primitives, no mesh files) follow the chosen solution, joint by joint name; a
+    file without visuals leaves the skeleton alone and the panel says why."""
+    pytest.importorskip("yourdfpy")
+    path = tmp_path / "prim.urdf"
+    path.write_text(_primitives_urdf())
+    robot = sweepik.load_robot(path)
+    v = _viewer(robot, urdf=path)
+    try:
+        assert v.meshes is not None  # type: ignore[attr-defined]
+        sols = v.set_configuration([0.3, -0.4, 0.5, 0.2, 0.6, 0.1])  # type: ignore[attr-defined]
+        np.testing.assert_array_equal(v._mesh_cfg, sols.q[0])  # type: ignore[attr-defined]  # (joints j1..j6 in order)
+    finally:
+        v.close()  # type: ignore[attr-defined]
+    bare = tmp_path / "bare.urdf"
+    bare.write_text(sweepik.urdf_text(sweepik.load_robot("ur5")))
+    v = _viewer(sweepik.load_robot(bare), urdf=bare)
+    try:
+        assert v.meshes is None and "skeleton only" in v.mesh_note  # type: ignore[attr-defined]
+    finally:
+        v.close()  # type: ignore[attr-defined]
+
+
 def _screenshot(url: str, out: Path) -> None:
     profile = out.parent / "chromium-profile"
     cmd = [

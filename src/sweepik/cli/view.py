@@ -51,5 +51,6 @@ def cmd_view(args: argparse.Namespace) -> int:
         from sweepik.trajectory import load_poses
 
         poses = load_poses(args.poses)
-    view(robot, poses=poses, port=args.port, host=args.host, limits=not args.no_limits, locked=locked, block=True)
+    urdf = args.robot if args.robot.lower().endswith(".urdf") else None  # (its meshes, where they resolve)
+    view(robot, poses=poses, port=args.port, host=args.host, limits=not args.no_limits, locked=locked, urdf=urdf)
     return 0

@@ -11,6 +11,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -61,6 +62,7 @@ class Viewer:
         host: str = "127.0.0.1",
         limits: bool = True,
         locked: Mapping[Any, float] | None = None,
+        urdf: str | Path | None = None,
     ) -> None:
         if not isinstance(robot, Robot):
             raise UnknownOptionError(f"view takes a sweepik.Robot, got {type(robot).__name__}")
@@ -79,6 +81,7 @@ class Viewer:
         self.server = viser.ViserServer(host=host, port=port, verbose=False)
         self.url = f"http://{host}:{self.server.get_port()}"
         self._build_scene()
+        self.meshes = None if urdf is None else self._load_meshes(Path(urdf))
         self._build_gui()
         first = self.poses[0] if self.poses is not None else robot.fk(self._home())
         self.show(first)
@@ -105,11 +108,51 @@ class Viewer:
         camera.look_at = (0.0, 0.0, 0.2 * size)
         camera.up = (0.0, 0.0, 1.0)
 
+    def _load_meshes(self, path: Path) -> Any:
+        """The URDF's own meshes for the chosen solution (viser's ``ViserUrdf``, yourdfpy), when the file has visual
+        geometry that resolves and its root is the chain's base; else None (the skeleton alone, and the panel says
+        why)."""
+        self.mesh_note = ""
+        try:
+            import yourdfpy
+            from viser.extras import ViserUrdf
+        except ImportError:
+            self.mesh_note = "meshes: need yourdfpy (pip install yourdfpy)"
+            return None
+        try:
+            urdf = yourdfpy.URDF.load(str(path), build_scene_graph=True, load_meshes=True)
+        except Exception as exc:  # noqa: BLE001 - yourdfpy's and trimesh's errors on a file sweepik has read already
+            self.mesh_note = f"meshes: not loaded ({type(exc).__name__})"
+            return None
+        if not urdf.scene.geometry:
+            self.mesh_note = "meshes: none found in the file (or their files did not resolve): skeleton only"
+            return None
+        base = self.robot.description.rpartition("chain ")[2].partition(" -> ")[0]
+        if base != urdf.base_link:
+            self.mesh_note = "meshes: the chain does not start at the file's root link: skeleton only"
+            return None
+        names = list(urdf.actuated_joint_names)
+        self._mesh_index = [names.index(n) if n in names else -1 for n in self.robot.joint_names]
+        self._mesh_cfg = np.zeros(len(names))
+        return ViserUrdf(self.server, urdf, root_node_name="/meshes")
+
+    def _pose_meshes(self, q: Array) -> None:
+        """The URDF's meshes at ``q`` (joints of the file that are not on the chain stay at 0)."""
+        if self.meshes is None:
+            return
+        for k, i in enumerate(self._mesh_index):
+            if i >= 0:
+                self._mesh_cfg[i] = q[k]
+        self.meshes.update_cfg(self._mesh_cfg)
+
     def _build_gui(self) -> None:
         gui = self.server.gui
         info = analyze(self.robot, locked=self.locked)
         how = plan_line(info["chosen"]) if info.get("chosen") else str(info.get("reason"))
-        gui.add_markdown(f"**{self.robot.name}** · {info['structure']}  \ndecomposition: {how}")
+        note = getattr(self, "mesh_note", "")
+        gui.add_markdown(
+            f"**{self.robot.name}** · {info['structure']}  \ndecomposition: {how}" + (f"  \n{note}" if note else "")
+        )
         self.status = gui.add_markdown("")
         self.choice = gui.add_slider("chosen solution", min=1, max=2, step=1, initial_value=1)
         self.choice.on_update(lambda _: self._chosen(int(self.choice.value) - 1))
@@ -224,6 +267,8 @@ class Viewer:
             sols = self.solutions
             if sols is None:
                 return
+            if len(sols):
+                self._pose_meshes(sols.q[min(self.chosen, len(sols) - 1)])
             for k in range(len(sols)):
                 chosen = k == self.chosen
                 if chosen or self.ghosts.value:
@@ -288,13 +333,15 @@ def view(
     host: str = "127.0.0.1",
     limits: bool = True,
     locked: Mapping[Any, float] | None = None,
+    urdf: str | Path | None = None,
     block: bool = True,
 ) -> Viewer:
     """Open a browser viewer of ``robot`` at ``http://host:port`` (printed; ``port=0`` takes a free one): drag the
     target and every solution follows. ``solutions`` (from :func:`~sweepik.solve`): start at their pose; ``poses
     (N, 4, 4)``: a slider steps through them. ``limits`` and ``locked`` as for ``solve``. ``block``: serve until
-    Ctrl-C (False: return the running :class:`Viewer`, whose ``close()`` stops it). Needs the ``view`` extra."""
-    v = Viewer(robot, poses=poses, port=port, host=host, limits=limits, locked=locked)
+    Ctrl-C (False: return the running :class:`Viewer`, whose ``close()`` stops it). ``urdf``: the URDF file the
+    robot was read from, to draw the chosen solution with its meshes (when they resolve). Needs the ``view`` extra."""
+    v = Viewer(robot, poses=poses, port=port, host=host, limits=limits, locked=locked, urdf=urdf)
     if solutions is not None:
         v.show(solutions.pose)
     print(f"sweepik viewer of {robot.name}: {v.url}", flush=True)
