@@ -259,7 +259,7 @@ def test_cli_bad_values_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str
         (["sample", "carm", "-5", "--out", str(tmp_path / "q.npy")], "number of poses"),
         (["sample", "carm", "abc", "--out", str(tmp_path / "q.npy")], "number of poses"),
         (["sample", "carm", "5", "6", "--out", str(tmp_path / "q.npy")], "sample takes"),
-        (["sample", "carm", "5", "--out", str(tmp_path / "q.csv")], ".npy"),
+        (["sample", "carm", "5", "--out", str(tmp_path / "q.txt")], ".npy"),
         (["sample", "carm", "5", "--out", str(tmp_path / "q.npy"), "--q-out", str(tmp_path / "q.npy")], "same file"),
         (["sample", "carm", "5"], "--out"),
     ]

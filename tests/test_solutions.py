@@ -90,18 +90,16 @@ def test_family_member_at_an_angle_past_pi() -> None:
 
 
 def _brute_windings(robot: sweepik.Robot, q: np.ndarray) -> np.ndarray:
-    """Every configuration equal to ``q`` modulo 2 pi on the revolute joints and inside the limits, by trying
-    every combination of -2..2 turns (the arms tested turn at most +-360 degrees)."""
+    """Every configuration equal to ``q`` modulo 2 pi on the revolute joints and inside the limits: per joint, the
+    values ``q_j + 2 pi t`` (t from -2 to 2, the arms tested turn at most +-360 degrees) inside its limits, then
+    every combination of them."""
     import itertools
 
-    out = []
-    for turns in itertools.product(range(-2, 3), repeat=robot.n_joints):
-        c = q + 2 * np.pi * np.asarray(turns) * robot.is_revolute
-        if all(t == 0 or robot.is_revolute[j] for j, t in enumerate(turns)) and np.all(
-            (c >= robot.lower - 1e-9) & (c <= robot.upper + 1e-9)
-        ):
-            out.append(c)
-    return np.array(out)
+    per_joint = [
+        [v for t in (range(-2, 3) if rev else (0,)) if lo - 1e-9 <= (v := qj + 2 * np.pi * t) <= hi + 1e-9]
+        for qj, rev, lo, hi in zip(q, robot.is_revolute, robot.lower, robot.upper, strict=True)
+    ]
+    return np.array(list(itertools.product(*per_joint)))
 
 
 @pytest.mark.parametrize("name", ["ur5", "doosan_m0609", "kinova_jaco2", "xarm6"])

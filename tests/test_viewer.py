@@ -149,8 +149,8 @@ def _changed(a: Path, b: Path) -> int:
 )
 def test_the_page_renders_the_arm_in_a_real_browser(name: str, q: list[float], image: str, tmp_path: Path) -> None:
     """Headless Chromium loads the page three times: with every solution drawn, with the chosen one only, and with
-    no arm; the arm changes thousands of pixels against the empty scene, and the ghosts (the UR5's 7 other
-    solutions, the C-Arm's family member) thousands more."""
+    no arm; the arms change thousands of pixels against the empty scene, the chosen UR5 alone too, and the ghosts
+    (the UR5's 7 other solutions, the C-Arm's family members) thousands more."""
     robot = sweepik.load_robot(name)
     v = _viewer(robot)
     try:
@@ -166,8 +166,10 @@ def test_the_page_renders_the_arm_in_a_real_browser(name: str, q: list[float], i
         v.solutions = None  # type: ignore[attr-defined]
         v._draw()  # type: ignore[attr-defined]
         _screenshot(v.url, shots["none"])  # type: ignore[attr-defined]
-        assert _changed(shots["chosen"], shots["none"]) > 1500, "the chosen arm is not on the page"
-        assert _changed(shots["all"], shots["chosen"]) > 1500, "the other solutions are not on the page"
+        assert _changed(shots["all"], shots["none"]) > 3000, "no arm on the page"
+        if name == "ur5":  # (the C-Arm's pose has families only: nothing is left when they are hidden)
+            assert _changed(shots["chosen"], shots["none"]) > 1500, "the chosen arm is not on the page"
+        assert _changed(shots["all"], shots["chosen"]) > 1500, "the other solutions (or families) are not on the page"
         keep = os.environ.get("SWEEPIK_SCREENSHOTS")
         if keep:
             shutil.copy(shots["all"], Path(keep) / image)

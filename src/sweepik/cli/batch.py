@@ -146,7 +146,7 @@ def cmd_solve_store(args: argparse.Namespace, robot: Robot, ik_kwargs: dict[str,
         raise CliInputError("give --workers N (a local cluster) or --scheduler ADDRESS (an existing one), not both")
     _check_output_path(args.out, directory=True)
     poses = _store_poses(args)
-    from sweepik.distributed import _checked_options, run
+    from sweepik.distributed import _checked_options, close_local_cluster, run
     from sweepik.io.store import store_info
 
     options = _checked_options(robot, stored=True, n_samples=N_SAMPLES, **ik_kwargs)
@@ -175,6 +175,7 @@ def cmd_solve_store(args: argparse.Namespace, robot: Robot, ik_kwargs: dict[str,
         return EXIT_INTERRUPTED
     finally:
         progress.close()
+        close_local_cluster()  # (the command's own cluster: stopped before the interpreter winds down)
     t = summary.totals
     if args.json:
         _print_json(
