@@ -348,18 +348,14 @@ q = arm.lower + np.random.default_rng(1).random((40, 6)) * (arm.upper - arm.lowe
 
 
 @pytest.mark.parametrize("guarded", [False, True])
-def test_a_plain_script_gets_one_clear_error_or_works(guarded: bool, tmp_path: Path) -> None:
-    """A script calling ``solve_dask`` at its top level: the local workers re-run it as they start; the call fails
-    with one SweepikError saying to guard it (one traceback, the script's own, not one per worker). Guarded, the
-    same script solves."""
+def test_a_plain_script_works_guarded_or_not(guarded: bool, tmp_path: Path) -> None:
+    """A script calling ``solve_dask`` at its top level, without ``if __name__ == "__main__":``: the local cluster
+    runs in the script's own process, so nothing re-runs the script (with worker processes it failed with "Nanny
+    failed to start"); guarded, the same."""
     call = "batch = sweepik.solve_dask(arm, arm.fk(q), n_workers=2)\nprint('solved', len(batch))"
     body = call if not guarded else "if __name__ == '__main__':\n    " + call.replace("\n", "\n    ")
     script = tmp_path / "script.py"
     script.write_text(SCRIPT.format(body=body))
     proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=WAIT_S, cwd=tmp_path)
-    if guarded:
-        assert proc.returncode == 0 and "solved 40" in proc.stdout, proc.stderr[-2000:]
-    else:
-        assert proc.returncode != 0
-        assert proc.stderr.count("Traceback") == 1, proc.stderr[-3000:]
-        assert 'if __name__ == "__main__":' in proc.stderr.splitlines()[-1]
+    assert proc.returncode == 0 and "solved 40" in proc.stdout, proc.stderr[-2000:]
+    assert "Traceback" not in proc.stderr

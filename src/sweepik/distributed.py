@@ -264,56 +264,22 @@ def close_local_cluster() -> None:
             cluster.close()
 
 
-def _main_script() -> str | None:
-    """The file this process runs as a script (``python x.py``), None in an interpreter, a notebook or ``-m``."""
-    import sys
-
-    main = sys.modules.get("__main__")
-    if main is None or getattr(main, "__spec__", None) is not None:
-        return None
-    path = getattr(main, "__file__", None)
-    return str(path) if path else None
-
-
-def _unguarded_message(script: str) -> str:
-    return (
-        f"solve_dask starts its local Dask workers as new Python processes, and each of them re-runs your script "
-        f'{script!r} as it starts; its call to solve_dask outside `if __name__ == "__main__":` then starts more. '
-        'Put the script\'s work under `if __name__ == "__main__":`, or pass a running dask.distributed Client '
-        "(or a scheduler address) as client"
-    )
-
-
 def _local_client(distributed: Any, n: int) -> Any:
-    """A client of the local cluster of ``n`` worker processes (one thread each): the one kept from an earlier call
-    when it has ``n`` workers and still runs, else a new one (the old one closed), kept for later calls."""
+    """A client of the local cluster: one worker with ``n`` threads in this process (the compiled kernels release
+    the GIL, so threads solve chunks side by side as ``solve_many``'s do; no worker process to start, no re-import
+    of the caller's script, no copy of poses and results between processes). The one kept from an earlier call when
+    it has ``n`` threads and still runs, else a new one (the old one closed), kept for later calls."""
     import atexit
-    import multiprocessing
 
-    if getattr(multiprocessing.current_process(), "_inheriting", False):
-        # a new worker process re-running the caller's unguarded script while it starts (multiprocessing's
-        # bootstrapping phase): it stops here, quietly; the caller, whose cluster then fails to start, says why
-        raise SystemExit(3)
     if _LOCAL and _LOCAL[0][0] == n and _LOCAL[0][2].status == "running":
         return _LOCAL[0][2]
     close_local_cluster()
-    import dask
-
-    # Dask's nannies set MALLOC_TRIM_THRESHOLD_ in the workers' environment (to hand freed memory back to the
-    # system). Setting it turns off glibc's adaptive mmap threshold: every large temporary array of the solver
-    # is then mapped, zero-filled and unmapped again, ~10 % of a chunk's time. A worker here holds a bounded
-    # number of chunks, so glibc's own policy is kept (a variable set in this process's environment still
-    # passes through, as Dask does).
     try:
-        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-            cluster = distributed.LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.CRITICAL
-            )
+        cluster = distributed.LocalCluster(
+            n_workers=1, threads_per_worker=n, processes=False, dashboard_address=":0", silence_logs=logging.CRITICAL
+        )
     except (RuntimeError, OSError) as exc:
-        script = _main_script()
-        if script is not None:
-            raise SweepikError(_unguarded_message(script) + f" (Dask: {exc})") from None
-        raise SweepikError(f"could not start a local Dask cluster of {n} workers: {exc}") from None
+        raise SweepikError(f"could not start a local Dask cluster of {n} threads: {exc}") from None
     c = distributed.Client(cluster)
     if not _LOCAL:
         atexit.register(close_local_cluster)
@@ -324,7 +290,7 @@ def _local_client(distributed: Any, n: int) -> Any:
 @contextlib.contextmanager
 def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
     """The client to use: ``client`` itself; a new one for a scheduler address (closed on exit); the kept local
-    cluster's (processes, one thread each) when None."""
+    cluster's (threads in this process) when None."""
     distributed = _check_client(client, n_workers)
     if client is None:
         yield _local_client(distributed, _local_threads(None, n_workers))
@@ -587,11 +553,9 @@ def solve_dask(
         robot: the arm (travels to the workers by value).
         poses: a NumPy array (or ``np.memmap``), the path of a ``.npy`` file (memory-mapped: the client reads one
             chunk at a time), or a Dask array ``(N, 4, 4)`` (each worker computes the chunks it solves).
-        client: None: a local cluster on this machine (``n_workers`` processes, default one per core, one thread
-            each), started by the first such call and kept for the next ones in this process (starting one costs
-            seconds; :func:`close_local_cluster` stops it, the process's exit too); a script that makes this call
-            must do so under ``if __name__ == "__main__":`` (the workers re-run the script as they start:
-            SweepikError saying so otherwise); a ``dask.distributed.Client``; or a scheduler address
+        client: None: a local cluster in this process (one worker of ``n_workers`` threads, default one per
+            core), started by the first such call and kept for the next ones (:func:`close_local_cluster` stops
+            it, the process's exit too); a ``dask.distributed.Client``; or a scheduler address
             (``"tcp://host:8786"``). The workers need sweepik (and its version) installed.
         out: a directory to write the store to (Zarr, see :mod:`sweepik.io.store`), chunk by chunk as chunks finish,
             marked complete at the end; :func:`~sweepik.io.store.load_solutions` reads it back. It must not exist,
@@ -602,7 +566,7 @@ def solve_dask(
         resume: continue the store at ``out``: only the chunks it lacks are solved (StoreError if it was written
             for other poses, another robot or other options).
         progress: ``progress("solve", done, total)`` (poses) after each chunk.
-        n_workers: processes of the local cluster (only when ``client`` is None).
+        n_workers: threads of the local cluster (only when ``client`` is None; default one per core).
         reduction, free_joint, strategy, limits, n_samples, locked: as :func:`~sweepik.solve_many` (with ``out``,
             ``reduction`` must be a name or None).
 

@@ -58,7 +58,7 @@ def add_store_options(p: argparse.ArgumentParser) -> None:
         "--workers",
         type=_count(1, 4096),
         metavar="N",
-        help="start a local Dask cluster of N worker processes, one thread each (default: one per core)",
+        help="start a local Dask cluster in this process, one worker of N threads (default: one per core)",
     )
     g.add_argument("--scheduler", metavar="ADDRESS", help="use the Dask cluster at ADDRESS (e.g. tcp://host:8786)")
     g.add_argument("--resume", action="store_true", help="continue the interrupted run that wrote STORE")

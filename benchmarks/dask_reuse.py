@@ -1,6 +1,6 @@
 """Throughput of ``solve_dask`` with its kept local cluster against ``solve_many`` (issue 38).
 
-    python scripts/dask_throughput.py [--n 200000] [--robot carm]
+    python benchmarks/dask_reuse.py [--n 200000] [--robot carm]
 
 Poses: ``--n`` random in-limit configurations' poses. Times, in one process: ``solve_many`` (after a warm-up
 solve), then two ``solve_dask`` calls on the same poses (``client=None``: the first starts the local cluster, the
