@@ -175,3 +175,21 @@ def test_the_page_renders_the_arm_in_a_real_browser(name: str, q: list[float], i
             shutil.copy(shots["all"], Path(keep) / image)
     finally:
         v.close()  # type: ignore[attr-defined]
+
+
+def test_view_from_python_and_the_cli_refusals(capsys: pytest.CaptureFixture[str]) -> None:
+    pytest.importorskip("viser")
+    from sweepik.cli.app import main
+
+    robot = sweepik.load_robot("ur5")
+    sols = sweepik.solve(robot, robot.fk([0.3, -1.0, 1.2, -0.4, 0.9, 0.2]))
+    v = sweepik.view(robot, sols, port=0, block=False)
+    try:
+        assert v.url.startswith("http://127.0.0.1:") and len(v.solutions) == len(sols)
+        np.testing.assert_array_equal(v.solutions.pose, sols.pose)
+    finally:
+        v.close()
+    assert "sweepik viewer of ur5: http://127.0.0.1:" in capsys.readouterr().out
+    assert main(["view", "franka_panda", "--port", "0"]) == 2
+    assert "--lock NAME=VALUE" in capsys.readouterr().err
+    assert main(["view", "ur5", "--port", "70000"]) == 2

@@ -29,7 +29,7 @@ import time
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -293,7 +293,7 @@ def _connected(client: Any, n_workers: int | None) -> Iterator[Any]:
     cluster's (threads in this process) when None."""
     distributed = _check_client(client, n_workers)
     if client is None:
-        yield _local_client(distributed, _local_threads(None, n_workers))
+        yield _local_client(distributed, cast(int, _local_threads(None, n_workers)))
     elif isinstance(client, str):
         with _client_at(distributed, client) as c:
             yield c

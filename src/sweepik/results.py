@@ -17,7 +17,7 @@ import operator
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, overload
+from typing import TYPE_CHECKING, Any, cast, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -228,7 +228,7 @@ class Solutions:
     reason: str | None
     pose: Array
     robot: Robot = field(repr=False)
-    winding_of: NDArray[np.intp] = field(default=None, repr=False)  # type: ignore[assignment]
+    winding_of: NDArray[np.intp] = field(default=cast("NDArray[np.intp]", None), repr=False)  # (None: own rows)
     wound: bool = field(default=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -309,7 +309,7 @@ class Solutions:
         column taken alike; ``winding_of`` renumbered (a row whose base is not kept becomes its own base);
         ``changes``: other fields to replace (as ``dataclasses.replace``)."""
         index = np.nonzero(rows)[0] if np.asarray(rows).dtype == np.bool_ else np.asarray(rows, dtype=np.intp)
-        fields: dict[str, object] = {
+        fields: dict[str, Any] = {
             "q": self.q[index],
             "error": self.error[index],
             "error_geodesic": self.error_geodesic[index],
@@ -317,7 +317,7 @@ class Solutions:
             "multiplicity": self.multiplicity[index],
             "winding_of": _renumbered(self.winding_of, index),
         }
-        return dataclasses.replace(self, **{**fields, **changes})
+        return dataclasses.replace(self, **cast(dict[str, Any], {**fields, **changes}))
 
     def __repr__(self) -> str:
         parts = [f"{len(self)} solution(s)"]
@@ -406,7 +406,7 @@ class Block:
             reason=self.reason(i),
             pose=take(self.poses[i]),
             robot=self.robot,
-            winding_of=None if self.winding_of is None else take(self.winding_of[s:e]),
+            winding_of=cast("NDArray[np.intp]", None if self.winding_of is None else take(self.winding_of[s:e])),
             wound=self.winding_of is not None,
         )
 

@@ -133,7 +133,7 @@ def _choice_tol(args: argparse.Namespace) -> float | None:
     """``--tol`` in radians (the metric's unit), checked."""
     if args.tol is None:
         return None
-    tol = check_tolerance(args.tol, "--tol")
+    tol = float(check_tolerance(args.tol, "--tol") or 0.0)
     return tol if args.rad else float(np.radians(tol))
 
 

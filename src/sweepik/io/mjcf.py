@@ -185,7 +185,7 @@ def _chain_robot(model: Any, chain: list[int], tip_T: Array, source: str, span: 
                         upper=hi,
                         name=names[j] or f"joint{j}",
                         origin=tuple(tuple(float(v) for v in row) for row in T),
-                        axis=tuple(float(v) for v in model.jnt_axis[j]),
+                        axis=(float(model.jnt_axis[j][0]), float(model.jnt_axis[j][1]), float(model.jnt_axis[j][2])),
                     )
                 )
             except RobotDefinitionError as exc:

@@ -162,7 +162,7 @@ class Viewer:
         self.limits_box.on_update(lambda _: self._set_limits(bool(self.limits_box.value)))
         if self.poses is not None and len(self.poses) > 1:
             step = gui.add_slider("pose", min=1, max=len(self.poses), step=1, initial_value=1)
-            step.on_update(lambda _: self.show(self.poses[int(step.value) - 1]))  # type: ignore[index]
+            step.on_update(lambda _: self.show(self.poses[int(step.value) - 1]))
         self.families_folder = gui.add_folder("self-motion families")
         with gui.add_folder("joints (forward kinematics)", expand_by_default=False):
             self.joint_sliders = [self._joint_slider(k) for k in range(self.robot.n_joints)]
