@@ -108,11 +108,11 @@ _GOLDEN_ITERS = 60
 
 
 def _nearest_on_family(robot: Robot, fam: Family, ref: Array, metric: DistanceFunction) -> tuple[Array, float]:
-    # (families are not wound: their members are compared modulo 2 pi)
-    """Member of ``fam`` nearest ``ref`` by ``metric``: dense sampling, then a golden-section search around
-    each local minimum of the samples (``_NEAREST_MINIMA`` at most, the lowest first), the best kept. Every local
-    minimum, not only the lowest sample: the nearest member can lie next to another sample of the same distance,
-    e.g. across the seam of a family that turns theta* through a whole circle (both ends are the same member)."""
+    """Member of ``fam`` nearest ``ref`` by ``metric`` (modulo 2 pi: families are not wound): dense sampling, then a
+    golden-section search around each local minimum of the samples (``_NEAREST_MINIMA`` at most, the lowest first),
+    the best kept. Every local minimum, not only the lowest sample: the nearest member can lie next to another sample
+    of the same distance, e.g. across the seam of a family that turns theta* through a whole circle (both ends are
+    the same member)."""
     lo, hi = fam.interval
     grid = np.linspace(lo, hi, _FAMILY_SAMPLES)
     members = fam.at(grid)

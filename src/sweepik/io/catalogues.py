@@ -5,7 +5,8 @@
   and where in it the URDF or MJCF file lies. Importing that module clones the repository when it is not in
   robot_descriptions' cache (``~/.cache/robot_descriptions``, or ``$ROBOT_DESCRIPTIONS_CACHE``); sweepik never
   downloads: it reads the module's paths without running it and opens the file in the cache, or says that the name
-  needs a download and how to get it. Descriptions given only as xacro are refused (expand them with xacro first).
+  needs a download and how to get it. A description given only as xacro is rendered to URDF by robot_descriptions
+  itself (with ``xacrodoc``, into its cache), once its repository is cached.
 * **example-robot-data** (``load_robot("example-robot-data:ur5")``, or a bare name that no bundled arm has, such as
   ``"panda"`` or ``"z1"``): the URDFs of the installed ``example-robot-data`` wheel (its ``share`` folder), or of
   ``$EXAMPLE_ROBOT_DATA_MODEL_DIR``; names as its loaders use them.
@@ -29,8 +30,8 @@ ERD_PREFIX = "example-robot-data:"
 
 @dataclass(frozen=True)
 class CatalogueEntry:
-    """Where a catalogue keeps an arm: its file, its format (``"urdf"`` or ``"mjcf"``) and the chain's default
-    tip link (None: the file's own default), for the message of a name that is missing its file too."""
+    """Where a catalogue keeps an arm: its file, its format (``"urdf"`` or ``"mjcf"``), the chain's default tip
+    link (None: the file's own default) and which catalogue and folder it comes from (for messages)."""
 
     path: Path
     format: str
