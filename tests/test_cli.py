@@ -337,6 +337,8 @@ def test_robots_shows_origin_axis_joints_and_the_lock_table(capsys: pytest.Captu
     assert code == 0 and "origin + axis joints" in out and "origin xyz [m]" in out and "axis" in out
     code, out, _ = run(capsys, "robots", "franka_panda")
     assert code == 0 and "lock a joint first" in out and "lock joint" in out and "closed form" in out
+    row = next(ln for ln in out.splitlines() if ln.strip().startswith("2 (joint2)  0 deg"))
+    assert row.rstrip().endswith("none: every pose a continuum")  # joints 1 and 3 coaxial when joint 2 is 0
 
 
 def test_first_run_says_it_compiles_on_a_terminal_only(

@@ -433,7 +433,7 @@ def run(
 
 
 def _local_threads(client: Any, n_workers: int | None) -> int | None:
-    """Worker threads of the local cluster ``_connected`` starts for ``client`` None (one per process), else None
+    """Worker threads of the local cluster ``_connected`` starts for ``client`` None (its one worker's), else None
     (an existing cluster's are known once connected)."""
     if client is not None:
         return None

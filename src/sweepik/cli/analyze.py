@@ -39,6 +39,13 @@ def add_analyze_parser(sub: _SubParsers) -> None:
     _add_json(p)
 
 
+def _no_plan(reason: str | None) -> str:
+    """The decomposition column of a lock that leaves nothing to solve: why, in a few words."""
+    if reason and "every pose is a continuum" in reason:
+        return "none: every pose a continuum"
+    return "none in the catalogue"
+
+
 def print_locks(robot: Any, locks: list[dict[str, Any]]) -> None:
     """The table of a 7-joint arm: for each joint, what locking it (at 0 and at a generic value) leaves."""
     print(f"{robot.n_joints} joints: solve with one locked (--lock NAME=VALUE); what each lock leaves:")
@@ -54,7 +61,7 @@ def print_locks(robot: Any, locks: list[dict[str, Any]]) -> None:
                     f"{lock['joint_number']} ({lock['joint_name']})",
                     f"{value:.4g} {unit}",
                     v["structure"],
-                    plan_line(chosen) if chosen else "none in the catalogue",
+                    plan_line(chosen) if chosen else _no_plan(v["reason"]),
                 ]
             )
     print(_format_table(["lock joint", "at", "structure of the other six", "decomposition"], rows))
