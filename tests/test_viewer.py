@@ -193,3 +193,21 @@ def test_view_from_python_and_the_cli_refusals(capsys: pytest.CaptureFixture[str
     assert main(["view", "franka_panda", "--port", "0"]) == 2
     assert "--lock NAME=VALUE" in capsys.readouterr().err
     assert main(["view", "ur5", "--port", "70000"]) == 2
+
+
+def test_a_viewer_that_cannot_start_leaves_no_server_running() -> None:
+    """A 7-joint arm without a lock cannot be solved: the viewer raises, and its port is free again."""
+    pytest.importorskip("viser")
+    import socket
+
+    from sweepik.viewer.app import Viewer
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with pytest.raises(sweepik.SweepikError):
+        Viewer(sweepik.load_robot("franka_panda"), port=port)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", port))  # (free: the server was stopped)
+    v = Viewer(sweepik.load_robot("franka_panda"), port=port, locked={"joint7": 0.3})
+    v.close()

@@ -80,11 +80,18 @@ class Viewer:
         viser = _viser()
         self.server = viser.ViserServer(host=host, port=port, verbose=False)
         self.url = f"http://{host}:{self.server.get_port()}"
-        self._build_scene()
-        self.meshes = None if urdf is None else self._load_meshes(Path(urdf))
-        self._build_gui()
-        first = self.poses[0] if self.poses is not None else robot.fk(self._home())
-        self.show(first)
+        try:
+            self._build_scene()
+            self.meshes = None if urdf is None else self._load_meshes(Path(urdf))
+            self._build_gui()
+        except BaseException:
+            self.close()
+            raise
+        try:
+            self.show(self.poses[0] if self.poses is not None else robot.fk(self._home()))
+        except BaseException:  # (e.g. a 7-joint arm without a lock: the server is not left running)
+            self.close()
+            raise
 
     # ------------------------------------------------------------------ set-up
 
