@@ -383,6 +383,12 @@ class Block:
     def n(self) -> int:
         return int(self.poses.shape[0])
 
+    @property
+    def row_in_pose(self) -> NDArray[np.intp]:
+        """``(K,)`` each row's index among its pose's rows (what ``winding_of`` is without windings)."""
+        counts = np.diff(self.bounds)
+        return (np.arange(self.q.shape[0]) - np.repeat(self.bounds[:-1], counts)).astype(np.intp)
+
     def reason(self, i: int) -> str | None:
         """Why pose ``i`` has no solution (None when it has some, or a family)."""
         if self.bounds[i + 1] > self.bounds[i] or self.families.get(i):
@@ -528,11 +534,7 @@ class SolutionBatch(Sequence[Solutions]):
     @cached_property
     def winding_of(self) -> NDArray[np.intp]:
         """``(K,)`` as :attr:`Solutions.winding_of`: the row, among its pose's rows, that each row winds."""
-        parts = [
-            np.arange(b.q.shape[0]) - np.repeat(b.bounds[:-1], np.diff(b.bounds)) if b.winding_of is None
-            else b.winding_of
-            for b in self._blocks
-        ]  # fmt: skip
+        parts = [b.row_in_pose if b.winding_of is None else b.winding_of for b in self._blocks]
         return np.concatenate(parts).astype(np.intp) if parts else np.zeros(0, dtype=np.intp)
 
     @cached_property

@@ -54,12 +54,10 @@ def winding_rows(robot: Robot, q: Array, joints: NDArray[np.bool_] | None = None
 def wound_block(block: Block, joints: NDArray[np.bool_] | None = None) -> Block:
     """``block`` with the windings of every solution (``winding_rows``) after the base rows of its pose."""
     base, extra = winding_rows(block.robot, block.q, joints)
+    local = block.row_in_pose
     if base.size == 0:
-        local = np.arange(block.q.shape[0]) - np.repeat(block.bounds[:-1], np.diff(block.bounds))
-        return dataclasses.replace(block, winding_of=local.astype(np.intp))
-    counts = np.diff(block.bounds)
-    pose_of_row = np.repeat(np.arange(block.n), counts)
-    local = np.arange(block.q.shape[0]) - block.bounds[pose_of_row]
+        return dataclasses.replace(block, winding_of=local)
+    pose_of_row = np.repeat(np.arange(block.n), np.diff(block.bounds))
     pose = np.concatenate([pose_of_row, pose_of_row[base]])
     order = np.argsort(2 * pose + np.concatenate([np.zeros(pose_of_row.size), np.ones(base.size)]), kind="stable")
     take = np.concatenate([np.arange(block.q.shape[0]), base])[order]
