@@ -255,7 +255,6 @@ class Viewer:
         self._family_sliders = []
         with self.families_folder:
             for k, fam in enumerate(sols.families):
-                lo, hi = fam.interval
                 slider = self.server.gui.add_slider(
                     f"family {k + 1}: {self.robot.joint_names[fam.free_joint]}",
                     min=0.0,
