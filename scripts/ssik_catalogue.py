@@ -5,10 +5,10 @@ per-joint constants (``T_left[i] @ Rot(axis_i, q_i) @ T_right[i]``), lengths in 
 artifact's ``fk``. For every six-joint arm: random configurations (uniform over [-pi, pi)) and configurations on
 singular sets (``tests/singular.py``), limits off; each pose solved once by ``sweepik.solve`` must give back the
 generating configuration (recall, ``singular.recovered``) and every solution must reproduce the pose (wrong); "slow"
-counts solves over ``--slow`` seconds, first solves included (an arm's kernels load on its first poses). (Set agreement
-with ssik's own solver is ``tests/test_any_arm.py``'s, on the bundled arms.)
+counts solves over ``--slow`` seconds, first solves included (an arm's kernels load on its first poses).
+``--agreement``: the solution sets compared with ssik's own solver's (:class:`Agreement`).
 
-    python scripts/ssik_catalogue.py [--n 50] [--singular 0] [--arms ur5_ik ...] [--rewrite] [--seed 0]
+    python scripts/ssik_catalogue.py [--n 50] [--singular 0] [--arms ur5_ik ...] [--rewrite] [--seed 0] [--agreement]
 
 ``--rewrite`` rewrites each arm at random first (axis reversals, zero offsets, base/tool transforms, millimetres):
 the recall must not change.
@@ -73,6 +73,52 @@ def check_fk(robot: Robot, name: str, rng: np.random.Generator) -> float:
     return max(float(np.abs(robot.fk(q) - m.fk(q)).max()) for q in Q)
 
 
+class Agreement:
+    """Set agreement with ssik's own solver (``--agreement``): per pose without a continuum, sweepik's solution set
+    and ssik's (``solve(T, respect_limits=False, enumerate_windings=False)``) compared by
+    ``oracles.unmatched_solutions``; every difference told apart by a tight FK check (1e-9 of the arm's size): a
+    solution only ssik has that passes it is a miss of sweepik's, one that fails it is ssik's error, and one only
+    sweepik has (each passed sweepik's certification) a miss of ssik's. Poses with a continuum are counted apart."""
+
+    def __init__(self) -> None:
+        self.same = self.poses = self.continua = 0
+        self.ssik_only_ok = self.ssik_only_bad = self.ours_only = 0
+
+    def add(self, name: str, robot: Robot, solver_robot: Robot, q: np.ndarray, sols, rw) -> None:  # type: ignore[no-untyped-def]
+        from oracles import unmatched_solutions
+
+        if sols.families:
+            self.continua += 1
+            return
+        m = ssik_module(name)
+        theirs = [x.q for x in m.solve(robot.fk(q), respect_limits=False, enumerate_windings=False)]
+        ref = np.array(theirs, dtype=np.float64).reshape(-1, robot.n_joints)
+        if rw is not None:
+            ref = rw.forward(ref)
+        extra_ours, extra_theirs = unmatched_solutions(sols.q, sols.multiplicity, ref, solver_robot)
+        self.poses += 1
+        self.same += not (extra_ours or extra_theirs)
+        self.ours_only += len(extra_ours)
+        T = solver_robot.fk(rw.forward(q[None])[0] if rw is not None else q)
+        for x in extra_theirs:
+            err = float(np.max(np.abs(solver_robot.fk(x) - T)))
+            ok = err <= 1e-9 * solver_robot.length_scale
+            self.ssik_only_ok += ok
+            self.ssik_only_bad += not ok
+
+    def merge(self, other: Agreement) -> None:
+        for k, v in vars(other).items():
+            setattr(self, k, getattr(self, k) + v)
+
+    def line(self) -> str:
+        if not (self.poses or self.continua):
+            return ""
+        return (
+            f"  same sets {self.same}/{self.poses} (continua {self.continua}); only ssik: {self.ssik_only_ok} pass FK, "
+            f"{self.ssik_only_bad} fail; only sweepik {self.ours_only}"
+        )
+
+
 def main() -> None:
     import ssik
 
@@ -83,9 +129,11 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--singular", type=int, default=0, help="configurations on (and near) the singular set per arm")
     ap.add_argument("--slow", type=float, default=0.05, help="report solves slower than this (s)")
+    ap.add_argument("--agreement", action="store_true", help="compare each solution set with ssik's own solve")
     args = ap.parse_args()
     names = args.arms or [a.name for a in ssik.list_arms() if a.dof == 6]
     total = total_rec = 0
+    overall = Agreement()
     for name in names:
         rng = np.random.default_rng(args.seed)
         robot = robot_from_ssik(name)
@@ -106,6 +154,7 @@ def main() -> None:
         T = solver_robot.fk(Qs)
         rec = wrong = slow = 0
         misses = []
+        agree = Agreement()
         t0 = time.perf_counter()
         for i, (t, q) in enumerate(zip(T, Qs, strict=True)):
             t1 = time.perf_counter()
@@ -122,15 +171,18 @@ def main() -> None:
                 misses.append(i)
             if len(s):
                 wrong += int((s.error_geodesic > 1e-9 * solver_robot.length_scale).sum())
+            if args.agreement:
+                agree.add(name, robot, solver_robot, Q[i], s, rw if args.rewrite else None)
         dt = time.perf_counter() - t0
         total += len(Q)
         total_rec += rec
         print(
             f"{name:24s} fk {fk_err:.1e}  recall {rec:3d}/{len(Q)}  wrong {wrong}  slow {slow}  "
-            f"{dt / len(Q) * 1e3:6.2f} ms/pose  {str(plan)[:70]}  misses {misses[:6]}",
+            f"{dt / len(Q) * 1e3:6.2f} ms/pose  {str(plan)[:70]}  misses {misses[:6]}{agree.line()}",
             flush=True,
         )
-    print(f"total recall {total_rec}/{total} ({100 * total_rec / max(total, 1):.2f} %)")
+        overall.merge(agree)
+    print(f"total recall {total_rec}/{total} ({100 * total_rec / max(total, 1):.2f} %){overall.line()}")
 
 
 if __name__ == "__main__":

@@ -6,8 +6,9 @@ their singular set in its generic part and, by the joint chosen, in every compon
 
 ``recovered``: a configuration is recovered by a solve when a solution (or a family member) lies within ``tol`` of it,
 or when the straight segment between them solves the pose (its midpoint and quarter points within the certification
-tolerance): the two are then the same root to the precision the pose fixes it (a double root is fixed only to about
-the square root of the rounding, and near a continuum less).
+tolerance), or, within 1e-3, a short arc of solutions joins them (``_on_one_arc``): the two are then the same root to
+the precision the pose fixes it (a double root is fixed only to about the square root of the rounding, and near a
+continuum less).
 """
 
 from __future__ import annotations
@@ -22,6 +23,15 @@ OFFSETS = (0.0, 0.0, 1e-9, 1e-7, 1e-5, 1e-4, 1e-3)
 #: The certification's tolerance on the geodesic pose error, relative to the length scale (``settings.ACCEPT_TOL_REL``
 #: with the margin the solver's polish leaves).
 SAME_ROOT_REL = 1e-12
+#: Farthest apart (radians, or times the length scale) that two configurations joined by an arc of solutions
+#: (``_on_one_arc``) count as one root: the close roots of issue 35 lie 1e-5 ... 1e-3 apart.
+ARC_REACH = 1e-3
+#: Points of the segment corrected onto the arc.
+ARC_POINTS = 9
+#: ... each solving the pose no worse than twice the worse end, or than this (relative to the length scale: rounding
+#: of the forward kinematics; the solver's ``settings.MEET_ROUNDING_REL``): a valley rising above that between two
+#: points (a PUMA 560 1e-7 rad short of its elbow fold: 6e-15 between two roots of 1e-16) makes them two roots.
+ARC_ROUNDING_REL = 1e-15
 
 
 def _range(robot: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -75,7 +85,31 @@ def recovered(robot: Any, sols: Any, q: np.ndarray, tol: float = 1e-6) -> bool:
     T = robot.fk(q)
     s = q + np.where(robot.is_revolute, np.angle(np.exp(1j * (s - q))), s - q)  # (the same winding as q)
     between = q[None] + np.array([0.25, 0.5, 0.75])[:, None] * (s - q)[None]
-    return bool(np.all(_geodesic(robot, between, T) <= SAME_ROOT_REL * robot.length_scale))
+    if np.all(_geodesic(robot, between, T) <= SAME_ROOT_REL * robot.length_scale):
+        return True
+    return bool(np.max(np.abs(d)) <= ARC_REACH and _on_one_arc(robot, q, s, T))
+
+
+def _on_one_arc(robot: Any, q: np.ndarray, s: np.ndarray, T: np.ndarray) -> bool:
+    """``q`` and ``s`` lie on one arc of configurations that all solve ``T``: points of the segment between them, each
+    corrected by Newton steps with the joint that moves most between them held, solve the pose as well as ``q`` and
+    ``s`` do (``ARC_ROUNDING_REL``) and move off the segment by a small part of its length. (Where the solution set
+    is a short curved valley at rounding level, an I2RT YAM pose on its singular set, two points 4e-5 rad apart both
+    solve the pose to 1e-15, the straight segment between them misses it by 1e-11, and the corrected one by 6e-16
+    everywhere: the pose fixes the configuration only to that arc, and either end is it.)"""
+    from sweepik.engine.polish import polished
+    from sweepik.model.units import orientation_weight
+
+    d = s - q
+    held = np.zeros((ARC_POINTS, robot.n_joints), dtype=bool)
+    held[:, int(np.argmax(np.abs(d) / np.where(robot.is_revolute, 1.0, robot.length_scale)))] = True
+    t = np.linspace(0.0, 1.0, ARC_POINTS + 2)[1:-1]
+    start = q[None] + t[:, None] * d[None]
+    weight = orientation_weight(robot.length_unit)
+    moved, err = polished(robot, start, np.broadcast_to(T, (ARC_POINTS, 4, 4)).copy(), weight, 20, fixed=held)
+    off = np.max(np.abs(moved - start)) <= 0.1 * np.max(np.abs(d))
+    ends = float(np.max(_geodesic(robot, np.stack([q, s]), T)))
+    return bool(off and np.all(err <= max(2.0 * ends, ARC_ROUNDING_REL * robot.length_scale)))
 
 
 def _geodesic(robot: Any, Q: np.ndarray, T: np.ndarray) -> np.ndarray:

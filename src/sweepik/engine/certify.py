@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik._jit import alive, inlined, unowned, writable
-from sweepik.engine import parallel
+from sweepik.engine import jacobi, parallel
 from sweepik.engine.dedupe import limit_args
 from sweepik.engine.search import AVAILABLE, PARALLEL_MIN
 from sweepik.engine.settings import J_CUTOFF_FACTOR, PINV_WIDEN
@@ -559,6 +559,72 @@ if AVAILABLE:
                 J[0, i], J[1, i], J[2, i] = zx, zy, zz
                 J[3, i], J[4, i], J[5, i] = 0.0, 0.0, 0.0
 
+    @inlined
+    def polish_row(H, P, rev, R_end, qk, Td, weight, held, iterations, backtrack, rcond, floor, work):
+        """``polish.polish`` of one configuration ``qk (n,)`` in place towards the pose ``Td (4, 4)``: its geodesic
+        error after. Damped Newton steps on the full pose (pseudo-inverse of the Jacobian, singular values below
+        ``rcond`` of the largest dropped; the joints where ``held (n,)`` is True held), a step kept only if it lowers
+        the error, else halved up to ``backtrack`` times, then tried with more small directions dropped
+        (``PINV_WIDEN``); it stops when no step improves it or (after one step) its error is at most ``floor``.
+        ``work``: :func:`polish_work`'s arrays."""
+        z, o, J, e, trial, B, V, step = work
+        n = H.shape[0]
+        cur = _geodesic(_poe_fk(H, P, rev, R_end, qk), Td, weight)[0]
+        for _ in range(iterations):
+            Tk = _poe_fk(H, P, rev, R_end, qk)
+            _jacobian(H, P, rev, qk, Tk, J, z, o)
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = Tk
+            e[0], e[1], e[2] = Td[0, 3] - px, Td[1, 3] - py, Td[2, 3] - pz
+            # dR = Rd R^T; its skew part, halved, scaled by the orientation weight
+            d21 = Td[2, 0] * r10 + Td[2, 1] * r11 + Td[2, 2] * r12
+            d12 = Td[1, 0] * r20 + Td[1, 1] * r21 + Td[1, 2] * r22
+            d02 = Td[0, 0] * r20 + Td[0, 1] * r21 + Td[0, 2] * r22
+            d20 = Td[2, 0] * r00 + Td[2, 1] * r01 + Td[2, 2] * r02
+            d10 = Td[1, 0] * r00 + Td[1, 1] * r01 + Td[1, 2] * r02
+            d01 = Td[0, 0] * r10 + Td[0, 1] * r11 + Td[0, 2] * r12
+            e[3], e[4], e[5] = 0.5 * weight * (d21 - d12), 0.5 * weight * (d02 - d20), 0.5 * weight * (d10 - d01)
+            for i in range(n):
+                for r in range(6):
+                    J[r, i] = 0.0 if held[i] else (J[r, i] * weight if r >= 3 else J[r, i])
+            improved = False
+            jacobi.decompose(J, B, V)
+            for widen in range(len(PINV_WIDEN)):  # (the step with more small directions dropped, if need be)
+                jacobi.solve(B, V, e, rcond * PINV_WIDEN[widen], step)
+                for i in range(n):  # (a held joint's zero column gives a step of rounding size: none at all)
+                    if held[i]:
+                        step[i] = 0.0
+                for _ in range(backtrack + 1):
+                    for i in range(n):
+                        trial[i] = qk[i] + step[i]
+                    new = _geodesic(_poe_fk(H, P, rev, R_end, trial), Td, weight)[0]
+                    if new < cur:  # (False for NaN)
+                        for i in range(n):
+                            qk[i] = trial[i]
+                        cur = new
+                        improved = True
+                        break
+                    for i in range(n):
+                        step[i] *= 0.5
+                if improved:
+                    break
+            if not improved or cur <= floor:
+                break
+        return cur
+
+    @inlined
+    def polish_work(n):
+        """The work arrays of :func:`polish_row` for ``n`` joints."""
+        return (
+            np.empty((n, 3)),
+            np.empty((n, 3)),
+            np.empty((6, n)),
+            np.empty(6),
+            np.empty(n),
+            np.empty((6, n)),
+            np.empty((n, n)),
+            np.empty(n),
+        )
+
     @lazy_njit(
         (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1], float64[:, ::1], float64[:, :, ::1])
         + (float64, types.boolean[:, ::1], int64, int64, float64, float64, float64[::1], int64, int64),
@@ -567,58 +633,12 @@ if AVAILABLE:
     )
     def _polish_rows(H, P, rev, R_end, q, target, weight, fixed, iterations, backtrack, rcond, floor, err, start, stop):
         """``polish.polish`` compiled, rows ``start .. stop - 1`` of ``q`` in place (``err``: their geodesic errors
-        after): damped Newton steps on the full pose (pseudo-inverse of the Jacobian, singular values below ``rcond``
-        of the largest dropped; ``fixed`` joints held), a step kept only if it lowers the error, else halved up to
-        ``backtrack`` times; a row stops when no step improves it or (after one step) its error is at most
-        ``floor``."""
-        n = H.shape[0]
-        z = np.empty((n, 3))
-        o = np.empty((n, 3))
-        J = np.empty((6, n))
-        e = np.empty(6)
-        trial = np.empty(n)
+        after; :func:`polish_row`)."""
+        work = polish_work(H.shape[0])
         for k in range(start, stop):
-            Td = target[k]
-            cur = _geodesic(_poe_fk(H, P, rev, R_end, q[k]), Td, weight)[0]
-            for _ in range(iterations):
-                Tk = _poe_fk(H, P, rev, R_end, q[k])
-                _jacobian(H, P, rev, q[k], Tk, J, z, o)
-                r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = Tk
-                e[0], e[1], e[2] = Td[0, 3] - px, Td[1, 3] - py, Td[2, 3] - pz
-                # dR = Rd R^T; its skew part, halved, scaled by the orientation weight
-                d21 = Td[2, 0] * r10 + Td[2, 1] * r11 + Td[2, 2] * r12
-                d12 = Td[1, 0] * r20 + Td[1, 1] * r21 + Td[1, 2] * r22
-                d02 = Td[0, 0] * r20 + Td[0, 1] * r21 + Td[0, 2] * r22
-                d20 = Td[2, 0] * r00 + Td[2, 1] * r01 + Td[2, 2] * r02
-                d10 = Td[1, 0] * r00 + Td[1, 1] * r01 + Td[1, 2] * r02
-                d01 = Td[0, 0] * r10 + Td[0, 1] * r11 + Td[0, 2] * r12
-                e[3], e[4], e[5] = 0.5 * weight * (d21 - d12), 0.5 * weight * (d02 - d20), 0.5 * weight * (d10 - d01)
-                for i in range(n):
-                    for r in range(6):
-                        J[r, i] = 0.0 if fixed[k, i] else (J[r, i] * weight if r >= 3 else J[r, i])
-                improved = False
-                for widen in range(len(PINV_WIDEN)):  # (the step with more small directions dropped, if need be)
-                    step = np.linalg.pinv(J, rcond * PINV_WIDEN[widen]) @ e
-                    for i in range(n):  # (a held joint's zero column gives a step of rounding size: none at all)
-                        if fixed[k, i]:
-                            step[i] = 0.0
-                    for _ in range(backtrack + 1):
-                        for i in range(n):
-                            trial[i] = q[k, i] + step[i]
-                        new = _geodesic(_poe_fk(H, P, rev, R_end, trial), Td, weight)[0]
-                        if new < cur:  # (False for NaN)
-                            for i in range(n):
-                                q[k, i] = trial[i]
-                            cur = new
-                            improved = True
-                            break
-                        for i in range(n):
-                            step[i] *= 0.5
-                    if improved:
-                        break
-                if not improved or cur <= floor:
-                    break
-            err[k] = cur
+            err[k] = polish_row(
+                H, P, rev, R_end, q[k], target[k], weight, fixed[k], iterations, backtrack, rcond, floor, work
+            )
 
 
 @lru_cache(maxsize=64)

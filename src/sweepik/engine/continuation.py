@@ -19,10 +19,16 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from sweepik._jit import writable
+from sweepik.engine import parallel
 from sweepik.engine.candidates import Spans
+from sweepik.engine.certify import AVAILABLE, chain_args
 from sweepik.engine.families import certified_members, families_of, off_families
 from sweepik.engine.polish import polished, pose_and_jacobian
+from sweepik.engine.search import PARALLEL_MIN
 from sweepik.engine.settings import (
+    BACKTRACK,
+    PINV_RCOND,
     PROBE_ERROR,
     PROBE_STEP,
     SEED_BATCH,
@@ -101,44 +107,225 @@ def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) ->
             lo, hi = x0 - robot.length_scale, x0 + robot.length_scale
         total = hi - lo
     h0 = total / TRACE_STEPS
-    sides: list[list[tuple[float, Array]]] = []
+    side = _side_compiled if AVAILABLE else _side
+    sides: list[tuple[Array, Array]] = []
     closed = False
     for sign in (1.0, -1.0):
-        reach = total - (sides[0][-1][0] - x0 if sides else 0.0) if periodic else (hi - x0 if sign > 0 else x0 - lo)
-        nodes: list[tuple[float, Array]] = [(x0, q0)]
-        h, done = h0 * PROBE_STEP, 0.0
+        reach = total - (sides[0][0][-1] - x0 if sides else 0.0) if periodic else (hi - x0 if sign > 0 else x0 - lo)
+        xs, qs, done = side(robot, world, x0, q0, joint, sign, reach, h0, tol)
+        sides.append((xs, qs))
+        back_home = weighted_joint_distance(robot, qs[-1], q0) <= TRACE_JUMP * 1e-3
+        if periodic and sign > 0 and done >= reach and back_home:
+            closed = True
+            break
+    theta, q = sides[0]
+    if len(sides) > 1:
+        theta = np.concatenate([sides[1][0][:0:-1], theta])
+        q = np.concatenate([sides[1][1][:0:-1], q])
+    if theta[-1] - theta[0] < TRACE_MIN * h0:
+        return None
+    return theta, q, closed
+
+
+def _side(
+    robot: Robot, world: Array, x0: float, q0: Array, joint: int, sign: float, reach: float, h0: float, tol: float
+) -> tuple[Array, Array, float]:
+    """The members of one side of the continuum through ``q0`` (``sign``: the way ``joint`` goes), ``reach`` far at
+    most, from the seed on: ``(joint values (M,), members (M, n), distance gone)``. Each step predicts the next member
+    by the secant through the last two, corrects it with the joint held, and keeps it when it solves the pose, lies
+    near its prediction (``TRACE_JUMP``) and the member halfway solves the pose too (:func:`_bridged`); a failed step
+    is halved. The reference of the compiled ``_trace_side`` (without Numba)."""
+    nodes: list[tuple[float, Array]] = [(x0, q0)]
+    h, done = h0 * PROBE_STEP, 0.0
+    while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if done >= TRACE_MIN * h0 else PROBE_STEP):
+        step = min(h, reach - done)
+        x, q = nodes[-1]
+        pred = q.copy()
+        if len(nodes) > 1:  # secant through the last two members
+            xp, qp = nodes[-2]
+            pred = q + (q - qp) * (step / abs(x - xp))
+        pred[joint] = x + sign * step
+        corr, err = correct(robot, pred[None], world[None], joint, tol)
+        if len(nodes) == 1 and not err[0] <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
+            break
+        if (
+            err[0] <= tol
+            and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP
+            and _bridged(robot, world, q, corr[0], joint, tol)
+        ):
+            nodes.append((x + sign * step, corr[0]))
+            done += step
+            h = min(2.0 * h, h0)
+        else:
+            h *= 0.5
+    return np.array([x for x, _ in nodes]), np.array([q for _, q in nodes]), done
+
+
+def _side_compiled(
+    robot: Robot, world: Array, x0: float, q0: Array, joint: int, sign: float, reach: float, h0: float, tol: float
+) -> tuple[Array, Array, float]:
+    """:func:`_side` in compiled calls (``_trace_side``), each filling a buffer of members; a full one is handed on
+    and the trace resumed from its last two members."""
+    n = robot.n_joints
+    scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
+    args = (*chain_args(robot), np.ascontiguousarray(world, dtype=np.float64), int(joint), float(sign), float(reach))
+    consts = (float(h0), float(tol), scale, orientation_weight(robot.length_unit))
+    xs, qs = np.empty(_BUFFER), np.empty((_BUFFER, n))
+    xs[0], qs[0] = x0, q0
+    count, h, done = 1, h0 * PROBE_STEP, 0.0
+    parts_x: list[Array] = []
+    parts_q: list[Array] = []
+    while True:
+        count, h, done, full = _trace_side(*args, *consts, xs, qs, count, h, done)
+        if not full:
+            break
+        parts_x.append(xs[: count - 2].copy())
+        parts_q.append(qs[: count - 2].copy())
+        xs[:2], qs[:2] = xs[count - 2 : count], qs[count - 2 : count]
+        count = 2
+    parts_x.append(xs[:count])
+    parts_q.append(qs[:count])
+    return np.concatenate(parts_x), np.concatenate(parts_q), done
+
+
+#: Members a compiled trace call holds before it hands them on (``_side_compiled``).
+_BUFFER = 512
+
+if AVAILABLE:
+    from numba import float64, int64, types
+
+    from sweepik._jit import inlined
+    from sweepik.engine.certify import polish_row, polish_work
+    from sweepik.reductions.kernels import lazy_njit
+
+    _CHAIN = (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1])
+
+    @inlined
+    def _distance(a, b, rev, scale):
+        """``results.weighted_joint_distance`` of two configurations."""
+        s = 0.0
+        for i in range(a.shape[0]):
+            d = a[i] - b[i]
+            if rev[i]:
+                d = abs(np.pi - (np.pi - d) % (2.0 * np.pi))
+            s += (d * scale[i]) ** 2
+        return np.sqrt(s)
+
+    @lazy_njit(
+        types.Tuple((int64, float64, float64, types.boolean))(
+            *_CHAIN,
+            float64[:, ::1],
+            int64,
+            float64,
+            float64,
+            float64,
+            float64,
+            float64[::1],
+            float64,
+            float64[::1],
+            float64[:, ::1],
+            int64,
+            float64,
+            float64,
+        ),
+        cache=True,
+        nogil=True,
+    )
+    def _trace_side(H, P, rev, R_end, world, joint, sign, reach, h0, tol, scale, weight, xs, qs, count, h, done):
+        """:func:`_side` from the members ``xs[:count], qs[:count]`` on (the seed alone, or the last two members of a
+        trace handed on), with the step ``h`` and the distance ``done`` it had: ``(count, h, done, full)``, ``full``
+        when the buffer filled before the side ended."""
+        n = H.shape[0]
+        work = polish_work(n)
+        held = np.zeros(n, dtype=np.bool_)
+        held[joint] = True
+        pred, mid = np.empty(n), np.empty(n)
+        floor = 1e-3 * tol
         while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if done >= TRACE_MIN * h0 else PROBE_STEP):
+            if count == xs.shape[0]:
+                return count, h, done, True
             step = min(h, reach - done)
-            x, q = nodes[-1]
-            pred = q.copy()
-            if len(nodes) > 1:  # secant through the last two members
-                xp, qp = nodes[-2]
-                pred = q + (q - qp) * (step / abs(x - xp))
+            x, q = xs[count - 1], qs[count - 1]
+            for i in range(n):
+                pred[i] = q[i]
+            if count > 1:  # secant through the last two members
+                f = step / abs(x - xs[count - 2])
+                for i in range(n):
+                    pred[i] = q[i] + (q[i] - qs[count - 2, i]) * f
             pred[joint] = x + sign * step
-            corr, err = correct(robot, pred[None], world[None], joint, tol)
-            if len(nodes) == 1 and not err[0] <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
+            corr = qs[count]
+            for i in range(n):
+                corr[i] = pred[i]
+            err = polish_row(
+                H, P, rev, R_end, corr, world, weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, floor, work
+            )
+            if count == 1 and not err <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
                 break
-            if (
-                err[0] <= tol
-                and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP
-                and _bridged(robot, world, q, corr[0], joint, tol)
-            ):
-                nodes.append((x + sign * step, corr[0]))
+            ok = err <= tol and _distance(corr, pred, rev, scale) <= TRACE_JUMP
+            if ok:  # the member halfway solves the pose too (``_bridged``)
+                for i in range(n):
+                    mid[i] = 0.5 * (q[i] + corr[i])
+                ok = (
+                    polish_row(
+                        H, P, rev, R_end, mid, world, weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, floor, work
+                    )
+                    <= tol
+                )
+            if ok:
+                xs[count] = x + sign * step
+                count += 1
                 done += step
                 h = min(2.0 * h, h0)
             else:
                 h *= 0.5
-        sides.append(nodes)
-        back_home = weighted_joint_distance(robot, nodes[-1][1], q0) <= TRACE_JUMP * 1e-3
-        if periodic and sign > 0 and done >= reach and back_home:
-            closed = True
-            break
-    back = sides[1][:0:-1] if len(sides) > 1 else []
-    ordered = back + sides[0]
-    theta = np.array([x for x, _ in ordered])
-    if theta[-1] - theta[0] < TRACE_MIN * h0:
-        return None
-    return theta, np.array([q for _, q in ordered]), closed
+        return count, h, done, False
+
+
+if AVAILABLE:
+
+    @lazy_njit(
+        (*_CHAIN, int64[::1], float64[::1], float64[:, ::1], int64[::1], float64[::1], float64[::1])
+        + (float64[:, :, ::1], int64, float64, float64, float64[:, ::1], float64[::1], int64, int64),
+        cache=True,
+        nogil=True,
+    )
+    def _traced_rows(H, P, rev, R_end, offsets, xs, qs, br, xu, x, world, joint, tol, weight, q, err, start, stop):
+        """:meth:`Traced.corrected` compiled, rows ``start .. stop - 1``: the member of branch ``br[k]`` at ``x[k]``
+        interpolated between its nodes at ``xu[k]`` (``x[k]`` unwrapped onto them and clipped, as ``np.interp``),
+        then corrected towards ``world[k]`` with the joint held (``correct``); ``q[k]`` and ``err[k]`` written (left
+        NaN and inf where there is no member)."""
+        n = H.shape[0]
+        work = polish_work(n)
+        held = np.zeros(n, dtype=np.bool_)
+        held[joint] = True
+        for k in range(start, stop):
+            b = br[k]
+            if b < 0 or b >= offsets.size - 1 or not (np.isfinite(x[k]) and np.isfinite(xu[k])):
+                continue
+            s0, s1 = offsets[b], offsets[b + 1]
+            if s1 == s0:
+                continue
+            i = min(max(np.searchsorted(xs[s0:s1], xu[k], side="right") - 1, 0), max(s1 - s0 - 2, 0))
+            a = s0 + i
+            if s1 - s0 == 1 or xu[k] <= xs[a]:
+                for c in range(n):
+                    q[k, c] = qs[a, c]
+            elif xu[k] >= xs[a + 1]:
+                for c in range(n):
+                    q[k, c] = qs[a + 1, c]
+            else:
+                f = (xu[k] - xs[a]) / (xs[a + 1] - xs[a])
+                for c in range(n):
+                    q[k, c] = qs[a, c] + f * (qs[a + 1, c] - qs[a, c])
+            q[k, joint] = x[k]
+            finite = True
+            for c in range(n):
+                finite = finite and np.isfinite(q[k, c])
+            if finite:
+                err[k] = polish_row(
+                    H, P, rev, R_end, q[k], world[k], weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, 1e-3 * tol,
+                    work,
+                )  # fmt: skip
 
 
 class Traced(Reduction):
@@ -153,6 +340,7 @@ class Traced(Reduction):
         super().__init__(robot, joint, max(nodes, default=-1) + 1)
         self.nodes = nodes
         self.tol = tol
+        self._pack: tuple[NDArray[np.int64], Array, Array] | None = None
 
     def add(self, theta: Array, q: Array) -> int:
         """A traced continuum as a new branch: its index."""
@@ -170,28 +358,57 @@ class Traced(Reduction):
         return np.clip(x, th[0], th[-1])
 
     def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        if branch is None:  # every branch (NaN where there is none)
+        return self.corrected(poses, theta, branch)[0]
+
+    def corrected(self, poses: Array, theta: Array, branch: IntArray | None = None) -> tuple[Array, Array]:
+        """``solve_rest``'s members ``(..., n)`` and their geodesic errors ``(...)`` as the Newton steps left them
+        (a member solves the pose where its error is within the certification's tolerance: no second FK needed;
+        NaN members, infinite errors, where there is none)."""
+        n, j = self.robot.n_joints, self.free_joint
+        if branch is None:  # every branch
             each = [
-                self.solve_rest(poses, theta, np.full(theta.shape, b, dtype=np.intp))
+                self.corrected(poses, theta, np.full(theta.shape, b, dtype=np.intp))
                 if b in self.nodes
-                else np.full((*theta.shape, self.robot.n_joints), np.nan)
+                else (np.full((*theta.shape, n), np.nan), np.full(theta.shape, np.inf))
                 for b in range(self.n_branches)
             ]
-            return np.stack(each, axis=-2)
-        n, j = self.robot.n_joints, self.free_joint
-        br = np.broadcast_to(branch, theta.shape).reshape(-1)
-        x = np.asarray(theta, dtype=np.float64).reshape(-1)
+            return np.stack([q for q, _ in each], axis=-2), np.stack([e for _, e in each], axis=-1)
+        br = np.array(np.broadcast_to(branch, theta.shape).reshape(-1), dtype=np.int64)
+        x = writable(np.reshape(theta, -1))
         world = np.repeat(_world(self.robot, poses), theta.shape[1], axis=0)
-        q = np.full((x.size, n), np.nan)
+        xu = np.full(x.size, np.nan)
         for b in np.unique(br).tolist():
             rows = np.nonzero(br == b)[0]
-            th, Q = self.nodes[b]
-            xu = self._unwrapped(b, x[rows])
-            q[rows] = np.stack([np.interp(xu, th, Q[:, i]) for i in range(n)], axis=-1)
-            q[rows, j] = x[rows]
-        ok = np.all(np.isfinite(q), axis=1) & np.isfinite(x)
-        q[ok] = correct(self.robot, q[ok], world[ok], j, self.tol)[0]
-        return q.reshape(*theta.shape, n)
+            xu[rows] = self._unwrapped(b, x[rows])
+        q, err = np.full((x.size, n), np.nan), np.full(x.size, np.inf)
+        if AVAILABLE:
+            offsets, xs, qs = self._packed()
+            weight = orientation_weight(self.robot.length_unit)
+            args = (offsets, xs, qs, br, xu, x, writable(world), j, float(self.tol), weight, q, err)
+            parallel.run(_traced_rows, x.size, PARALLEL_MIN, *chain_args(self.robot), *args)
+        else:
+            for b in np.unique(br).tolist():
+                rows = np.nonzero(br == b)[0]
+                th, Q = self.nodes[b]
+                q[rows] = np.stack([np.interp(xu[rows], th, Q[:, i]) for i in range(n)], axis=-1)
+                q[rows, j] = x[rows]
+            ok = np.all(np.isfinite(q), axis=1) & np.isfinite(x)
+            q[ok], err[ok] = correct(self.robot, q[ok], world[ok], j, self.tol)
+        return q.reshape(*theta.shape, n), err.reshape(theta.shape)
+
+    def _packed(self) -> tuple[NDArray[np.int64], Array, Array]:
+        """The nodes of every branch end to end, as the compiled members take them: ``(offsets (B + 1,), joint values,
+        members)``, branch ``b``'s at ``offsets[b]:offsets[b + 1]`` (none for a branch without nodes). Kept until a
+        branch is added."""
+        if self._pack is None or self._pack[0].size != self.n_branches + 1:
+            counts = [self.nodes[b][0].size if b in self.nodes else 0 for b in range(self.n_branches)]
+            offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+            n = self.robot.n_joints
+            have = [b for b in range(self.n_branches) if b in self.nodes]
+            xs = np.concatenate([np.zeros(0)] + [np.asarray(self.nodes[b][0], dtype=np.float64) for b in have])
+            qs = np.concatenate([np.zeros((0, n))] + [np.asarray(self.nodes[b][1], dtype=np.float64) for b in have])
+            self._pack = (offsets, np.ascontiguousarray(xs), np.ascontiguousarray(qs))
+        return self._pack
 
 
 def _pieces(pose: int, branch: int, theta: Array, closed: bool, periodic: bool) -> list[tuple[int, int, float, float]]:

@@ -55,6 +55,9 @@ def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Arr
 
     def members(x: Array) -> tuple[Array, NDArray[np.bool_]]:
         pose, branches = np.zeros(x.size, np.intp), np.full(x.size, branch, dtype=np.intp)
+        own = _own_errors(red, chain_pose[None], x[None], branches[None])
+        if own is not None:
+            return own[0][0], np.all(np.isfinite(own[0][0]), axis=-1) & (own[1][0] <= tol)
         q = family_members(robot, red, chain_pose[None], pose, branches, x)
         return q, _solve_chain(robot, q, chain_pose, tol)
 
@@ -105,9 +108,21 @@ def _certified(
         q = q.reshape(*theta.shape, robot.n_joints)
         ok = np.all(np.isfinite(q), axis=-1) & (err <= tol).reshape(theta.shape)
     else:
-        q = red.solve_rest(chain[pose], theta, np.broadcast_to(branch[:, None], theta.shape))
-        ok = _solve_chain(robot, q, chain[pose][:, None], tol)
+        br = np.broadcast_to(branch[:, None], theta.shape)
+        own = _own_errors(red, chain[pose], theta, br)
+        if own is not None:
+            q, ok = own[0], np.all(np.isfinite(own[0]), axis=-1) & (own[1] <= tol)
+        else:
+            q = red.solve_rest(chain[pose], theta, br)
+            ok = _solve_chain(robot, q, chain[pose][:, None], tol)
     return ok, np.nan_to_num(q)
+
+
+def _own_errors(red: Reduction, chain: Array, theta: Array, branch: NDArray[np.intp]) -> tuple[Array, Array] | None:
+    """The members ``(K, M, n)`` and pose errors ``(K, M)`` of a reduction whose members come with their own (a traced
+    continuum's, from the Newton steps that made them: ``continuation.Traced.corrected``), else None."""
+    corrected = getattr(red, "corrected", None)
+    return None if corrected is None else corrected(chain, theta, branch)
 
 
 def _members_ok(

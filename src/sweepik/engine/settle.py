@@ -15,7 +15,7 @@ from sweepik.engine.families import (
     MAX_ISOLATED_SOLUTIONS,
 )
 from sweepik.engine.partners import close_partners, nearly_singular, valley_bottoms
-from sweepik.engine.polish import polish
+from sweepik.engine.polish import polish, polished
 from sweepik.engine.settings import (
     ACCEPT_TOL_REL,
     MEET_NEAR,
@@ -149,10 +149,14 @@ def _merge_meeting(
         mid, mid_inside = wrap_inside(robot, moved)
         eg, ep = errors_of(robot, mid, target, weight)
         # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``; a pair farther apart than
-        # ``MEET_NEAR``: no worse than twice the worse of them, or than ``MEET_ROUNDING_REL``)
+        # ``MEET_NEAR``: no worse than twice the worse of them as far as a polish takes them -- a closed form's
+        # values below ``POLISH_ABOVE_REL`` are not polished, and may miss the pose by as much as a valley between
+        # two roots rises -- or than ``MEET_ROUNDING_REL``)
         best = max(min(err_geo[a], err_geo[b]), POLISH_ABOVE_REL * robot.length_scale)
         if apart > MEET_NEAR:
-            best = max(2.0 * max(err_geo[a], err_geo[b]), MEET_ROUNDING_REL * robot.length_scale)
+            _, pair_err = polished(robot, w[[a, b]], np.repeat(target, 2, axis=0), weight, SNAP_ITERATIONS)
+            worse = max(min(err_geo[a], pair_err[0]), min(err_geo[b], pair_err[1]))
+            best = max(2.0 * worse, MEET_ROUNDING_REL * robot.length_scale)
         if stays and eg[0] <= best and (mid_inside[0] or not (inside[a] or inside[b])):
             w[a], err_geo[a], err_paper[a], inside[a] = mid[0], eg[0], ep[0], mid_inside[0]
             mult[a] += mult[b]
