@@ -308,3 +308,34 @@ def test_numerical_continuum_next_to_a_self_motion(q: list[float]) -> None:
         err = pose_error_geodesic(arm.fk(m), np.broadcast_to(T, (9, 4, 4)), w)
         # (an end sits where members stop being certified: another FK's rounding can put it a hair over)
         assert np.all(err <= 1.01 * ACCEPT_TOL_REL * arm.length_scale), (err / (ACCEPT_TOL_REL * arm.length_scale), f)
+
+
+def test_compiled_trace_follows_the_reference() -> None:
+    """The compiled side of a trace (``_side_compiled``) and its NumPy reference (``_side``) follow the same continuum
+    to the same ends (the trace's resolution), their members solving the pose; a small buffer hands the compiled
+    trace on several times."""
+    import sweepik.engine.continuation as cont
+    from sweepik.engine.settings import ACCEPT_TOL_REL, TRACE_HALVINGS, TRACE_STEPS
+
+    if not cont.AVAILABLE:
+        pytest.skip("compiled kernels only")
+    robot = load_robot("carm")
+    q0 = on_theta2_self_motion(robot, np.random.default_rng(2), 1)[0]
+    world = robot.fk(q0)
+    tol = ACCEPT_TOL_REL * robot.length_scale
+    h0 = 2.0 * np.pi / TRACE_STEPS
+    buffer = cont._BUFFER
+    try:
+        cont._BUFFER = 7
+        for sign in (1.0, -1.0):
+            xs_c, qs_c, done_c = cont._side_compiled(robot, world, float(q0[1]), q0, 1, sign, np.pi, h0, tol)
+            xs_p, qs_p, done_p = cont._side(robot, world, float(q0[1]), q0, 1, sign, np.pi, h0, tol)
+            assert abs(done_c - done_p) <= 2.0 * h0 * 2.0**-TRACE_HALVINGS
+            assert xs_c.size > 7  # (handed on)
+            assert np.all(np.diff(xs_c) * sign > 0)
+            err = pose_error_geodesic(
+                robot.fk(qs_c), np.broadcast_to(world, (len(qs_c), 4, 4)), orientation_weight(robot.length_unit)
+            )
+            assert np.all(err <= tol)
+    finally:
+        cont._BUFFER = buffer

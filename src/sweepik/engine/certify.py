@@ -560,17 +560,18 @@ if AVAILABLE:
                 J[3, i], J[4, i], J[5, i] = 0.0, 0.0, 0.0
 
     @inlined
-    def polish_row(H, P, rev, R_end, qk, Td, weight, held, iterations, backtrack, rcond, floor, work):
+    def polish_row(H, P, rev, R_end, qk, Td, weight, held, iterations, backtrack, rcond, floor, work, settled=0.0):
         """``polish.polish`` of one configuration ``qk (n,)`` in place towards the pose ``Td (4, 4)``: its geodesic
         error after. Damped Newton steps on the full pose (pseudo-inverse of the Jacobian, singular values below
         ``rcond`` of the largest dropped; the joints where ``held (n,)`` is True held), a step kept only if it lowers
         the error, else halved up to ``backtrack`` times, then tried with more small directions dropped
-        (``PINV_WIDEN``); it stops when no step improves it or (after one step) its error is at most ``floor``.
-        ``work``: :func:`polish_work`'s arrays."""
+        (``PINV_WIDEN``); it stops when no step improves it or (after one step) its error is at most ``floor``, and
+        once a full step fails with the error at most ``settled`` (rounding level: no halving or narrower step is
+        tried there). ``work``: :func:`polish_work`'s arrays."""
         z, o, J, e, trial, B, V, step = work
         n = H.shape[0]
         cur = _geodesic(_poe_fk(H, P, rev, R_end, qk), Td, weight)[0]
-        for _ in range(iterations):
+        for it in range(iterations):
             Tk = _poe_fk(H, P, rev, R_end, qk)
             _jacobian(H, P, rev, qk, Tk, J, z, o)
             r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = Tk
@@ -587,7 +588,7 @@ if AVAILABLE:
                 for r in range(6):
                     J[r, i] = 0.0 if held[i] else (J[r, i] * weight if r >= 3 else J[r, i])
             improved = False
-            jacobi.decompose(J, B, V)
+            jacobi.decompose(J, B, V, it > 0)  # (from the last step's: the Jacobian moved little)
             for widen in range(len(PINV_WIDEN)):  # (the step with more small directions dropped, if need be)
                 jacobi.solve(B, V, e, rcond * PINV_WIDEN[widen], step)
                 for i in range(n):  # (a held joint's zero column gives a step of rounding size: none at all)
@@ -603,9 +604,11 @@ if AVAILABLE:
                         cur = new
                         improved = True
                         break
+                    if cur <= settled:
+                        break
                     for i in range(n):
                         step[i] *= 0.5
-                if improved:
+                if improved or cur <= settled:
                     break
             if not improved or cur <= floor:
                 break

@@ -16,6 +16,8 @@ A fixed joint in the Newton step is well posed along a continuum: the Jacobian h
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -32,10 +34,12 @@ from sweepik.engine.settings import (
     PROBE_ERROR,
     PROBE_STEP,
     SEED_BATCH,
+    TRACE_FLOOR,
     TRACE_HALVINGS,
     TRACE_JUMP,
     TRACE_MIN,
     TRACE_NEWTON,
+    TRACE_SETTLED,
     TRACE_SHARE,
     TRACE_SINGULAR,
     TRACE_STEPS,
@@ -80,7 +84,7 @@ def correct(robot: Robot, q: Array, world: Array, joint: int | IntArray, tol: fl
     weight = orientation_weight(robot.length_unit)
     fixed = np.zeros(q.shape, dtype=bool)
     fixed[np.arange(q.shape[0]), joint] = True
-    return polished(robot, q, world, weight, iterations=TRACE_NEWTON, fixed=fixed, floor=1e-3 * tol)
+    return polished(robot, q, world, weight, iterations=TRACE_NEWTON, fixed=fixed, floor=TRACE_FLOOR * tol)
 
 
 def _bridged(robot: Robot, world: Array, a: Array, b: Array, joint: int, tol: float) -> bool:
@@ -211,6 +215,14 @@ if AVAILABLE:
             s += (d * scale[i]) ** 2
         return np.sqrt(s)
 
+    @inlined
+    def _correct_row(H, P, rev, R_end, q, world, weight, held, tol, work):
+        """:func:`correct` of one configuration ``q`` in place (the ``held`` joint held): its error after."""
+        floor, settled = TRACE_FLOOR * tol, TRACE_SETTLED * tol
+        return polish_row(
+            H, P, rev, R_end, q, world, weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, floor, work, settled
+        )
+
     @lazy_njit(
         types.Tuple((int64, float64, float64, types.boolean))(
             *_CHAIN,
@@ -240,7 +252,6 @@ if AVAILABLE:
         held = np.zeros(n, dtype=np.bool_)
         held[joint] = True
         pred, mid = np.empty(n), np.empty(n)
-        floor = 1e-3 * tol
         while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if done >= TRACE_MIN * h0 else PROBE_STEP):
             if count == xs.shape[0]:
                 return count, h, done, True
@@ -256,21 +267,14 @@ if AVAILABLE:
             corr = qs[count]
             for i in range(n):
                 corr[i] = pred[i]
-            err = polish_row(
-                H, P, rev, R_end, corr, world, weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, floor, work
-            )
+            err = _correct_row(H, P, rev, R_end, corr, world, weight, held, tol, work)
             if count == 1 and not err <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
                 break
             ok = err <= tol and _distance(corr, pred, rev, scale) <= TRACE_JUMP
             if ok:  # the member halfway solves the pose too (``_bridged``)
                 for i in range(n):
                     mid[i] = 0.5 * (q[i] + corr[i])
-                ok = (
-                    polish_row(
-                        H, P, rev, R_end, mid, world, weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, floor, work
-                    )
-                    <= tol
-                )
+                ok = _correct_row(H, P, rev, R_end, mid, world, weight, held, tol, work) <= tol
             if ok:
                 xs[count] = x + sign * step
                 count += 1
@@ -284,37 +288,42 @@ if AVAILABLE:
 if AVAILABLE:
 
     @lazy_njit(
-        (*_CHAIN, int64[::1], float64[::1], float64[:, ::1], int64[::1], float64[::1], float64[::1])
+        (*_CHAIN, int64[::1], float64[::1], float64[:, ::1], int64[::1], float64[::1], types.boolean, int64)
         + (float64[:, :, ::1], int64, float64, float64, float64[:, ::1], float64[::1], int64, int64),
         cache=True,
         nogil=True,
     )
-    def _traced_rows(H, P, rev, R_end, offsets, xs, qs, br, xu, x, world, joint, tol, weight, q, err, start, stop):
+    def _traced_rows(H, P, rev, R_end, offsets, xs, qs, br, x, periodic, per, world, joint, tol, weight, q, err, start,
+                     stop):  # fmt: skip
         """:meth:`Traced.corrected` compiled, rows ``start .. stop - 1``: the member of branch ``br[k]`` at ``x[k]``
-        interpolated between its nodes at ``xu[k]`` (``x[k]`` unwrapped onto them and clipped, as ``np.interp``),
-        then corrected towards ``world[k]`` with the joint held (``correct``); ``q[k]`` and ``err[k]`` written (left
-        NaN and inf where there is no member)."""
+        interpolated between its nodes (``x[k]`` moved by whole turns next to them when ``periodic``, and clipped to
+        them, as ``Traced._unwrapped`` and ``np.interp``), then corrected towards ``world[k // per]`` with the joint
+        held (``correct``); ``q[k]`` and ``err[k]`` written (left NaN and inf where there is no member)."""
         n = H.shape[0]
         work = polish_work(n)
         held = np.zeros(n, dtype=np.bool_)
         held[joint] = True
         for k in range(start, stop):
             b = br[k]
-            if b < 0 or b >= offsets.size - 1 or not (np.isfinite(x[k]) and np.isfinite(xu[k])):
+            if b < 0 or b >= offsets.size - 1 or not np.isfinite(x[k]):
                 continue
             s0, s1 = offsets[b], offsets[b + 1]
             if s1 == s0:
                 continue
-            i = min(max(np.searchsorted(xs[s0:s1], xu[k], side="right") - 1, 0), max(s1 - s0 - 2, 0))
+            t = x[k]
+            if periodic:
+                t += 2.0 * np.pi * math.floor((0.5 * (xs[s0] + xs[s1 - 1]) - t) / (2.0 * np.pi) + 0.5)
+            t = min(max(t, xs[s0]), xs[s1 - 1])
+            i = min(max(np.searchsorted(xs[s0:s1], t, side="right") - 1, 0), max(s1 - s0 - 2, 0))
             a = s0 + i
-            if s1 - s0 == 1 or xu[k] <= xs[a]:
+            if s1 - s0 == 1 or t <= xs[a]:
                 for c in range(n):
                     q[k, c] = qs[a, c]
-            elif xu[k] >= xs[a + 1]:
+            elif t >= xs[a + 1]:
                 for c in range(n):
                     q[k, c] = qs[a + 1, c]
             else:
-                f = (xu[k] - xs[a]) / (xs[a + 1] - xs[a])
+                f = (t - xs[a]) / (xs[a + 1] - xs[a])
                 for c in range(n):
                     q[k, c] = qs[a, c] + f * (qs[a + 1, c] - qs[a, c])
             q[k, joint] = x[k]
@@ -322,10 +331,7 @@ if AVAILABLE:
             for c in range(n):
                 finite = finite and np.isfinite(q[k, c])
             if finite:
-                err[k] = polish_row(
-                    H, P, rev, R_end, q[k], world[k], weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, 1e-3 * tol,
-                    work,
-                )  # fmt: skip
+                err[k] = _correct_row(H, P, rev, R_end, q[k], world[k // per], weight, held, tol, work)
 
 
 class Traced(Reduction):
@@ -375,22 +381,21 @@ class Traced(Reduction):
             return np.stack([q for q, _ in each], axis=-2), np.stack([e for _, e in each], axis=-1)
         br = np.array(np.broadcast_to(branch, theta.shape).reshape(-1), dtype=np.int64)
         x = writable(np.reshape(theta, -1))
-        world = np.repeat(_world(self.robot, poses), theta.shape[1], axis=0)
-        xu = np.full(x.size, np.nan)
-        for b in np.unique(br).tolist():
-            rows = np.nonzero(br == b)[0]
-            xu[rows] = self._unwrapped(b, x[rows])
+        world = _world(self.robot, poses)  # (one per pose: theta's rows are poses)
         q, err = np.full((x.size, n), np.nan), np.full(x.size, np.inf)
         if AVAILABLE:
             offsets, xs, qs = self._packed()
             weight = orientation_weight(self.robot.length_unit)
-            args = (offsets, xs, qs, br, xu, x, writable(world), j, float(self.tol), weight, q, err)
+            per = max(int(theta.shape[1]), 1)
+            args = (offsets, xs, qs, br, x, self.periodic, per, writable(world), j, float(self.tol), weight, q, err)
             parallel.run(_traced_rows, x.size, PARALLEL_MIN, *chain_args(self.robot), *args)
         else:
+            world = np.repeat(world, theta.shape[1], axis=0)
             for b in np.unique(br).tolist():
                 rows = np.nonzero(br == b)[0]
                 th, Q = self.nodes[b]
-                q[rows] = np.stack([np.interp(xu[rows], th, Q[:, i]) for i in range(n)], axis=-1)
+                xu = self._unwrapped(b, x[rows])
+                q[rows] = np.stack([np.interp(xu, th, Q[:, i]) for i in range(n)], axis=-1)
                 q[rows, j] = x[rows]
             ok = np.all(np.isfinite(q), axis=1) & np.isfinite(x)
             q[ok], err[ok] = correct(self.robot, q[ok], world[ok], j, self.tol)

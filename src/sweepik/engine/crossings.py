@@ -15,12 +15,21 @@ that direction moves most held:
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine.continuation import scaled_singular
-from sweepik.engine.families import golden_least
-from sweepik.engine.settings import CROSS_RANK, CROSS_SAMPLES, CROSS_SINGULAR, CROSS_STEP, CROSS_STEPS, VERTEX_REL
+from sweepik.engine.settings import (
+    CROSS_RANK,
+    CROSS_SAMPLES,
+    CROSS_SINGULAR,
+    CROSS_STEP,
+    CROSS_STEPS,
+    VERTEX_REL,
+    VERTEX_WIDTH,
+)
 from sweepik.model.robot import Robot
 from sweepik.results import Family
 
@@ -31,13 +40,72 @@ IntArray = NDArray[np.intp]
 def _second_singular(robot: Robot, family: Family, theta: Array) -> Array:
     """Second smallest singular value over the largest of the (scaled) Jacobian at the family's members ``theta``
     (infinite where a member is not finite)."""
-    q = family.at(theta)
+    q = _probe(family, theta)
     out = np.full(theta.shape, np.inf)
     ok = np.all(np.isfinite(q), axis=-1)
     if ok.any():
         s, _ = scaled_singular(robot, q[ok])
         out[ok] = s[:, -2] / s[:, 0]
     return out
+
+
+def _probe(family: Family, theta: Array) -> Array:
+    """The family's members at ``theta`` (inside its interval) to probe the Jacobian at: a traced family's as the
+    Newton steps left them (``Traced.corrected``; next to a crossing they converge linearly and a member may miss the
+    certification by a little, which ``Family.at`` would answer with one nudged away: the search wants it where it
+    is), another's from ``Family.at``."""
+    corrected = getattr(family.reduction, "corrected", None)
+    if corrected is None or family.held is not None:
+        return family.at(theta)
+    lo, hi = family.interval
+    th = np.clip(theta, lo, hi)
+    q = corrected(family.chain_pose[None], th[None], np.full((1, th.size), family.branch, dtype=np.intp))[0][0]
+    return np.asarray(family.reduction.robot.wrap(q))
+
+
+def vertex_least(
+    excess: Callable[[Array], Array], a: Array, m: Array, b: Array, ea: Array, em: Array, eb: Array
+) -> tuple[Array, Array]:
+    """The least ``excess`` in each bracket ``[a, b]`` about its least sample ``m`` (``ea >= em <= eb``), for an
+    excess shaped like a V (the second singular value along a family about a crossing: the distance to it times a
+    slope; rounded at the bottom where two families only nearly meet): ``(x, excess there)``, the least found.
+
+    Each step samples where the V through the three points has its vertex (the steeper side's slope, mirrored
+    through the sample of the other side: one step reaches the vertex of a V), and keeps the least sample with its
+    neighbours. A bracket is settled once its least excess is at most 0 (a crossing), or once the excess cannot
+    reach 0 in it: a convex function lies above each side's secant extended over the other side, whose lower end is
+    then above 0. At most ``CROSS_STEPS`` steps (a golden-section search took ~20 where a V's takes 2 to 6)."""
+    a, m, b = (np.array(v, dtype=np.float64) for v in (a, m, b))
+    ea, em, eb = (np.array(v, dtype=np.float64) for v in (ea, em, eb))
+    for _ in range(CROSS_STEPS):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sl, sr = (ea - em) / (m - a), (eb - em) / (b - m)  # (the two sides' slopes, as magnitudes)
+        bound = np.minimum(em - sr * (m - a), em - sl * (b - m))
+        todo = np.nonzero((em > 0.0) & ~(bound > 0.0) & (b - a > VERTEX_WIDTH * np.maximum(np.abs(m), 1.0)))[0]
+        if todo.size == 0:
+            break
+        k_a, k_m, k_b, k_ea, k_em, k_eb, k_sl, k_sr = (v[todo] for v in (a, m, b, ea, em, eb, sl, sr))
+        slope = np.maximum(k_sl, k_sr)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = np.where(  # the vertex: right of m where the left side is the steeper, else left of it
+                k_sl >= k_sr,
+                (k_em - k_eb + slope * (k_m + k_b)) / (2.0 * slope),
+                (k_ea - k_em + slope * (k_a + k_m)) / (2.0 * slope),
+            )
+        w = k_b - k_a
+        x = np.where(np.isfinite(x), x, k_m + 0.25 * w * np.where(k_b - k_m > k_m - k_a, 1.0, -1.0))
+        x = np.clip(x, k_a + 0.01 * w, k_b - 0.01 * w)
+        close = np.abs(x - k_m) < 0.01 * w  # (not on the least sample itself: a little to its wider side)
+        x = np.where(close, k_m + 0.01 * w * np.where(k_b - k_m > k_m - k_a, 1.0, -1.0), x)
+        ex = excess(x)
+        better, right = ex < k_em, x > k_m
+        # the least three: x between its neighbours where it is the least, else it closes its side of the bracket
+        a[todo] = np.where(better, np.where(right, k_m, k_a), np.where(right, k_a, x))
+        ea[todo] = np.where(better, np.where(right, k_em, k_ea), np.where(right, k_ea, ex))
+        b[todo] = np.where(better, np.where(right, k_b, k_m), np.where(right, x, k_b))
+        eb[todo] = np.where(better, np.where(right, k_eb, k_em), np.where(right, ex, k_eb))
+        m[todo], em[todo] = np.where(better, x, k_m), np.where(better, ex, k_em)
+    return m, em
 
 
 def crossing_seeds(robot: Robot, families: tuple[Family, ...]) -> tuple[Array, IntArray]:
@@ -63,16 +131,16 @@ def crossing_seeds(robot: Robot, families: tuple[Family, ...]) -> tuple[Array, I
         drop = np.maximum(high - s2[dips], 1e-300)  # (per sample step)
         vertex = s2[dips] - 0.5 * (s2[dips] - low + drop)
         dips = dips[vertex <= VERTEX_REL * s2[dips]]
-        rise = np.maximum(left, right)
         if dips.size == 0:
             continue
 
         def excess(t: Array, f: Family = f) -> Array:
             return _second_singular(robot, f, t) - CROSS_SINGULAR
 
-        a, b = grid[np.maximum(dips - 1, 0)], grid[np.minimum(dips + 1, grid.size - 1)]
-        slope = 2.0 * rise[dips] / (grid[1] - grid[0])  # (a bound on the V's slope)
-        x, e = golden_least(excess, a, b, grid[dips], s2[dips] - CROSS_SINGULAR, steps=CROSS_STEPS, slope=slope)
+        e_grid = s2 - CROSS_SINGULAR
+        x, e = vertex_least(
+            excess, grid[dips - 1], grid[dips], grid[dips + 1], e_grid[dips - 1], e_grid[dips], e_grid[dips + 1]
+        )
         x = x[e <= 0.0]
         if x.size == 0:
             continue

@@ -56,16 +56,26 @@ def _rotate_pairs(B, V):
 
 
 @inlined
-def decompose(A, B, V):
+def decompose(A, B, V, warm=False):
     """``A (m, n)`` as ``B V^T``: ``B (m, n)`` with orthogonal columns (``sigma_k u_k``), ``V (n, n)`` orthogonal
-    (both overwritten)."""
+    (both overwritten). ``warm``: start from the ``V`` given (orthogonal: the last decomposition's), ``B = A V``:
+    for a matrix close to the last one (a Newton step's next Jacobian) its columns are nearly orthogonal already,
+    and one or two sweeps finish them."""
     m, n = A.shape
-    for i in range(m):
-        for k in range(n):
-            B[i, k] = A[i, k]
-    for i in range(n):
-        for k in range(n):
-            V[i, k] = 1.0 if i == k else 0.0
+    if warm:
+        for i in range(m):
+            for k in range(n):
+                s = 0.0
+                for j in range(n):
+                    s += A[i, j] * V[j, k]
+                B[i, k] = s
+    else:
+        for i in range(m):
+            for k in range(n):
+                B[i, k] = A[i, k]
+        for i in range(n):
+            for k in range(n):
+                V[i, k] = 1.0 if i == k else 0.0
     for _ in range(MAX_SWEEPS):
         if not _rotate_pairs(B, V):
             break

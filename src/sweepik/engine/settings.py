@@ -27,7 +27,7 @@ PINV_WIDEN = (1.0, 1e4, 1e7)
 
 #: Candidates with a pose error below this times the length scale get a Newton polish on the full pose
 #: (removes the ill-conditioning of a reduction; spurious candidates are far above it).
-POLISH_BELOW_REL = 1e-6
+POLISH_BELOW_REL = 1e-5
 
 #: ... and above this (already at rounding level: nothing to gain), ...
 POLISH_ABOVE_REL = 1e-14
@@ -261,6 +261,12 @@ TRACE_JUMP = 0.25
 #: singular set (carm_swapped's theta2 self-motion at theta2 = -90 deg) Newton converges only linearly: with 6 steps
 #: the tracing stopped ~1e-3 short of the crossing on both sides, and the solutions in that gap went missing.
 TRACE_NEWTON = 20
+#: ... stopping once the error is at most this times the certification's tolerance ...
+TRACE_FLOOR = 1e-3
+#: ... or once a full step fails to lower an error at most this times it (rounding level, ~1.6e-15 of the arm's
+#: size: the halvings and narrower steps tried after a failed step cannot gain there, and cost a correction as much
+#: as its converging steps; compiled tracing only).
+TRACE_SETTLED = 8e-3
 #: A seed is followed only where a continuum can pass along the joint: the arm's Jacobian (lengths over the arm's
 #: length scale) has its smallest singular value below this fraction of its largest (members of a continuum: ~1e-17,
 #: ~1e-9 where two singular directions meet, and up to ~1e-7 where the member is pinned down only to the root of the
@@ -289,10 +295,13 @@ PROBE_ERROR = 1e-2
 
 #: Members sampled along a family (its interval, ends included) ...
 CROSS_SAMPLES = 65
-#: ... and golden-section steps at most around a least second singular value between them, until it is below
-#: ``CROSS_SINGULAR`` (a crossing, located to about that over its slope: far closer than the seeds'
-#: step) or cannot get there any more (its slope bounded by twice the rise to the samples beside it).
+#: ... and steps at most of the search for a least second singular value between them (``crossings.vertex_least``),
+#: until it is below ``CROSS_SINGULAR`` (a crossing, located to about that over its slope: far closer than the seeds'
+#: step) or cannot get there any more.
 CROSS_STEPS = 40
+#: ... or until its bracket is this narrow (relative to the joint's value, at least 1: below it the second singular
+#: value is rounding).
+VERTEX_WIDTH = 1e-13
 #: The second singular value (over the largest) at a crossing: members of a continuum have their smallest at ~1e-17.
 CROSS_SINGULAR = 1e-7
 #: A family whose second singular value stays below this over half its members is not searched: the arm
