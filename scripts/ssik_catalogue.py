@@ -97,7 +97,8 @@ class Agreement:
     """Set agreement with ssik's own solver (``--agreement``): per pose without a continuum, sweepik's solution set
     and ssik's (``solve(T, respect_limits=False, enumerate_windings=False)``) compared by
     ``oracles.unmatched_solutions``; every solution only ssik has is polished (:func:`_root_near`): where it lands on
-    a root of the pose that sweepik's set lacks (to 1e-4) it is a miss of sweepik's, else ssik's error (a
+    a root of the pose that sweepik's answer does not hold (``singular.recovered``: the same root to the precision the
+    pose fixes it, an arc of rounding-level solutions included) it is a miss of sweepik's, else ssik's error (a
     configuration missing the pose by 1e-10 ... 1e-6, or a second copy of a root sweepik has). One only sweepik has
     (each passed sweepik's certification) is a miss of ssik's. Poses with a continuum are counted apart."""
 
@@ -106,7 +107,7 @@ class Agreement:
         self.ssik_only_ok = self.ssik_only_bad = self.ours_only = 0
 
     def add(self, name: str, robot: Robot, solver_robot: Robot, q: np.ndarray, sols, rw) -> None:  # type: ignore[no-untyped-def]
-        from oracles import contains, unmatched_solutions
+        from oracles import unmatched_solutions
 
         if sols.families:
             self.continua += 1
@@ -123,9 +124,7 @@ class Agreement:
         T = solver_robot.fk(rw.forward(q[None])[0] if rw is not None else q)
         for x in extra_theirs:
             root = _root_near(solver_robot, x, T)
-            missed = root is not None and not contains(
-                sols.q, root, solver_robot.is_revolute, solver_robot.length_scale, 1e-4
-            )
+            missed = root is not None and not recovered(solver_robot, sols, root)
             self.ssik_only_ok += missed
             self.ssik_only_bad += not missed
 
