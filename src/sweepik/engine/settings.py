@@ -27,7 +27,7 @@ PINV_WIDEN = (1.0, 1e4, 1e7)
 
 #: Candidates with a pose error below this times the length scale get a Newton polish on the full pose
 #: (removes the ill-conditioning of a reduction; spurious candidates are far above it).
-POLISH_BELOW_REL = 1e-5
+POLISH_BELOW_REL = 1e-6
 
 #: ... and above this (already at rounding level: nothing to gain), ...
 POLISH_ABOVE_REL = 1e-14
