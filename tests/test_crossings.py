@@ -89,3 +89,27 @@ def test_the_issue_reproducers_wrist_circle() -> None:
         q = np.array(q)
         s = sweepik.solve(robot, robot.fk(q), limits=False)
         assert recovered(robot, s, q), name
+
+
+def test_vertex_least_reaches_a_vertex_and_settles_a_rounded_one() -> None:
+    """``vertex_least`` on V-shaped functions: a V reaching zero is found below zero in a few steps; a V rounded off
+    above zero (two families that only nearly meet) is settled above zero, as the golden section settled it."""
+    from sweepik.engine.crossings import vertex_least
+
+    calls = []
+
+    def v_shape(x: np.ndarray) -> np.ndarray:
+        calls.append(x.size)
+        return np.abs(x - np.array([0.3137, -0.71])[: x.size]) * np.array([2.0, 0.5])[: x.size] - 1e-7
+
+    a, m, b = np.array([0.25, -0.8]), np.array([0.3, -0.7]), np.array([0.35, -0.6])
+    x, e = vertex_least(v_shape, a, m, b, v_shape(a), v_shape(m), v_shape(b))
+    assert np.all(e <= 0.0) and np.allclose(x, [0.3137, -0.71], atol=1e-6)
+    assert len(calls) - 3 <= 6
+
+    def rounded(x: np.ndarray) -> np.ndarray:
+        return np.sqrt((2.0 * (x - 0.3137)) ** 2 + 1e-10) - 1e-7
+
+    a, m, b = np.array([0.25]), np.array([0.3]), np.array([0.35])
+    x, e = vertex_least(rounded, a, m, b, rounded(a), rounded(m), rounded(b))
+    assert e[0] > 0.0 and abs(x[0] - 0.3137) < 1e-3

@@ -6,7 +6,8 @@ Why not ``np.linalg.pinv`` inside the kernels: for a 6 x 6 matrix its LAPACK cal
 and work arrays) costs ~12 us on this machine, about ten times the arithmetic; a traced continuum's correction made
 four to seven of them, and a singular pose's solve traced hundreds (docs/performance.md). The rotations need no
 allocation and give the singular values to high relative accuracy (a one-sided Jacobi SVD is at least as accurate as
-the QR-based one, Demmel & Veselic 1992), so that the cut-off ``rcond`` drops the same directions.
+the QR-based one, Demmel & Veselic 1992), so that the cut-off ``rcond`` drops the same directions (but for a
+singular value at the cut-off itself, where the two may decide apart).
 
 The columns of ``B = A`` are rotated in pairs until every pair is orthogonal to ``ORTHOGONAL`` (relative), the same
 rotations accumulated in ``V``: then ``A = B V^T`` with orthogonal columns ``b_k = sigma_k u_k`` and
