@@ -16,8 +16,6 @@ A fixed joint in the Newton step is well posed along a continuum: the Jacobian h
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import NDArray
 
@@ -201,6 +199,7 @@ if AVAILABLE:
     from sweepik._jit import inlined
     from sweepik.engine.certify import polish_row, polish_work
     from sweepik.reductions.kernels import lazy_njit
+    from sweepik.subproblems.trig import wrap_pi
 
     _CHAIN = (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1])
 
@@ -209,9 +208,7 @@ if AVAILABLE:
         """``results.weighted_joint_distance`` of two configurations."""
         s = 0.0
         for i in range(a.shape[0]):
-            d = a[i] - b[i]
-            if rev[i]:
-                d = abs(np.pi - (np.pi - d) % (2.0 * np.pi))
+            d = wrap_pi(a[i] - b[i]) if rev[i] else a[i] - b[i]
             s += (d * scale[i]) ** 2
         return np.sqrt(s)
 
@@ -311,8 +308,9 @@ if AVAILABLE:
             if s1 == s0:
                 continue
             t = x[k]
-            if periodic:
-                t += 2.0 * np.pi * math.floor((0.5 * (xs[s0] + xs[s1 - 1]) - t) / (2.0 * np.pi) + 0.5)
+            if periodic:  # (by whole turns next to the nodes' middle)
+                mid = 0.5 * (xs[s0] + xs[s1 - 1])
+                t = mid - wrap_pi(mid - t)
             t = min(max(t, xs[s0]), xs[s1 - 1])
             i = min(max(np.searchsorted(xs[s0:s1], t, side="right") - 1, 0), max(s1 - s0 - 2, 0))
             a = s0 + i
