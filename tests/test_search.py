@@ -258,3 +258,42 @@ def test_edge_intervals_left_alone_hide_no_roots(name: str, monkeypatch: pytest.
     np.testing.assert_array_equal(changes, crosses.astype(int))
     ends = np.minimum(np.abs(f0), np.abs(f1))
     assert np.all(crosses | (np.abs(f).min(axis=1) >= 0.5 * ends))
+
+
+@pytest.mark.parametrize("name", ["i2rt_yam", "xarm6", "fanuc_crx10ia"])
+def test_domain_edge_samples_lie_inside_their_domains(name: str) -> None:
+    """A generic sweep's domain edges (the zeros of its margins) become samples on the domain's side
+    (``inside_zeros``, the compiled one-pass search's ``_inside``: the same samples, see
+    ``test_one_pass_search_is_the_staged_search``): at each, its margin is >= 0 (0 ... 1e-8), not a rounding step below
+    0, where the branches it bounds are NaN and the stretch to the next sample went unsearched (an I2RT YAM written
+    with other axis signs lost a solution 0.04 rad from such an edge), unless the margin touches 0 from below (no
+    domain on either side). Random poses and poses on the singular sets."""
+    from singular import singular_configurations
+
+    from sweepik.engine.settings import EDGE_PROBE_REL
+
+    robot = load_robot(name)
+    red = sweepik.reductions.get_reduction(robot, "auto")
+    if red.closed_form:
+        pytest.skip(f"{name}: a closed form (no sweep, no domain edges)")
+    rng = np.random.default_rng(7)
+    Q = np.concatenate([rng.uniform(robot.lower, robot.upper, (100, 6)), singular_configurations(robot, 100, rng)])
+    chain = chunk.chain_poses(robot, robot.fk(Q))
+    margins, lo, hi = red.edge_reduction(chain, red.sample_hints(chain))
+    cand, _ = search.search(margins, chain, lo, hi, sweepik.engine.settings.N_SAMPLES, None, multiplicity=False)
+    if margins.periodic:
+        cand = candidates.Candidates(cand.pose, cand.branch, candidates.wrapped(cand.theta), cand.mult)
+    reach = EDGE_PROBE_REL * (hi - lo)
+
+    def margin(t: np.ndarray) -> np.ndarray:
+        return np.asarray(margins.residual_rows(chain, cand.pose, t[:, None], cand.branch[:, None]))[:, 0]
+
+    before = margin(cand.theta)
+    after = margin(search.inside_zeros(margins, chain, cand, reach).theta)
+    edge = np.abs(before) <= 1e-8  # (the others: samples next to a margin's own NaN, the range's ends)
+    assert edge.sum() > 50 and (before[edge] < 0.0).sum() > 5  # (the rounding put some outside)
+    outside = edge & ~(after >= 0.0)
+    touching = (margin(cand.theta - reach[cand.pose]) < 0.0) & (margin(cand.theta + reach[cand.pose]) < 0.0)
+    assert (touching[outside]).all(), cand.theta[outside & ~touching]
+    assert outside.sum() <= edge.sum() / 10
+    assert (np.abs(after[edge] - before[edge]) <= 1e-8).all()

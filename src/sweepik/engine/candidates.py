@@ -82,11 +82,13 @@ def set_edge_zeros(zeros: Callable[[Reduction, Array, Array, Array], Array]) -> 
 
 def grid_hints(reduction: Reduction, poses: Array) -> Array | None:
     """The samples ``(N, H)`` that ``sample_grid`` adds to the uniform grid (NaN: none): the zeros of the reduction's
-    ``edge_reduction`` (its domain edges), then its hints and,
+    ``edge_reduction`` (its domain edges, each on its domain's side: ``search.inside_zeros``), then its hints and,
     for a non-periodic theta*, its limits (a solution exactly at a limit, a rail end, is then a sample); for a
-    periodic theta* wrapped into [-pi, pi]."""
+    periodic theta* wrapped into [-pi, pi] (the zeros before they are moved inside: ``edge_zeros``)."""
     hints = reduction.sample_hints(poses)
     edges = reduction.edge_reduction(poses, hints)
+    if hints is not None and hints.size and reduction.periodic:
+        hints = wrapped(hints)
     if edges is not None:  # the domain edges' samples first (the zeros of the reduction it gives)
         assert _edge_zeros is not None, "sweepik.engine.search registers the edge zeros when imported"
         zeros = _edge_zeros(edges[0], poses, edges[1], edges[2])
@@ -98,9 +100,12 @@ def grid_hints(reduction: Reduction, poses: Array) -> Array | None:
         ends = np.empty((poses.shape[0], 2))
         ends[:, 0], ends[:, 1] = reduction.robot.lower[j], reduction.robot.upper[j]
         hints = ends if hints is None else np.concatenate([hints, ends], axis=1)
-    if hints is not None and hints.size and reduction.periodic:
-        hints = np.pi - np.mod(np.pi - hints, 2.0 * np.pi)
     return hints
+
+
+def wrapped(theta: Array) -> Array:
+    """Angles wrapped into (-pi, pi], bit for bit as the compiled ``subproblems.trig.wrap_pi``."""
+    return np.pi - np.mod(np.pi - theta, 2.0 * np.pi)
 
 
 def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:

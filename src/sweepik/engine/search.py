@@ -37,6 +37,7 @@ from sweepik.engine.settings import (
     DIFF_LEVELS,
     DIFF_SHRINK,
     DIFF_STEP_REL,
+    EDGE_NUDGES,
     EDGE_PROBE_REL,
     EXTREMUM_REACH,
     FAMILY_BISECT,
@@ -253,6 +254,22 @@ if AVAILABLE:
             _push(out_t, out_b, cnt, _root(res, p, b, xe, tb, fx, fb, xtol), b)
         elif abs(fx) <= FAR_NOISE * noise:
             _push(out_t, out_b, cnt, xe, b)
+
+    @inlined
+    def _inside(res, p, x, b, reach):
+        """A margin's zero ``x`` (branch ``b``) on the margin's non-negative side: itself if it is there, else moved by
+        the least of ``reach 2^-k`` (k = EDGE_NUDGES - 1 ... 0) that gets there, up first (``inside_zeros``, the
+        NumPy twin); ``x`` where neither side is (a domain narrower than that)."""
+        if not res(p, x, b) < 0.0:
+            return x
+        d = reach * 2.0 ** (1 - EDGE_NUDGES)
+        for _ in range(EDGE_NUDGES):
+            if res(p, x + d, b) >= 0.0:
+                return x + d
+            if res(p, x - d, b) >= 0.0:
+                return x - d
+            d *= 2.0
+        return x
 
     @inlined
     def _g(res, p, x, b, h):
@@ -918,14 +935,15 @@ if AVAILABLE:
         return k
 
     @inlined
-    def _with_ends(row, k, ends, periodic):
-        """theta*'s ``ends`` after the first ``k`` samples of ``row``, and all of them wrapped into [-pi, pi] for a
-        periodic theta*, as ``candidates.grid_hints`` gives them: their new number."""
+    def _with_ends(row, k, ends, periodic, start):
+        """theta*'s ``ends`` after the first ``k`` samples of ``row``, and those from ``start`` on (the first: margins'
+        zeros, wrapped already) wrapped into [-pi, pi] for a periodic theta*, as ``candidates.grid_hints`` gives
+        them: their new number."""
         for j in range(ends.shape[0]):
             row[k] = ends[j]
             k += 1
         if periodic:
-            for j in range(k):
+            for j in range(start, k):
                 row[j] = wrap_pi(row[j])
         return k
 
@@ -964,7 +982,7 @@ if AVAILABLE:
         ``plan``: the addresses and counts (``_E_*``); ``noise``: the search's residual noise and the margins';
         ``twins``: the candidates' copies to make (``_twin_copies``). A pose whose margins overflow the buffers is
         marked in ``redo`` (its count 0), for ``search`` to redo with the NumPy engine."""
-        se, sw = _as_search(plan[_E_SEARCH]), as_swing(plan[_E_SWING])
+        se, sw, margin = _as_search(plan[_E_SEARCH]), as_swing(plan[_E_SWING]), as_residual(plan[_E_MARGIN])
         n_swing, n, periodic = plan[_E_N_SWING], plan[_E_N], plan[_E_PERIODIC] != 0
         n_s, n_e, n_c = s.shape[0], ends.shape[0], out_t.shape[1]
         n_all = plan[_E_N_ALL]
@@ -993,7 +1011,7 @@ if AVAILABLE:
                 for m in range(3):
                     known_m[0, k, m] = shared[n_all + m]
             # the margins' samples: the swing samples and theta*'s ends (``grid_hints`` of the margins)
-            k = _with_ends(row, _add_swings(row, 0, swings), ends, periodic)
+            k = _with_ends(row, _add_swings(row, 0, swings), ends, periodic, 0)
             M = _merge_row(hlo[i], hhi[i], s, row[:k], grid, True)
             if P:
                 _known_at(grid, M, hlo[i], hhi[i], s, known_at)
@@ -1005,10 +1023,13 @@ if AVAILABLE:
                 cnt[i] = 0
                 fcnt[i] = 0
                 continue
-            # its own samples: the margins' zeros, the swing samples, theta*'s ends (``sample_hints``, ``grid_hints``)
+            # its own samples: the margins' zeros (inside their domains), the swing samples, theta*'s ends
+            # (``sample_hints``, ``grid_hints``)
+            reach = EDGE_PROBE_REL * (hhi[i] - hlo[i])
             for j in range(cnt[i]):
-                row[j] = out_t[i, j]
-            k = _with_ends(row, _add_swings(row, cnt[i], swings), ends, periodic)
+                t = wrap_pi(out_t[i, j]) if periodic else out_t[i, j]
+                row[j] = _inside(margin, params[i], t, out_b[i, j], reach)
+            k = _with_ends(row, _add_swings(row, cnt[i], swings), ends, periodic, cnt[i])
             M = _merge_row(lo[i], hi[i], s, row[:k], grid, True)
             same = P != 0 and lo[i] == hlo[i] and hi[i] == hhi[i]  # (the uniform samples the margins' search had)
             if same:
@@ -1038,7 +1059,7 @@ if AVAILABLE:
         for i in range(start, stop):
             redo[i] = False
             fn(params[i], row[:nh])
-            _with_ends(row, nh, ends, periodic)
+            _with_ends(row, nh, ends, periodic, 0)
             M = _merge_row(lo[i], hi[i], s, row, grid, False)
             _pose_search(se, plan[_E_RES], plan[_E_RES_ALL], plan[_E_N_ALL], branches, noise[0], plan[_E_MULT] != 0,
                          params, grid, M, n_grid, span, hi[i] - lo[i], out_t, out_b, out_m, cnt, fam, fcnt, i,
@@ -1323,6 +1344,9 @@ def edge_zeros(reduction, poses: Array, lo: Array, hi: Array) -> Array:
         cand, _ = search(reduction, poses, lo, hi, N_SAMPLES, None, multiplicity=False)
     else:
         cand, _ = _ref.find_candidates(reduction, poses, lo, hi, N_SAMPLES)
+    if reduction.periodic:  # (wrapped as samples are, then moved inside: wrapping can move a zero outside)
+        cand = candidates.Candidates(cand.pose, cand.branch, candidates.wrapped(cand.theta), cand.mult)
+    cand = inside_zeros(reduction, poses, cand, EDGE_PROBE_REL * (hi - lo))
     if N == 1:
         return cand.theta[None, :]
     counts = np.bincount(cand.pose, minlength=N)
@@ -1331,6 +1355,33 @@ def edge_zeros(reduction, poses: Array, lo: Array, hi: Array) -> Array:
     slot = np.arange(cand.pose.size) - np.repeat(np.cumsum(counts) - counts, counts)
     out[cand.pose[order], slot] = cand.theta[order]
     return out
+
+
+def inside_zeros(reduction, poses: Array, cand: candidates.Candidates, reach: Array) -> candidates.Candidates:
+    """The zeros ``cand`` of a margin ``reduction`` (``Reduction.edge_reduction``) each on its margin's
+    non-negative side, as the compiled one-pass search places them (``_inside``; ``reach (N,)`` per pose): a domain
+    edge's sample outside the domain is NaN for the branches it bounds, and the stretch from it to the next sample
+    would go unsearched."""
+    if not cand.theta.size:
+        return cand
+    t = cand.theta.copy()
+
+    def margin(k: NDArray[np.intp], x: Array) -> Array:
+        return np.asarray(reduction.residual_rows(poses, cand.pose[k], x[:, None], cand.branch[k, None]))[:, 0]
+
+    k = np.arange(t.size)
+    k = k[margin(k, t) < 0.0]  # the zeros still outside
+    d = reach[cand.pose[k]] * 2.0 ** (1 - EDGE_NUDGES)
+    for _ in range(EDGE_NUDGES):
+        for sign in (1.0, -1.0):
+            if not k.size:
+                return candidates.Candidates(cand.pose, cand.branch, t, cand.mult)
+            x = t[k] + sign * d
+            ok = margin(k, x) >= 0.0
+            t[k[ok]] = x[ok]
+            k, d = k[~ok], d[~ok]
+        d = 2.0 * d
+    return candidates.Candidates(cand.pose, cand.branch, t, cand.mult)
 
 
 candidates.set_edge_zeros(edge_zeros)

@@ -154,6 +154,11 @@ FAR_NOISE = 1e12
 #: finite this far past it (relative to the theta* range): the first level then judges the interval beside it in that
 #: edge's coordinate, as the levels below do (``BEND``).
 EDGE_PROBE_REL = 1e-9
+#: A margin's zero (a domain edge, ``Reduction.edge_reduction``) found a rounding step outside the domain is moved
+#: onto its inside (margin >= 0) before it becomes a sample, by the least of ``EDGE_PROBE_REL x range x 2^-k``,
+#: k = EDGE_NUDGES - 1 ... 0, that gets there: a sample outside is NaN for the branches the edge bounds, and the
+#: stretch from it to the next sample would go unsearched (an extremum touching zero there was missed).
+EDGE_NUDGES = 24
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
 XTOL_REL = 1e-16
 #: Half-step of the central difference used to locate extrema, relative to the theta* range.
@@ -185,8 +190,11 @@ J_CUTOFF_FACTOR = 1e-4
 
 # The Newton polish (polish.py)
 
-#: Newton steps at most (a step that does not lower the error ends a configuration's polish).
-ITERATIONS = 8
+#: Newton steps at most (a step that does not lower the error ends a configuration's polish). Next to a double root
+#: on a singular set the steps drop the small singular direction and creep along the valley (5-10 % of the error a
+#: step): an I2RT YAM written with other axis signs had its candidates 4e-5 rad off the root at 1.5e-11 of the arm,
+#: certified after 11 steps; 8 left them uncertified and the pose without a solution. Regular roots take 2-4.
+ITERATIONS = 16
 #: A Newton step that raises the error is halved up to this many times (backtracking): next to a fold of the
 #: arm's workspace (an elbow nearly straight) the full step overshoots, a shorter one converges. Where the arm loses
 #: two ranks (a KR 6 with its wrist centre on axis 1 and its elbow straight) the step from a member interpolated
