@@ -53,7 +53,7 @@ def main() -> None:
     robots = [sweepik.load_robot(n) for n in (args.arms or sweepik.bundled_robots())]
     if args.ssik:
         import ssik
-        from ssik_catalogue import robot_from_ssik
+        from catalogue import robot_from_ssik
 
         robots += [robot_from_ssik(a.name) for a in ssik.list_arms() if a.dof == 7]
     if args.only:

@@ -17,7 +17,6 @@ the recall must not change.
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 import time
 from pathlib import Path
@@ -26,51 +25,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
+from catalogue import check_fk, robot_from_ssik, ssik_module  # noqa: E402
 from rewrites import rewrite  # noqa: E402
 from singular import recovered, singular_configurations  # noqa: E402
 
 import sweepik  # noqa: E402
-from sweepik.model.robot import Joint, Robot  # noqa: E402
-
-
-def ssik_module(name: str):  # type: ignore[no-untyped-def]
-    import ssik
-
-    entry = next(a for a in ssik.list_arms() if a.name == name)
-    return importlib.import_module(entry.import_path)
-
-
-def _tuple(T: np.ndarray) -> tuple[tuple[float, ...], ...]:
-    return tuple(tuple(float(v) for v in row) for row in T)
-
-
-def robot_from_ssik(name: str) -> Robot:
-    """The ssik artifact ``name`` as a sweepik robot (origin + axis, metres, limits from the artifact)."""
-    m = ssik_module(name)
-    joints = []
-    carry = np.eye(4)
-    for i, (ax, TL, TR, ty, lim) in enumerate(
-        zip(m._JOINT_AXES, m._JOINT_T_LEFTS, m._JOINT_T_RIGHTS, m._JOINT_TYPES, m._JOINT_LIMITS, strict=True)
-    ):
-        typ = "revolute" if ty in ("revolute", "continuous") else "prismatic"
-        joints.append(
-            Joint(
-                typ,
-                origin=_tuple(carry @ np.asarray(TL)),
-                axis=tuple(float(v) for v in ax),
-                lower=-np.pi if lim is None else float(lim[0]),
-                upper=np.pi if lim is None else float(lim[1]),
-                name=str(m._JOINT_NAMES[i]),
-            )
-        )
-        carry = np.asarray(TR, dtype=np.float64)
-    return Robot(name.removesuffix("_ik"), tuple(joints), "none", T_flange_tool=carry, length_unit="m")
-
-
-def check_fk(robot: Robot, name: str, rng: np.random.Generator) -> float:
-    m = ssik_module(name)
-    Q = rng.uniform(-np.pi, np.pi, (20, robot.n_joints))
-    return max(float(np.abs(robot.fk(q) - m.fk(q)).max()) for q in Q)
+from sweepik.model.robot import Robot  # noqa: E402
 
 
 def _root_near(robot: Robot, x: np.ndarray, T: np.ndarray) -> np.ndarray | None:

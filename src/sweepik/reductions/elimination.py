@@ -515,7 +515,9 @@ def _polish(H, P, rev, R_end, q0, RT, pT, max_iter, tol):
         step, pr = _solve6(J, r)
         if nr < tol:
             break
-        if it >= 6 and nr > 1e-6:  # no real root near this start (e.g. a complex candidate): give up
+        # no real root near this start (e.g. a complex candidate): give up (from a complex pair's real part a double
+        # root is still ~1e-5 away after 6 steps)
+        if it >= 6 and nr > 1e-4:
             break
         improved = False
         smallstep = False
@@ -1174,8 +1176,10 @@ class IKResult:
     info: dict
 
 
-# candidate filter: |Im theta_e| (approx.) under this is tried (Newton decides)
-IMAG_TOL = 5e-3
+# candidate filter: |Im theta_e| (approx.) under this is tried (Newton decides). Next to a singular set a double root
+# of the eigen-joint comes out as a complex pair: 0.008 ... 0.02 apart on the I2RT big YAM (joints 2-4 parallel to
+# 3e-6 rad), whose roots there were lost at 5e-3.
+IMAG_TOL = 5e-2
 # two configurations closer than this (max-norm; angles mod 2 pi, lengths / arm size) are one solution
 MERGE_TOL = 1e-6
 # FK acceptance (relative to arm size for positions, radians for rotations)
@@ -1521,14 +1525,14 @@ class GeneralIK:
         # polish, an odd number of solutions (the real roots of a real polynomial come in an even number:
         # odd means a double root or a lost one)
         sing = info.get("singular_pencil", False)
-        suspicious = sing or info["n_real_fail"] > 0 or len(sols) % 2 == 1
-        continuum = False
         n_singular = info.get("n_singular", 0)
+        suspicious = sing or info["n_real_fail"] > 0 or len(sols) % 2 == 1 or n_singular > 0
+        continuum = False
         if suspicious:
             allsing = sing
-            # an odd count explained by a double root (a solution with a singular Jacobian) gets one second
-            # opinion; the other triggers up to two
-            n_more = 1 if (not sing and info["n_real_fail"] == 0 and n_singular > 0) else 2
+            # up to two: a solution with a singular Jacobian (a double root) may have lost a near-double pair that
+            # rounding made complex (an even count, every root polished: the I2RT big YAM's singular set)
+            n_more = 2
             for a in self.arrangements[1 : 1 + n_more]:
                 s2, i2 = self._solve_with(a, RT, pT)
                 infos.append(i2)
@@ -1537,7 +1541,7 @@ class GeneralIK:
                 sols = sols[_merge_nb(sols, self.rev, MERGE_TOL)]
                 s2sing = i2.get("singular_pencil", False)
                 allsing = allsing and s2sing
-                if not s2sing and i2["n_real_fail"] == 0 and len(s2) % 2 == 0:
+                if not s2sing and i2["n_real_fail"] == 0 and len(s2) % 2 == 0 and not i2.get("n_singular", 0):
                     break
             continuum = allsing
         if n_singular:
