@@ -7,9 +7,9 @@ For every joint and every lock value ``analyze(robot)["locks"]`` lists, ``--n`` 
 at that value (the others uniform within their limits, or over one turn) are solved with the joint locked, limits
 off; the configuration must come back (``tests/singular.recovered``). A lock ``analyze`` says nothing solves must be
 refused by ``solve`` with NoReductionError (never answered wrongly). ``--ssik``: the 7-joint arms of ssik 8.2's
-prebuilt catalogue too (built as ``scripts/ssik_catalogue.py`` does); ``--only``: the arms whose name contains one of
-these. ``--numerical K``: the solution sets of the first K configurations of each lock are compared with a
-many-start numerical search's on the held arm (``oracles.numerical_solutions``, sets equal to 1e-4; both see the
+prebuilt catalogue too (``tests/catalogue.py``); ``--only``: the arms whose name contains one of these.
+``--numerical K``: the solution sets of the first K configurations of each lock are compared with a many-start
+numerical search's on the held arm (``oracles.numerical_solutions``, sets equal to 1e-4; both see the
 joints over one turn).
 """
 
@@ -23,7 +23,6 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from oracles import numerical_solutions, same_solution_set  # noqa: E402
 from singular import recovered  # noqa: E402
