@@ -5,7 +5,9 @@ exact plan can still be useless in floating point. Vendors' descriptions are rou
 wrist centre 25 um off an axis, two axes "meeting" 40 km away. A plan that sweeps across such a near-structure has a
 residual whose branch domains shrink to 1e-4 rad or whose roots come in pairs 1e-5 rad apart, and the sweep misses
 them: the Doosan M0609 swept on joint 1 found 0 of 8 solutions on 5 poses in 20 while the same arm swept on joint 4
-found all (issue 35).
+found all (issue 35). (Much of that was the sweep's, not the plan's: a domain edge's sample a rounding step outside
+its domain left the stretch beside it unsearched; with edges moved inside, ``search.inside_zeros``, the joint-1 sweep
+recovers all 64 of the check, and the M0609 is solved by both sweeps, one the other's companion: ~2 times the time.)
 
 So where an arm has a near-structure (``structure.near_structure``: a relation that holds to ``NEAR_TOL`` but not
 exactly), the automatic decomposition checks every plan it could choose on ``N_CHECK`` configurations drawn once per

@@ -37,6 +37,7 @@ from sweepik.engine.settings import (
     DIFF_LEVELS,
     DIFF_SHRINK,
     DIFF_STEP_REL,
+    EDGE_MARGIN,
     EDGE_NUDGES,
     EDGE_PROBE_REL,
     EXTREMUM_REACH,
@@ -259,8 +260,10 @@ if AVAILABLE:
     def _inside(res, p, x, b, reach):
         """A margin's zero ``x`` (branch ``b``) on the margin's non-negative side: itself if it is there, else moved by
         the least of ``reach 2^-k`` (k = EDGE_NUDGES - 1 ... 0) that gets there, up first (``inside_zeros``, the
-        NumPy twin); ``x`` where neither side is (a domain narrower than that)."""
-        if not res(p, x, b) < 0.0:
+        NumPy twin); ``x`` where neither side is (a domain narrower than that), and where its margin is below
+        ``-EDGE_MARGIN`` (no zero: a sample next to the margin's own NaN, a range end)."""
+        m = res(p, x, b)
+        if not (m < 0.0 and m >= -EDGE_MARGIN):  # (inside, or no edge: a sample next to the margin's own NaN)
             return x
         d = reach * 2.0 ** (1 - EDGE_NUDGES)
         for _ in range(EDGE_NUDGES):
@@ -1370,7 +1373,8 @@ def inside_zeros(reduction, poses: Array, cand: candidates.Candidates, reach: Ar
         return np.asarray(reduction.residual_rows(poses, cand.pose[k], x[:, None], cand.branch[k, None]))[:, 0]
 
     k = np.arange(t.size)
-    k = k[margin(k, t) < 0.0]  # the zeros still outside
+    m = margin(k, t)
+    k = k[(m < 0.0) & (m >= -EDGE_MARGIN)]  # the zeros still outside (``_inside``)
     d = reach[cand.pose[k]] * 2.0 ** (1 - EDGE_NUDGES)
     for _ in range(EDGE_NUDGES):
         for sign in (1.0, -1.0):

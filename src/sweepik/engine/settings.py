@@ -159,6 +159,10 @@ EDGE_PROBE_REL = 1e-9
 #: k = EDGE_NUDGES - 1 ... 0, that gets there: a sample outside is NaN for the branches the edge bounds, and the
 #: stretch from it to the next sample would go unsearched (an extremum touching zero there was missed).
 EDGE_NUDGES = 24
+#: ... only a zero whose margin is within this below 0 (a rounding step outside: 2e-11 ... 5e-10 seen; the margins'
+#: search also gives samples next to a margin's own NaN and the range's ends, which no nudge moves inside, and trying
+#: them all made a Doosan M0609's solve 2-3 times slower).
+EDGE_MARGIN = 1e-8
 #: Root tolerance relative to the theta* range (2000 mm -> 2e-13 mm, 2 pi -> 6e-16 rad).
 XTOL_REL = 1e-16
 #: Half-step of the central difference used to locate extrema, relative to the theta* range.
