@@ -1340,8 +1340,9 @@ def search(
 
 def edge_zeros(reduction, poses: Array, lo: Array, hi: Array) -> Array:
     """Zeros ``(N, K)`` (NaN-padded) of ``reduction``'s residual over ``[lo, hi]`` (``(N,)`` each), without their
-    multiplicities: the domain edges a reduction's ``edge_reduction`` describes (``candidates.grid_hints``). Compiled;
-    the NumPy reference without Numba."""
+    multiplicities: the domain edges a reduction's ``edge_reduction`` describes (``candidates.grid_hints``), wrapped
+    into [-pi, pi] for a periodic theta* and each on its domain's side (``inside_zeros``). Compiled; the NumPy
+    reference without Numba."""
     N = poses.shape[0]
     if AVAILABLE:
         cand, _ = search(reduction, poses, lo, hi, N_SAMPLES, None, multiplicity=False)
