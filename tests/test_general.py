@@ -168,6 +168,24 @@ def test_iter_solve_and_single_poses_equal_the_batch() -> None:
         assert list(a.multiplicity) == list(b.multiplicity)
 
 
+def test_a_solve_keeps_no_roots_for_the_next_call() -> None:
+    """The elimination's roots are kept while a chunk is solved (the engine asks for them several times) and dropped
+    after it: solving the same poses again solves them again (a benchmark repeating its poses times the solve), and
+    gives the same solutions."""
+    robot = random_arm("6r", 0)
+    red = sweepik.reductions.get_reduction(robot, "auto")
+    T = robot.fk(poses_of(robot, 12, 0, seed=9))
+    first = sweepik.solve_many(robot, T, reduction=red, limits=False)
+    assert red._last is None and not red._kept
+    calls = []
+    solve_new = red._solve_new
+    red._solve_new = lambda flat, keys: calls.append(len(keys)) or solve_new(flat, keys)
+    again = sweepik.solve_many(robot, T, reduction=red, limits=False)
+    assert sum(calls) == len(T) and not red._kept
+    for a, b in zip(first, again, strict=True):
+        assert np.array_equal(a.q, b.q)
+
+
 def test_design_and_bench_take_an_arm_without_structure() -> None:
     """``compare_designs`` and ``bench_arms`` measure an arm that only the general method solves."""
     from sweepik.experiments.bench import bench_arms

@@ -21,7 +21,7 @@ from sweepik import load_robot, solve
 from sweepik.io.robot_file import bundled_robots
 from sweepik.model.origin_axis import origin_axis_form
 from sweepik.model.structure import NEAR_TOL, PARALLEL_TOL, near_structure
-from sweepik.plan_check import N_CHECK, check_plan
+from sweepik.plan_check import N_CHECK, PlanCheck, check_plan
 from sweepik.reductions import decompose
 
 
@@ -123,3 +123,14 @@ def test_nearly_coaxial_axes_are_a_near_structure() -> None:
     assert any("2≈≡3" in t for t in near_structure(arm.chain, arm.length_scale))
     with pytest.raises(sweepik.NoReductionError, match="continuum"):
         solve(arm, arm.fk(np.zeros(6)))
+
+
+def test_of_plans_that_check_alike_a_clearly_faster_one_is_chosen() -> None:
+    """``decompose.cheapest``: the better ranked plan unless another's check took under ``FASTER`` of its time (a
+    nearer gap is this machine's noise and would flip the choice from run to run)."""
+    ur5 = decompose.plans(load_robot("ur5"))
+    a, b, c = (PlanCheck(p, 64, 64, 512, 0, s) for p, s in zip(ur5[:3], (0.010, 0.006, 0.004), strict=True))
+    assert decompose.cheapest([a, b]) is a  # (0.6 of the time: within the noise)
+    assert decompose.cheapest([a, b, c]) is c
+    assert decompose.cheapest([c, a]) is c
+    assert a == PlanCheck(a.plan, 64, 64, 512, 0, 1.0)  # (the time is not part of the result)

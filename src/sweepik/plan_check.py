@@ -22,13 +22,15 @@ the first time. An arm without a near-structure takes the ranking's first plan u
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
 
 from sweepik.model.robot import Robot
 from sweepik.reductions import Plan, reduction_for, set_plan_check
+from sweepik.reductions.decompose import cheapest
 from sweepik.solving import solve_many
 
 __all__ = ["N_CHECK", "N_QUICK", "RECOVER_TOL", "PlanCheck", "check_plan", "checked_choice"]
@@ -55,6 +57,8 @@ class PlanCheck:
     checked: int
     solutions: int
     families: int
+    #: Wall time of the check's batch after its first configuration (the first loads the plan's kernels), s.
+    seconds: float = field(default=0.0, compare=False)
 
     @property
     def score(self) -> tuple[int, int]:
@@ -83,7 +87,12 @@ def check_configurations(robot: Robot, n: int = N_CHECK) -> np.ndarray:
 def check_plan(robot: Robot, plan: Plan, n: int = N_CHECK) -> PlanCheck:
     """Solve ``FK(q)`` with ``plan`` (limits off) for ``n`` configurations of the check and count those given back."""
     Q = check_configurations(robot, n)
-    batch = solve_many(robot, robot.fk(Q), reduction=reduction_for(robot, plan), limits=False)
+    red, poses = reduction_for(robot, plan), robot.fk(Q)
+    first = solve_many(robot, poses[:1], reduction=red, limits=False)
+    t0 = time.perf_counter()
+    rest = solve_many(robot, poses[1:], reduction=red, limits=False)
+    seconds = time.perf_counter() - t0
+    batch = [*first, *rest]
     found = 0
     n_solutions = sum(len(s) for s in batch)
     n_families = sum(len(s.families) for s in batch)
@@ -93,14 +102,14 @@ def check_plan(robot: Robot, plan: Plan, n: int = N_CHECK) -> PlanCheck:
         d = sols.nearest(q) - q
         d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
         found += bool(np.max(np.abs(d)) < RECOVER_TOL)
-    return PlanCheck(plan, found, len(Q), n_solutions, n_families)
+    return PlanCheck(plan, found, len(Q), n_solutions, n_families, seconds)
 
 
 def checked_choice(
     robot: Robot, options: tuple[Plan, ...], hints: tuple[Plan, ...] = ()
 ) -> tuple[Plan, tuple[PlanCheck, ...]]:
-    """The plan of ``options`` (best ranked first) with the best ``PlanCheck.score`` (ties: the better ranked), with
-    every plan's check (in the order of ``options``). The first of ``hints`` (plans of ``options``) that gives back
+    """The plan of ``options`` (best ranked first) with the best ``PlanCheck.score`` (ties: ``decompose.cheapest``),
+    with every plan's check (in the order of ``options``). The first of ``hints`` (plans of ``options``) that gives back
     all of ``N_QUICK`` configurations is taken instead, with the quick checks made."""
     quick: list[PlanCheck] = []
     for hint in hints:
@@ -108,8 +117,8 @@ def checked_choice(
         if quick[-1].passed:
             return hint, tuple(quick)
     checks = tuple(check_plan(robot, plan) for plan in options)
-    best = max(checks, key=lambda c: c.score)  # (max keeps the first of equals: the better ranked)
-    return best.plan, checks
+    top = max(c.score for c in checks)
+    return cheapest([c for c in checks if c.score == top]).plan, checks
 
 
 set_plan_check(checked_choice)

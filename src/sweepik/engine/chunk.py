@@ -136,11 +136,17 @@ def solve_chunk(
     """The solutions of the chunk ``poses``; ``one_call``: a single pose may take the one compiled call (False: the
     caller found that it cannot). A reduction with a ``companion`` (an arm with a near-structure): both solve, and
     the companion's solutions that the first lacks are joined (:mod:`.companion`)."""
-    block = _solve_chunk_by(robot, red, poses, strategy, limits, n_samples, use_fallback, one_call)
     comp = getattr(red, "companion", None)
-    if comp is None or strategy != "precise":
-        return block
-    return joined(block, _solve_chunk_by(robot, comp, poses, strategy, limits, n_samples, use_fallback, False))
+    try:
+        block = _solve_chunk_by(robot, red, poses, strategy, limits, n_samples, use_fallback, one_call)
+        if comp is None or strategy != "precise":
+            return block
+        return joined(block, _solve_chunk_by(robot, comp, poses, strategy, limits, n_samples, use_fallback, False))
+    finally:  # (what the reductions kept for these poses: dropped)
+        chain = chain_poses(robot, poses)
+        for r in (red, comp):
+            if r is not None:
+                r.release(chain)
 
 
 @dataclasses.dataclass

@@ -140,6 +140,12 @@ class Reduction(ABC):
         """Per-pose parameters ``(N, P)`` of the compiled kernels (only with ``kernel``)."""
         raise NotImplementedError
 
+    def release(self, poses: Array) -> None:
+        """Forget what was kept for the chain poses ``poses`` while their chunk was solved (the engine calls it
+        when the chunk is done; default: nothing is kept). A later call with the same poses works them out anew, so
+        a benchmark that solves the same poses again times the solve, not a lookup."""
+        return None
+
     def __init__(self, robot: Robot, free_joint: int, n_branches: int) -> None:
         self.robot = robot
         self.free_joint = int(free_joint)

@@ -116,19 +116,15 @@ class GeneralReduction(Reduction):
     def kernel_params(self, poses: Array) -> Array:
         """``(N, MAX_SOLUTIONS * n + 1)`` per chain pose: its roots (row-major, NaN-padded), then 1.0 where it is
         a continuum (``continuum_poses``). Each distinct pose is solved once: the engine asks for rows of the same
-        poses several times, so the rows of the last ``_ROOTS_KEPT`` distinct poses are kept by value."""
-        last = self._last
-        if last is not None and (last[1] is poses or (last[0].shape == poses.shape and np.array_equal(last[0], poses))):
-            return last[2]
+        poses several times, so the rows of the last ``_ROOTS_KEPT`` distinct poses are kept by value until their
+        chunk is done (``release``)."""
+        if self._is_last(poses):
+            assert self._last is not None
+            return self._last[2]
         robot = self.robot
-        world = poses
-        if not robot.base_is_identity:
-            world = robot.T_world_base @ world
-        world = world @ robot.T_flange_tool
-        flat = np.ascontiguousarray(world.reshape(world.shape[0], 16))
+        flat, keys = self._keys(poses)
         n = robot.n_joints
         rows = np.empty((flat.shape[0], MAX_SOLUTIONS * n + 1))
-        keys = [pose.tobytes() for pose in flat]
         got = [self._kept.get(key) for key in keys]  # (read once: another thread's chunk may evict them)
         new: dict[bytes, int] = {}
         for i, (key, row) in enumerate(zip(keys, got, strict=True)):
@@ -139,6 +135,27 @@ class GeneralReduction(Reduction):
             rows[i] = solved[key] if row is None else row
         self._last = (poses.copy(), poses, rows)
         return rows
+
+    def _is_last(self, poses: Array) -> bool:
+        last = self._last
+        return last is not None and (
+            last[1] is poses or (last[0].shape == poses.shape and np.array_equal(last[0], poses))
+        )
+
+    def release(self, poses: Array) -> None:
+        if self._is_last(poses):
+            self._last = None
+        for key in self._keys(poses)[1]:
+            self._kept.pop(key, None)
+
+    def _keys(self, poses: Array) -> tuple[Array, list[bytes]]:
+        """The chain poses ``poses`` in the world frame of the chain, flat ``(N, 16)``, and their keys."""
+        world = poses
+        if not self.robot.base_is_identity:
+            world = self.robot.T_world_base @ world
+        world = world @ self.robot.T_flange_tool
+        flat = np.ascontiguousarray(world.reshape(world.shape[0], 16))
+        return flat, [pose.tobytes() for pose in flat]
 
     def _solve_new(self, flat: Array, keys: list[bytes]) -> Array:
         """The rows of the distinct poses ``flat (U, 16)`` (the world frame of the chain), kept under ``keys`` too: by
