@@ -27,7 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 from catalogue import check_fk, robot_from_ssik, ssik_module  # noqa: E402
 from rewrites import rewrite  # noqa: E402
-from singular import recovered, singular_configurations  # noqa: E402
+from singular import one_root, recovered, singular_configurations  # noqa: E402
 
 import sweepik  # noqa: E402
 from sweepik.model.robot import Robot  # noqa: E402
@@ -60,11 +60,16 @@ class Agreement:
     a root of the pose that sweepik's answer does not hold (``singular.recovered``: the same root to the precision the
     pose fixes it, an arc of rounding-level solutions included) it is a miss of sweepik's, else ssik's error (a
     configuration missing the pose by 1e-10 ... 1e-6, or a second copy of a root sweepik has). One only sweepik has
-    (each passed sweepik's certification) is a miss of ssik's. Poses with a continuum are counted apart."""
+    (each passed sweepik's certification) is a miss of ssik's, unless it is the same root as another of sweepik's
+    solutions (``singular.one_root``: a second copy, counted apart as ``close``). Poses with a continuum are counted apart.
+
+    ``same``: poses whose two sets match solution for solution; ``right``: poses where sweepik lacks no root ssik
+    found and gives none twice (the differences left are ssik's: a solution off the pose, a second copy, a
+    root it lacks)."""
 
     def __init__(self) -> None:
-        self.same = self.poses = self.continua = 0
-        self.ssik_only_ok = self.ssik_only_bad = self.ours_only = 0
+        self.same = self.right = self.poses = self.continua = 0
+        self.ssik_only_ok = self.ssik_only_bad = self.ours_only = self.close = 0
 
     def add(self, name: str, robot: Robot, solver_robot: Robot, q: np.ndarray, sols, rw) -> None:  # type: ignore[no-untyped-def]
         from oracles import unmatched_solutions
@@ -81,12 +86,19 @@ class Agreement:
         self.poses += 1
         self.same += not (extra_ours or extra_theirs)
         self.ours_only += len(extra_ours)
+        close = sum(
+            any(one_root(solver_robot, x, s) for s in sols.q if np.any(s != x)) for x in map(np.asarray, extra_ours)
+        )
+        self.close += close
         T = solver_robot.fk(rw.forward(q[None])[0] if rw is not None else q)
+        lacks = 0
         for x in extra_theirs:
             root = _root_near(solver_robot, x, T)
             missed = root is not None and not recovered(solver_robot, sols, root)
-            self.ssik_only_ok += missed
+            lacks += missed
             self.ssik_only_bad += not missed
+        self.ssik_only_ok += lacks
+        self.right += not (lacks or close)
 
     def merge(self, other: Agreement) -> None:
         for k, v in vars(other).items():
@@ -96,8 +108,9 @@ class Agreement:
         if not (self.poses or self.continua):
             return ""
         return (
-            f"  same sets {self.same}/{self.poses} (continua {self.continua}); only ssik: {self.ssik_only_ok} roots "
-            f"sweepik lacks, {self.ssik_only_bad} not; only sweepik {self.ours_only}"
+            f"  same sets {self.same}/{self.poses}, sweepik's right {self.right} (continua {self.continua}); only "
+            f"ssik: {self.ssik_only_ok} roots sweepik lacks, {self.ssik_only_bad} not; only sweepik {self.ours_only} "
+            f"({self.close} the same root as another)"
         )
 
 

@@ -51,3 +51,16 @@ def check_fk(robot: Robot, name: str, rng: np.random.Generator) -> float:
     m = ssik_module(name)
     Q = rng.uniform(-np.pi, np.pi, (20, robot.n_joints))
     return max(float(np.abs(robot.fk(q) - m.fk(q)).max()) for q in Q)
+
+
+def catalogue_configurations(name: str, n: int = 200, n_singular: int = 50) -> tuple[Robot, np.ndarray]:
+    """ssik's arm ``name`` as a sweepik robot and the configurations ``scripts/ssik_catalogue.py --n n --singular
+    n_singular`` draws for it (seed 0): ``n`` uniform over a turn, then ``n_singular`` on and next to its singular
+    set."""
+    from singular import singular_configurations
+
+    robot = robot_from_ssik(name)
+    rng = np.random.default_rng(0)
+    rng.uniform(-np.pi, np.pi, (20, 6))  # (``check_fk``'s draw)
+    Q = rng.uniform(-np.pi, np.pi, (n, 6))
+    return robot, np.concatenate([Q, singular_configurations(robot, n_singular, rng)])

@@ -77,7 +77,11 @@ def recovered(robot: Any, sols: Any, q: np.ndarray, tol: float = 1e-6) -> bool:
     """``q`` is among ``sols`` (a ``sweepik.Solutions``) as the module docstring says."""
     if not (len(sols) or sols.families):
         return False
-    s = sols.nearest(q)
+    return same_root(robot, q, sols.nearest(q), tol)
+
+
+def same_root(robot: Any, q: np.ndarray, s: np.ndarray, tol: float = 1e-6) -> bool:
+    """``q`` and the solution ``s`` are the same root of ``FK(q)`` as the module docstring says."""
     d = s - q
     d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
     if np.max(np.abs(d)) < tol:
@@ -88,6 +92,21 @@ def recovered(robot: Any, sols: Any, q: np.ndarray, tol: float = 1e-6) -> bool:
     if np.all(_geodesic(robot, between, T) <= SAME_ROOT_REL * robot.length_scale):
         return True
     return bool(np.max(np.abs(d)) <= ARC_REACH and _on_one_arc(robot, q, s, T))
+
+
+def one_root(robot: Any, q: np.ndarray, s: np.ndarray) -> bool:
+    """Two solutions ``q`` and ``s`` of ``FK(q)`` are one root to the precision the pose fixes it, strictly: their
+    midpoint solves the pose no worse than a few times the worse of them (or than FK's rounding,
+    ``ARC_ROUNDING_REL``), or an arc of solutions joins them (``_on_one_arc``). Two roots 1e-6 apart next to a fold
+    (each solving the pose to 1e-16, their midpoint to 5e-13) are two; ``same_root`` takes them as one."""
+    T = robot.fk(q)
+    s = q + np.where(robot.is_revolute, np.angle(np.exp(1j * (s - q))), s - q)
+    ends = float(np.max(_geodesic(robot, np.stack([q, s]), T)))
+    mid = float(_geodesic(robot, (0.5 * (q + s))[None], T)[0])
+    if mid <= max(4.0 * ends, ARC_ROUNDING_REL * robot.length_scale):
+        return True
+    d = np.abs(s - q) / np.where(robot.is_revolute, 1.0, robot.length_scale)
+    return bool(np.max(d) <= ARC_REACH and _on_one_arc(robot, q, s, T))
 
 
 def _on_one_arc(robot: Any, q: np.ndarray, s: np.ndarray, T: np.ndarray) -> bool:

@@ -317,3 +317,27 @@ def test_two_roots_next_to_the_elbow_fold_stay_two() -> None:
     sols = solve(robot, robot.fk(q), limits=False)
     assert recovered(robot, sols, q)
     assert np.all(sols.multiplicity == 1)
+
+
+@pytest.mark.parametrize("name", ["piper_ik", "m1013_ik"])
+def test_a_sweep_gives_no_root_twice_on_a_vendor_arms_singular_set(name: str) -> None:
+    """ssik's AgileX Piper and Doosan M1013 (swept; the M1013 with a companion plan) on the 50 configurations on and
+    next to their singular sets that ``scripts/ssik_catalogue.py --singular 50`` draws: next to a fold a double root is
+    a flat valley solving the pose to rounding, which the sweep reached from several samples and branches, each polish
+    stopping elsewhere in it (a Piper pose gave five points 1e-6 ... 1e-5 apart, each of multiplicity 2; 19 and 20
+    such copies on the 250 poses before ``settle.meetings`` took sweeps). No two solutions of a pose are one root
+    (``singular.one_root``: their midpoint, or an arc between them, solves the pose as well as they do), and every
+    configuration comes back."""
+    pytest.importorskip("ssik")
+    from catalogue import catalogue_configurations
+    from singular import one_root, recovered
+
+    robot, Q = catalogue_configurations(name)
+    twice = []
+    for k, q in enumerate(Q[200:]):
+        s = solve(robot, robot.fk(q), limits=False)
+        assert recovered(robot, s, q), (name, k)
+        if s.families:
+            continue
+        twice += [(k, a, b) for a in range(len(s)) for b in range(a + 1, len(s)) if one_root(robot, s.q[a], s.q[b])]
+    assert not twice

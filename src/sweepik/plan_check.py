@@ -22,12 +22,12 @@ the first time. An arm without a near-structure takes the ranking's first plan u
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
+from sweepik.engine.chunk import counting_stepwise
 from sweepik.model.robot import Robot
 from sweepik.reductions import Plan, reduction_for, set_plan_check
 from sweepik.reductions.decompose import cheapest
@@ -57,8 +57,9 @@ class PlanCheck:
     checked: int
     solutions: int
     families: int
-    #: Wall time of the check's batch after its first configuration (the first loads the plan's kernels), s.
-    seconds: float = field(default=0.0, compare=False)
+    #: Configurations whose candidates needed Newton steps (``chunk.counting_stepwise``; the general method polishes
+    #: every root inside its elimination: all of them): what a plan costs beyond its sweep (``decompose.cheapest``).
+    polished: int = 0
 
     @property
     def score(self) -> tuple[int, int]:
@@ -87,12 +88,9 @@ def check_configurations(robot: Robot, n: int = N_CHECK) -> np.ndarray:
 def check_plan(robot: Robot, plan: Plan, n: int = N_CHECK) -> PlanCheck:
     """Solve ``FK(q)`` with ``plan`` (limits off) for ``n`` configurations of the check and count those given back."""
     Q = check_configurations(robot, n)
-    red, poses = reduction_for(robot, plan), robot.fk(Q)
-    first = solve_many(robot, poses[:1], reduction=red, limits=False)
-    t0 = time.perf_counter()
-    rest = solve_many(robot, poses[1:], reduction=red, limits=False)
-    seconds = time.perf_counter() - t0
-    batch = [*first, *rest]
+    with counting_stepwise() as stepwise:
+        batch = solve_many(robot, robot.fk(Q), reduction=reduction_for(robot, plan), limits=False)
+    polished = len(Q) if plan.family == "general" else stepwise[0]
     found = 0
     n_solutions = sum(len(s) for s in batch)
     n_families = sum(len(s.families) for s in batch)
@@ -102,7 +100,7 @@ def check_plan(robot: Robot, plan: Plan, n: int = N_CHECK) -> PlanCheck:
         d = sols.nearest(q) - q
         d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
         found += bool(np.max(np.abs(d)) < RECOVER_TOL)
-    return PlanCheck(plan, found, len(Q), n_solutions, n_families, seconds)
+    return PlanCheck(plan, found, len(Q), n_solutions, n_families, polished)
 
 
 def checked_choice(

@@ -4,8 +4,10 @@ answer, and the block of results; a single pose in one compiled call where it ca
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
+from collections.abc import Iterator
 from functools import lru_cache
 
 import numpy as np
@@ -15,7 +17,7 @@ from sweepik.engine import certify, one_pose, search
 from sweepik.engine.candidates import Candidates, Spans, twin_copies
 from sweepik.engine.companion import joined
 from sweepik.engine.continuation import continuum_families
-from sweepik.engine.dedupe import finish, settle
+from sweepik.engine.dedupe import finish, near_pairs, settle
 from sweepik.engine.families import (
     MAX_ISOLATED_SOLUTIONS,
     collapse_continua,
@@ -34,8 +36,8 @@ from sweepik.engine.settings import (
     SEED_TOL_REL,
 )
 from sweepik.engine.settle import (
-    closed_form_meetings,
     errors_of,
+    meetings,
     next_to_folds,
     per_joint,
     settle_bounds,
@@ -202,8 +204,8 @@ def _solve_chunk_by(
     pose_idx, q, err_paper, err_geo, mult, inside, keep = _settled_rows(
         robot, red, poses, strategy, limits, n_samples, use_fallback, found
     )
-    if red.closed_form:
-        q, mult = closed_form_meetings(robot, poses, pose_idx, q, err_geo, err_paper, inside, keep, mult)
+    if red.closed_form or strategy == "precise":
+        q, mult = meetings(robot, poses, pose_idx, q, err_geo, err_paper, inside, keep, mult, red.closed_form)
     if strategy == "precise" and pose_idx.size > MAX_ISOLATED_SOLUTIONS:  # (fewer: no pose can hold a continuum)
         # a numerical continuum of certified solutions is reported once
         keep[keep] = collapse_continua(robot, pose_idx[keep], q[keep])
@@ -501,6 +503,10 @@ def settled(
         )
     if out is None or out.status != one_pose.OK or out.certified > MAX_ISOLATED_SOLUTIONS:
         return None
+    if not red.closed_form and out.q.shape[0] > 1:  # (two solutions that may be one root: merged stepwise)
+        one = np.zeros(out.q.shape[0], dtype=np.intp)
+        if near_pairs(robot, one, out.q, np.ones(one.size, dtype=np.bool_), per_joint(robot, MEET_REL)).size:
+            return None
     special, _ = special_solutions(red, chain)
     if special is not None and np.isfinite(special).all(-1).any():
         return None
@@ -521,6 +527,22 @@ def settled(
     return out
 
 
+#: While :func:`counting_stepwise` is active, the count of poses settled step by step (``_settle_stepwise``: their
+#: candidates needed a polish, the fallback reduction or a snap to the limits): the cost a plan check weighs.
+_stepwise_poses: list[int] | None = None
+
+
+@contextlib.contextmanager
+def counting_stepwise() -> Iterator[list[int]]:
+    """``[n]``: the poses settled step by step while the block runs (one thread: the check's batch is one chunk)."""
+    global _stepwise_poses
+    outer, _stepwise_poses = _stepwise_poses, [0]
+    try:
+        yield _stepwise_poses
+    finally:
+        _stepwise_poses = outer
+
+
 def _settle_stepwise(
     robot: Robot,
     red: Reduction,
@@ -539,6 +561,8 @@ def _settle_stepwise(
     polish of near misses, the certification, the fallback reduction for poses it could not certify, the snap of
     solutions just outside the limits (``dedupe.settle`` does the same in one compiled pass when none of these is
     due). Returns ``(pose_idx, q, err_paper, err_geo, mult, inside, keep)``."""
+    if _stepwise_poses is not None:
+        _stepwise_poses[0] += int(np.unique(pose_idx).size)
     weight = orientation_weight(robot.length_unit)
     finite = np.isfinite(q).all(axis=-1)
     if not finite.all():

@@ -7,16 +7,20 @@ Two plans sweeping different joints lose a root together far more rarely than on
 near-structure is solved by its chosen plan and its **companion** (``decompose.companion_plan``: the best checked
 plan sweeping another joint or the other chain), and the two answers are joined pose by pose: a solution of the
 companion is added where the first answer has none within the duplicate tolerance (``dedupe.DEDUPE_ANGLE``,
-``DEDUPE_LENGTH_REL``). Families are the first answer's. Arms without a near-structure have no companion and pay
-nothing.
+``DEDUPE_LENGTH_REL``), nor one that is the same root to the precision the pose fixes it (``settle.one_root``).
+Families are the first answer's. Arms without a near-structure have no companion and pay nothing.
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine.dedupe import DEDUPE_ANGLE, DEDUPE_LENGTH_REL
+from sweepik.engine.settings import MEET_REL
+from sweepik.engine.settle import one_root, per_joint
 from sweepik.results import Block
 
 __all__ = ["joined"]
@@ -26,8 +30,10 @@ def joined(first: Block, second: Block) -> Block:
     """``first`` with the solutions of ``second`` (the same poses) that it lacks added, pose by pose."""
     robot = first.robot
     tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
+    near = per_joint(robot, MEET_REL)
     take: list[NDArray[np.intp]] = []
     counts = np.zeros(first.n, dtype=np.intp)
+    mult = first.multiplicity
     for i in range(first.n):
         a = first.q[first.bounds[i] : first.bounds[i + 1]]
         b_rows = np.arange(second.bounds[i], second.bounds[i + 1])
@@ -36,13 +42,24 @@ def joined(first: Block, second: Block) -> Block:
         b = second.q[b_rows]
         if a.shape[0]:
             d = b[:, None, :] - a[None, :, :]
-            d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d)
-            new = ~np.any(np.all(np.abs(d) <= tol, axis=-1), axis=1)
+            d = np.abs(np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d))
+            new = ~np.any(np.all(d <= tol, axis=-1), axis=1)
+            # (one within MEET_REL of the first's may be the same root, to the precision the pose fixes it)
+            for k in np.flatnonzero(new & np.any(np.all(d <= near, axis=-1), axis=1)):
+                row = b_rows[k]
+                for j in np.flatnonzero(np.all(d[k] <= near, axis=-1)):
+                    at = first.bounds[i] + j
+                    ea, eb = first.error_geodesic[at], second.error_geodesic[row]
+                    if one_root(robot, first.poses[i], a[j], b[k], ea, eb) is not None:
+                        new[k] = False
+                        mult = mult.copy() if mult is first.multiplicity else mult
+                        mult[at] = max(mult[at], second.multiplicity[row], 2)
+                        break
             b_rows = b_rows[new]
         take.append(b_rows)
         counts[i] = b_rows.size
     if not counts.any():
-        return first
+        return first if mult is first.multiplicity else dataclasses.replace(first, multiplicity=mult)
     extra = np.concatenate(take)
     pose_of = np.concatenate(
         [np.repeat(np.arange(first.n), np.diff(first.bounds)), np.repeat(np.arange(first.n), counts)]
@@ -60,7 +77,7 @@ def joined(first: Block, second: Block) -> Block:
         error=both(first.error, second.error),
         error_geodesic=both(first.error_geodesic, second.error_geodesic),
         within_limits=both(first.within_limits, second.within_limits),
-        multiplicity=both(first.multiplicity, second.multiplicity),
+        multiplicity=both(mult, second.multiplicity),
         families=first.families,
         n_reachable=np.maximum(first.n_reachable, second.n_reachable),
         empty_reason=first.empty_reason,

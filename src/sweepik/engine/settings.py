@@ -77,6 +77,16 @@ MEET_NEAR = 1e-4
 #: 6e-4 apart, each 1e-16, midpoint 2.2e-16).
 MEET_ROUNDING_REL = 1e-15
 
+#: Passes over a pose's pairs of close solutions: a merged pair's root lies between them, so its pairs with the rest
+#: of a cluster (a flat valley next to the singular set: up to five points 1e-6 ... 1e-5 apart) are asked again.
+MEET_PASSES = 4
+
+#: Where a pair's midpoint misses the pose, the points of the segment between them (fractions of the way) corrected
+#: with the joint that moves most held: on one arc of solutions they solve the pose as the pair does (a valley that
+#: curves), between two roots they cannot. Newton steps of each correction.
+MEET_ARC = (0.25, 0.5, 0.75)
+MEET_ARC_STEPS = 12
+
 #: A family's end is at a joint limit when a joint of its member there is this close to it (radians; relative to
 #: the length scale for a slide): the limits cut it there (``family_join._cut_short``) ...
 AT_LIMIT = 1e-7

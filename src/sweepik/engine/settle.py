@@ -18,7 +18,10 @@ from sweepik.engine.partners import close_partners, nearly_singular, valley_bott
 from sweepik.engine.polish import polish, polished
 from sweepik.engine.settings import (
     ACCEPT_TOL_REL,
+    MEET_ARC,
+    MEET_ARC_STEPS,
     MEET_NEAR,
+    MEET_PASSES,
     MEET_REL,
     MEET_ROUNDING_REL,
     MEET_STAY,
@@ -86,7 +89,7 @@ def snap_to_limits(
     return w_all, inside
 
 
-def closed_form_meetings(
+def meetings(
     robot: Robot,
     poses: Array,
     pose_idx: NDArray[np.intp],
@@ -96,16 +99,33 @@ def closed_form_meetings(
     inside: NDArray[np.bool_],
     keep: NDArray[np.bool_],
     mult: NDArray[np.intp],
+    closed_form: bool,
 ) -> tuple[Array, NDArray[np.intp]]:
-    """A closed form's branches that meet: one solution, a multiple root, whether the deduplication found them one
-    (``keep``) or the closed form's rounding split them in two (merged here, in place of ``err_*``, ``inside`` and
-    ``keep``). Returns ``(q, mult)`` (copies where changed)."""
-    if not keep.all():
+    """Solutions of a pose that are one root to the precision the pose fixes it, merged into one (in place of
+    ``err_*``, ``inside`` and ``keep``). Returns ``(q, mult)`` (copies where changed).
+
+    A closed form's branches that meet: one solution, a multiple root, whether the deduplication found them one
+    (``keep``: the dropped copies' multiplicities added) or the closed form's rounding split them in two (their
+    multiplicities added). A sweep's: two certified points of a flat valley next to the singular set (its polish
+    stops anywhere along a curve that solves the pose to rounding: a Piper on its singular set gave five points
+    1e-6 ... 1e-5 apart, each a double root), one double root (or the larger multiplicity of the two): copies of one
+    root found from several samples or branches, not branches that meet."""
+    if closed_form and not keep.all():
         mult = merged_multiplicity(robot, pose_idx, q, keep, mult)
-    pair = _meeting_pairs(robot, pose_idx, q, keep)
+    asked = keep
+    if not closed_form:  # (not a pose with more than an arm has: a numerical continuum, reported once later)
+        count = np.bincount(pose_idx[keep], minlength=int(pose_idx.max(initial=-1)) + 1)
+        asked = keep & (count[pose_idx] <= MAX_ISOLATED_SOLUTIONS)
+    pair = _meeting_pairs(robot, pose_idx, q, asked)
     if pair.size:
         q, mult = q.copy(), mult.copy()
-        _merge_meeting(robot, poses, pair, q, err_geo, err_paper, inside, keep, mult, pose_idx)
+    for _ in range(MEET_PASSES):  # (a merged pair's root moved: its pairs with the rest of a cluster asked again)
+        if not (
+            pair.size
+            and _merge_meeting(robot, poses, pair, q, err_geo, err_paper, inside, keep, mult, pose_idx, closed_form)
+        ):
+            break
+        pair = _meeting_pairs(robot, pose_idx, q, keep & asked)
     return q, mult
 
 
@@ -125,42 +145,81 @@ def _merge_meeting(
     keep: NDArray[np.bool_],
     mult: NDArray[np.intp],
     pose_idx: NDArray[np.intp],
-) -> None:
-    """In place: each pair of ``_meeting_pairs`` whose midpoint (polished) solves the pose as well as the better of
-    them, or at rounding level (``POLISH_ABOVE_REL``), becomes that midpoint (its errors, its limit check, the pair's
-    multiplicities summed), the second row dropped.
-    Two distinct roots this close (a pose next to the singular set) keep apart: between them the pose error grows
-    quadratically, far above theirs."""
-    weight = orientation_weight(robot.length_unit)
+    summed: bool = True,
+) -> bool:
+    """In place: each pair of ``_meeting_pairs`` that is ``one_root`` becomes that root (its errors, its limit
+    check, the pair's multiplicities summed; not ``summed``: the larger, at least 2), the second row dropped.
+    Whether any pair was merged."""
+    merged = False
     for a, b in pair.tolist():
         if not (keep[a] and keep[b]):
             continue
-        d = w[b] - w[a]
-        d = np.where(robot.is_revolute, np.mod(d + np.pi, 2.0 * np.pi) - np.pi, d)
-        target = poses[pose_idx[a]][None]
-        # (polished: the pair's other joints carry rounding of their own, which moves the pose linearly)
-        half = (w[a] + 0.5 * d)[None]
-        moved = polish(robot, half, target, weight, SNAP_ITERATIONS)
-        # (the polish may not carry the midpoint over to one of the pair: two distinct roots are not one)
-        step = np.where(robot.is_revolute, np.mod(moved - half + np.pi, 2.0 * np.pi) - np.pi, moved - half)
-        unit = per_joint(robot, 1.0)
-        apart = float(np.max(np.abs(d) / unit))
-        stays = np.max(np.abs(step[0]) / unit) <= MEET_STAY * apart
-        mid, mid_inside = wrap_inside(robot, moved)
-        eg, ep = errors_of(robot, mid, target, weight)
-        # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``; a pair farther apart than
-        # ``MEET_NEAR``: no worse than twice the worse of them as far as a polish takes them -- a closed form's
-        # values below ``POLISH_ABOVE_REL`` are not polished, and may miss the pose by as much as a valley between
-        # two roots rises -- or than ``MEET_ROUNDING_REL``)
-        best = max(min(err_geo[a], err_geo[b]), POLISH_ABOVE_REL * robot.length_scale)
-        if apart > MEET_NEAR:
-            _, pair_err = polished(robot, w[[a, b]], np.repeat(target, 2, axis=0), weight, SNAP_ITERATIONS)
-            worse = max(min(err_geo[a], pair_err[0]), min(err_geo[b], pair_err[1]))
-            best = max(2.0 * worse, MEET_ROUNDING_REL * robot.length_scale)
-        if stays and eg[0] <= best and (mid_inside[0] or not (inside[a] or inside[b])):
-            w[a], err_geo[a], err_paper[a], inside[a] = mid[0], eg[0], ep[0], mid_inside[0]
-            mult[a] += mult[b]
+        root = one_root(robot, poses[pose_idx[a]], w[a], w[b], err_geo[a], err_geo[b])
+        if root is not None and (root[3] or not (inside[a] or inside[b])):
+            w[a], err_geo[a], err_paper[a], inside[a] = root
+            mult[a] = mult[a] + mult[b] if summed else max(mult[a], mult[b], 2)
             keep[b] = False
+            merged = True
+    return merged
+
+
+def one_root(
+    robot: Robot, pose: Array, wa: Array, wb: Array, ea: float, eb: float
+) -> tuple[Array, float, float, bool] | None:
+    """The one root that two close certified solutions ``wa``, ``wb`` of ``pose (4, 4)`` (pose errors ``ea``,
+    ``eb``) are to the precision the pose fixes it: their midpoint, polished, if it solves the pose as well as the
+    better of them, or at rounding level (``POLISH_ABOVE_REL``), and the polish leaves it between them (or the
+    midpoint itself solves the pose as well as they do: a flat valley); as
+    ``(q, error_geodesic, error, within_limits)``. None: two roots (next to the singular set two roots this close
+    keep apart: between them the pose error grows quadratically, far above theirs)."""
+    weight = orientation_weight(robot.length_unit)
+    d = wb - wa
+    d = np.where(robot.is_revolute, np.mod(d + np.pi, 2.0 * np.pi) - np.pi, d)
+    target = pose[None]
+    # (polished: the pair's other joints carry rounding of their own, which moves the pose linearly)
+    half = (wa + 0.5 * d)[None]
+    moved = polish(robot, half, target, weight, SNAP_ITERATIONS)
+    # (the polish may not carry the midpoint over to one of the pair: two distinct roots are not one)
+    step = np.where(robot.is_revolute, np.mod(moved - half + np.pi, 2.0 * np.pi) - np.pi, moved - half)
+    unit = per_joint(robot, 1.0)
+    apart = float(np.max(np.abs(d) / unit))
+    if np.max(np.abs(step[0]) / unit) > MEET_STAY * apart:
+        # (or a flat valley, along which the polish drifts: the midpoint itself solves the pose as well as the pair,
+        # or a curved one, on which points of the segment corrected with the joint that moves most held lie --
+        # where between two roots the error rises quadratically)
+        flat = max(2.0 * max(ea, eb), MEET_ROUNDING_REL * robot.length_scale)
+        if errors_of(robot, half, target, weight)[0][0] > flat and not _on_one_arc(robot, pose, wa, d, flat):
+            return None
+    mid, mid_inside = wrap_inside(robot, moved)
+    eg, ep = errors_of(robot, mid, target, weight)
+    # (better than both, or at rounding level as they may be: ``POLISH_ABOVE_REL``; a pair farther apart than
+    # ``MEET_NEAR``: no worse than twice the worse of them as far as a polish takes them -- a closed form's
+    # values below ``POLISH_ABOVE_REL`` are not polished, and may miss the pose by as much as a valley between
+    # two roots rises -- or than ``MEET_ROUNDING_REL``)
+    best = max(min(ea, eb), POLISH_ABOVE_REL * robot.length_scale)
+    if apart > MEET_NEAR:
+        _, pair_err = polished(robot, np.stack([wa, wb]), np.repeat(target, 2, axis=0), weight, SNAP_ITERATIONS)
+        worse = max(min(ea, pair_err[0]), min(eb, pair_err[1]))
+        best = max(2.0 * worse, MEET_ROUNDING_REL * robot.length_scale)
+    if eg[0] > best:
+        return None
+    return mid[0], float(eg[0]), float(ep[0]), bool(mid_inside[0])
+
+
+def _on_one_arc(robot: Robot, pose: Array, wa: Array, d: Array, flat: float) -> bool:
+    """The segment from ``wa`` to ``wa + d`` lies along an arc of solutions of ``pose``: its points at
+    ``MEET_ARC`` of the way, each polished with the joint that moves most along it held, solve the pose to ``flat``
+    and stay within ``MEET_STAY`` of the segment's length of it (a valley that curves: an AgileX Piper's pair 7e-6
+    apart, their midpoint at 3e-13 of its size, the corrected points at 2e-15 like the pair)."""
+    unit = per_joint(robot, 1.0)
+    t = np.asarray(MEET_ARC)[:, None]
+    start = wa[None] + t * d[None]
+    held = np.zeros(start.shape, dtype=np.bool_)
+    held[:, int(np.argmax(np.abs(d) / unit))] = True
+    target = np.broadcast_to(pose, (t.size, 4, 4)).copy()
+    moved, err = polished(robot, start, target, orientation_weight(robot.length_unit), MEET_ARC_STEPS, fixed=held)
+    off = np.max(np.abs(moved - start) / unit) <= MEET_STAY * float(np.max(np.abs(d) / unit))
+    return bool(off and np.all(err <= flat))
 
 
 def next_to_folds(
