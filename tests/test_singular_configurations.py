@@ -35,13 +35,13 @@ def test_singular_configurations_come_back(name: str) -> None:
             assert np.all(err <= 1e-9 * robot.length_scale), (name, q.tolist())
 
 
-@pytest.mark.xfail(strict=True, reason="known miss (issue 35): a double root 3e-9 rad from its branch's domain edge")
 def test_double_root_next_to_a_domain_edge() -> None:
     """A Kinova JACO2 configuration on its singular set whose root, for the sweep of joint 1, is a double root 3e-9 rad
-    from the edge of its branch's domain (the elbow folded, joint 3 6e-4 rad from pi): the sample at the edge misses
-    the pose by 1.8e-6 of the arm's size, just above the polish's reach (``settings.POLISH_BELOW_REL``, 1e-6), and
-    the root is lost; the other five joints' sweeps find it. Polishing up to 1e-5 found it, but made the C-Arm's
-    solves 1.5 times slower (near misses polished onto known roots), and was taken back."""
+    from the edge of its branch's domain (the elbow folded, joint 3 6e-4 rad from pi): the search gives the edge's
+    candidate as a multiple root, missing the pose by 8e-6 of the arm's size, above the polish's reach for a simple
+    root (``settings.POLISH_BELOW_REL``, 1e-6); a multiple root's candidate is polished up to
+    ``POLISH_MULTIPLE_REL`` (1e-4), and the root comes back. (Polishing every candidate up to 1e-5 found it too, but
+    made the C-Arm's solves 1.5 times slower.)"""
     robot = sweepik.load_robot("kinova_jaco2")
     q = np.array([1.4942846789307929, -1.0306292312665568, -3.140989212954335, -0.0021499103074310117,
                   -1.3213829312698724, 0.3336677201394145])  # fmt: skip
@@ -49,3 +49,5 @@ def test_double_root_next_to_a_domain_edge() -> None:
     s = sweepik.solve(robot, robot.fk(q), limits=False)
     assert recovered(robot, s, q)
     assert np.all(s.error_geodesic <= 1e-12 * robot.length_scale)
+    batch = sweepik.solve_many(robot, robot.fk(np.stack([q, np.full(6, 0.3)])), limits=False)  # (the compiled pass)
+    assert recovered(robot, batch[0], q)

@@ -17,7 +17,7 @@ from sweepik.engine import certify, one_pose, search
 from sweepik.engine.candidates import Candidates, Spans, twin_copies
 from sweepik.engine.companion import joined
 from sweepik.engine.continuation import continuum_families
-from sweepik.engine.dedupe import finish, near_pairs, settle
+from sweepik.engine.dedupe import any_near, finish, settle
 from sweepik.engine.families import (
     MAX_ISOLATED_SOLUTIONS,
     collapse_continua,
@@ -380,7 +380,7 @@ def _settled_rows(
     settled = None
     if strategy == "precise" and err_geo is not None and err_paper is not None:
         bounds = settle_bounds(robot)
-        settled = settle(robot, q, err_geo, err_paper, pose_idx, len(poses), bounds, snap_reach(robot))
+        settled = settle(robot, q, err_geo, err_paper, pose_idx, mult, len(poses), bounds, snap_reach(robot))
     if settled is None:
         return _settle_stepwise(
             robot, red, poses, strategy, limits, n_samples, use_fallback, pose_idx, q, mult, err_geo, err_paper
@@ -503,10 +503,8 @@ def settled(
         )
     if out is None or out.status != one_pose.OK or out.certified > MAX_ISOLATED_SOLUTIONS:
         return None
-    if not red.closed_form and out.q.shape[0] > 1:  # (two solutions that may be one root: merged stepwise)
-        one = np.zeros(out.q.shape[0], dtype=np.intp)
-        if near_pairs(robot, one, out.q, np.ones(one.size, dtype=np.bool_), per_joint(robot, MEET_REL)).size:
-            return None
+    if not red.closed_form and out.q.shape[0] > 1 and any_near(robot, out.q, per_joint(robot, MEET_REL)):
+        return None  # (two solutions that may be one root: merged stepwise, ``settle.meetings``)
     special, _ = special_solutions(red, chain)
     if special is not None and np.isfinite(special).all(-1).any():
         return None
@@ -571,9 +569,10 @@ def _settle_stepwise(
             err_geo, err_paper = err_geo[finite], err_paper[finite]
     if err_geo is None or err_paper is None:
         err_geo, err_paper = errors_of(robot, q, poses[pose_idx], weight)
-    below, above, paper_above, accept = settle_bounds(robot)
+    below, above, paper_above, accept, multiple = settle_bounds(robot)
     if strategy == "precise":
-        near = np.nonzero((err_geo <= below) & ((err_geo > above) | (err_paper > paper_above)))[0]
+        reach = np.where(mult >= 2, multiple, below)  # (a multiple root's candidate: further, POLISH_MULTIPLE_REL)
+        near = np.nonzero((err_geo <= reach) & ((err_geo > above) | (err_paper > paper_above)))[0]
         if near.size:
             target = poses[pose_idx[near]]
             polished = polish(robot, q[near], target, weight, floor=above)

@@ -34,6 +34,7 @@ __all__ = [
     "finish",
     "settle",
     "wrap_inside",
+    "any_near",
     "limit_args",
     "merged_multiplicity",
     "near_pairs",
@@ -104,17 +105,19 @@ def settle(
     err_geo: Array,
     err_paper: Array,
     pose_idx: NDArray[np.intp],
+    mult: NDArray[np.intp],
     n_poses: int,
-    thresholds: tuple[float, float, float, float],
+    thresholds: tuple[float, float, float, float, float],
     reach: Array,
 ) -> tuple[NDArray[np.bool_], NDArray[np.intp], Array, NDArray[np.bool_], NDArray[np.bool_]] | None:
     """The solver's steps from candidates to final ones in one compiled pass, for the poses (of ``n_poses``) where
     none of its rarer steps is due: ``(due, rows, w, inside, keep)``. ``due (n_poses,)`` marks the poses left to the
-    solver's steps: a candidate is due a polish (``err_geo`` at most ``thresholds[0]`` and above ``thresholds[1]``,
-    or ``err_paper`` above ``thresholds[2]``), or a certified one lies outside the limits by at most ``reach`` (per
-    joint: the solver tries it at the limit). Of the other poses, ``rows`` are the certified candidates (finite,
-    ``err_geo`` within ``thresholds[3]``), in order, with ``finish``'s wrapped configurations ``w``, limit check and
-    duplicate mask: the values the solver's NumPy steps give. None without Numba."""
+    solver's steps: a candidate is due a polish (``err_geo`` at most ``thresholds[0]``, ``thresholds[4]`` for a
+    multiple root's (``mult`` 2 or more), and above ``thresholds[1]``, or ``err_paper`` above ``thresholds[2]``), or
+    a certified one lies outside the limits by at most ``reach`` (per joint: the solver tries it at the limit). Of
+    the other poses, ``rows`` are the certified candidates (finite, ``err_geo`` within ``thresholds[3]``), in order,
+    with ``finish``'s wrapped configurations ``w``, limit check and duplicate mask: the values the solver's NumPy
+    steps give. None without Numba."""
     if not AVAILABLE:
         return None
     K = q.shape[0]
@@ -143,6 +146,7 @@ def settle(
         np.ascontiguousarray(err_geo, dtype=np.float64),
         np.ascontiguousarray(err_paper, dtype=np.float64),
         pose,
+        np.require(mult, np.int64, ["C", "W"]),  # (a writable copy where it is read-only: the signature's)
         np.array(thresholds, dtype=np.float64),
         rev,
         lower,
@@ -202,6 +206,16 @@ def near_pairs(
         return _near_pairs(robot, pose_idx, w, keep, reach)
     pairs = out[: count[0]].astype(np.intp)
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))] if pairs.shape[0] > 1 else pairs
+
+
+def any_near(robot: Robot, w: Array, reach: Array) -> bool:
+    """Two rows of one pose's configurations ``w (K, n)`` lie within ``reach (n,)`` of each other, joint by joint
+    (revolute ones modulo 2 pi): ``near_pairs``' question for a single pose, answered in one compiled call (the one
+    compiled call's answer is checked for it on every single pose)."""
+    if not AVAILABLE:
+        one = np.zeros(w.shape[0], dtype=np.intp)
+        return bool(_near_pairs(robot, one, w, np.ones(one.size, dtype=np.bool_), reach).size)
+    return bool(_any_within(np.ascontiguousarray(w, dtype=np.float64), limit_args(robot)[0], reach))
 
 
 def _near_pairs(
@@ -370,6 +384,15 @@ if AVAILABLE:
             start = stop
         count[0] = c
 
+    @lazy_njit(boolean(float64[:, ::1], boolean[::1], float64[::1]), cache=True, nogil=True)
+    def _any_within(w, rev, reach):  # pragma: no cover
+        """``any_near``: some two rows of ``w`` within ``reach``."""
+        for a in range(w.shape[0]):
+            for b in range(a + 1, w.shape[0]):
+                if _rows_within(w, a, b, rev, reach):
+                    return True
+        return False
+
     @lazy_njit(
         (int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True, nogil=True
     )
@@ -489,21 +512,22 @@ if AVAILABLE:
 
     #: ``_settle``'s arguments (``one_pose`` calls it by its address too).
     _SETTLE_SIG = (
-        (float64[:, ::1], float64[::1], float64[::1], int64[::1], float64[::1], boolean[::1], float64[::1])
+        (float64[:, ::1], float64[::1], float64[::1], int64[::1], int64[::1], float64[::1], boolean[::1])
+        + (float64[::1],)
         + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, boolean[::1], int64[::1])
         + (float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64[::1], int64[::1], int64, int64)
     )
 
     @lazy_njit(_SETTLE_SIG, cache=True, nogil=True)
     def _settle(
-        q, eg, ep, pose, thr, rev, lower, upper, ltol, beyond, reach, tol, scale,
+        q, eg, ep, pose, mult, thr, rev, lower, upper, ltol, beyond, reach, tol, scale,
         due, idx, w, score, inside, keep, parts, counts, start, stop,
     ):  # pragma: no cover  # fmt: skip
         """``settle``'s kernel for parts ``start .. stop - 1`` (rows ``parts[p] .. parts[p + 1] - 1``; a pose's rows
         lie in one part): marks the poses due the solver's rarer steps (``due``, one entry per pose, False on entry);
         of the other poses, the certified rows (``idx``, their wrapped configurations ``w``, ``score``, ``inside``,
         ``keep``), written from the part's first row on, ``counts[p]`` of them."""
-        polish_below, polish_above, polish_paper_above, accept = thr[0], thr[1], thr[2], thr[3]
+        polish_below, polish_above, polish_paper_above, accept, polish_multiple = thr[0], thr[1], thr[2], thr[3], thr[4]
         n = q.shape[1]
         for part in range(start, stop):
             lo, hi = parts[part], parts[part + 1]
@@ -517,7 +541,8 @@ if AVAILABLE:
                 if not finite:
                     continue
                 e = eg[k]
-                if e <= polish_below and (e > polish_above or ep[k] > polish_paper_above):
+                below = polish_multiple if mult[k] >= 2 else polish_below
+                if e <= below and (e > polish_above or ep[k] > polish_paper_above):
                     due[pose[k]] = True  # a Newton polish (or, failing it, the fallback reduction)
                     continue
                 if not e <= accept:

@@ -100,7 +100,7 @@ if AVAILABLE:
     _A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG, _A_ROWS, _A_AMP, _A_DIV, _A_SING, _A_SIZE = range(9)
 
     @internal
-    def _settled(settle, q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale):
+    def _settled(settle, q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale):
         """One pose's certified candidates settled (``dedupe._settle`` at the address ``settle``): whether one is
         due the solver's rarer steps, and the count, rows, wrapped configurations, limit check and duplicate mask
         of the certified ones (buffers as long as the candidates)."""
@@ -115,8 +115,8 @@ if AVAILABLE:
         due = np.empty(1, dtype=np.bool_)
         due[0] = False
         _as_settle(settle)(
-            q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, due, rows, w, score, inside,
-            keep, ints[0:2], ints[2:3], 0, 1,
+            q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, due, rows, w, score,
+            inside, keep, ints[0:2], ints[2:3], 0, 1,
         )  # fmt: skip
         return due[0], ints[2], rows, w, inside, keep
 
@@ -212,7 +212,7 @@ if AVAILABLE:
             addr[_A_CFG], params, world, pose, theta, branch, True, H, P, rev, R_end, weight, q, eg, ep, 0, K
         )
         due, c, rows, w, inside, keep = _settled(
-            addr[_A_SETTLE], q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
+            addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
         )
         if due and status == OK:
             status, c = DUE, 0
@@ -251,7 +251,7 @@ if AVAILABLE:
         for k in range(nb):
             pose[k], mult[k] = 0, 1
         due, c, rows, w, inside, keep = _settled(
-            addr[_A_SETTLE], q, eg, ep, pose, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
+            addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
         )
         status = DUE if due else OK
         if status == OK and _branches_meet(c, w, keep, lrev, meet):
@@ -366,7 +366,7 @@ def settle_one(
     hi: Array,
     n_samples: int,
     params: Array,
-    thresholds: tuple[float, float, float, float],
+    thresholds: tuple[float, float, float, float, float],
     reach: Array,
     clip_rel: float,
     seed_tol: float,
@@ -400,7 +400,7 @@ def settle_closed(
     red: Any,
     world: Array,
     params: Array,
-    thresholds: tuple[float, float, float, float],
+    thresholds: tuple[float, float, float, float, float],
     reach: Array,
     meet: Array,
     only_inside: bool,

@@ -28,6 +28,12 @@ PINV_WIDEN = (1.0, 1e4, 1e7)
 #: Candidates with a pose error below this times the length scale get a Newton polish on the full pose
 #: (removes the ill-conditioning of a reduction; spurious candidates are far above it).
 POLISH_BELOW_REL = 1e-6
+#: ... and a candidate the search gives as a multiple root (an extremum of the residual touching zero, multiplicity
+#: 2 or more) up to this: a double root is fixed in theta* only to about the square root of the rounding, and next to
+#: a branch domain's edge the residual grows like the square root of the distance to it (a Kinova JACO2 on its
+#: singular set: a double root 3e-9 rad from the edge, the edge's candidate missing the pose by 8e-6 of the arm's
+#: size, certified after the polish). Such candidates are few (singular poses): the common pose pays nothing.
+POLISH_MULTIPLE_REL = 1e-4
 
 #: ... and above this (already at rounding level: nothing to gain), ...
 POLISH_ABOVE_REL = 1e-14

@@ -27,6 +27,7 @@ from sweepik.engine.settings import (
     MEET_STAY,
     POLISH_ABOVE_REL,
     POLISH_BELOW_REL,
+    POLISH_MULTIPLE_REL,
     POLISH_PAPER_ABOVE_REL,
     SNAP_ITERATIONS,
     SNAP_REACH,
@@ -39,12 +40,18 @@ from sweepik.results import joint_distance
 Array = NDArray[np.float64]
 
 
-def settle_bounds(robot: Robot) -> tuple[float, float, float, float]:
+def settle_bounds(robot: Robot) -> tuple[float, float, float, float, float]:
     """The precise strategy's thresholds, absolute (times the arm's length scale): polish below, polish above, polish
-    above on the paper's J, acceptance (``POLISH_BELOW_REL`` ... ``ACCEPT_TOL_REL``); the stepwise path and
-    ``dedupe.settle`` take the same values."""
+    above on the paper's J, acceptance, polish below for a multiple root's candidate (``POLISH_BELOW_REL`` ...
+    ``ACCEPT_TOL_REL``, ``POLISH_MULTIPLE_REL``); the stepwise path and ``dedupe.settle`` take the same values."""
     ls = robot.length_scale
-    return POLISH_BELOW_REL * ls, POLISH_ABOVE_REL * ls, POLISH_PAPER_ABOVE_REL * ls, ACCEPT_TOL_REL * ls
+    return (
+        POLISH_BELOW_REL * ls,
+        POLISH_ABOVE_REL * ls,
+        POLISH_PAPER_ABOVE_REL * ls,
+        ACCEPT_TOL_REL * ls,
+        POLISH_MULTIPLE_REL * ls,
+    )
 
 
 @lru_cache(maxsize=64)
