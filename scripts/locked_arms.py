@@ -38,7 +38,10 @@ def _same_as_numerical(robot: sweepik.Robot, k: int, v: float, s: sweepik.Soluti
     assert held is not None
     num = numerical_solutions(held.arm, robot.fk(q), n_starts=400, full_circle=True)
     ours = s.q[:, list(held.free)]
-    return bool(same_solution_set(ours, num, held.arm.is_revolute, held.arm.length_scale, tol=1e-4))
+    same = bool(same_solution_set(ours, num, held.arm.is_revolute, held.arm.length_scale, tol=1e-4))
+    if not same:  # (which side lacks what: a many-start search can miss a root, so can sweepik)
+        print(f"    differs at q = {q.tolist()}: sweepik {len(ours)} solutions, numerical {len(num)}", flush=True)
+    return same
 
 
 def main() -> None:

@@ -61,7 +61,8 @@ class Agreement:
     pose fixes it, an arc of rounding-level solutions included) it is a miss of sweepik's, else ssik's error (a
     configuration missing the pose by 1e-10 ... 1e-6, or a second copy of a root sweepik has). One only sweepik has
     (each passed sweepik's certification) is a miss of ssik's, unless it is the same root as another of sweepik's
-    solutions (``singular.one_root``: a second copy, counted apart as ``close``). Poses with a continuum are counted apart.
+    solutions (``singular.one_root``: a second copy, counted apart as ``close``). Poses with a continuum are counted
+    apart.
 
     ``same``: poses whose two sets match solution for solution; ``right``: poses where sweepik lacks no root ssik
     found and gives none twice (the differences left are ssik's: a solution off the pose, a second copy, a
