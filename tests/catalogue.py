@@ -53,14 +53,16 @@ def check_fk(robot: Robot, name: str, rng: np.random.Generator) -> float:
     return max(float(np.abs(robot.fk(q) - m.fk(q)).max()) for q in Q)
 
 
-def catalogue_configurations(name: str, n: int = 200, n_singular: int = 50) -> tuple[Robot, np.ndarray]:
+def catalogue_configurations(
+    name: str, n: int = 200, n_singular: int = 50, rng: np.random.Generator | None = None
+) -> tuple[Robot, np.ndarray]:
     """ssik's arm ``name`` as a sweepik robot and the configurations ``scripts/ssik_catalogue.py --n n --singular
-    n_singular`` draws for it (seed 0): ``n`` uniform over a turn, then ``n_singular`` on and next to its singular
-    set."""
+    n_singular`` draws for it (seed 0, or from ``rng``, which then goes on as the script's does, e.g. to its
+    ``--rewrite``): ``n`` uniform over a turn, then ``n_singular`` on and next to its singular set."""
     from singular import singular_configurations
 
     robot = robot_from_ssik(name)
-    rng = np.random.default_rng(0)
+    rng = np.random.default_rng(0) if rng is None else rng
     rng.uniform(-np.pi, np.pi, (20, 6))  # (``check_fk``'s draw)
     Q = rng.uniform(-np.pi, np.pi, (n, 6))
     return robot, np.concatenate([Q, singular_configurations(robot, n_singular, rng)])

@@ -26,13 +26,14 @@ def test_lapack_eigenvalues_are_numpys() -> None:
 @pytest.mark.parametrize(("kind", "seed"), [("6r", 0), ("6r", 5), ("5r1p", 2)])
 def test_compiled_path_equals_the_full_path(kind: str, seed: int) -> None:
     """Every pose the compiled path answers has the full path's solution set; on uniform configurations it answers
-    nearly all (it hands a pose to the full path only where its checks question it)."""
+    nearly all (it hands a pose to the full path only where its checks question it: a near-real pair of eigenvalues
+    that does not polish, ``elimination.PAIR_IMAG``, about 1 pose in 20 on random arms)."""
     robot = random_arm(kind, seed)
     path, ik = _fast_path(robot), _setup(robot)
     assert path is not None and not isinstance(ik, str)
     T = robot.fk(poses_of(robot, 60, 0, seed=seed))
     q, count = solve_poses(path, T, MAX_SOLUTIONS)
-    assert np.sum(count < 0) <= 2
+    assert np.sum(count < 0) <= 6
     for k in np.flatnonzero(count >= 0):
         assert np.all(np.isnan(q[k, count[k] :]))
         full = ik.solve(T[k]).q
