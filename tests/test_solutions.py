@@ -89,44 +89,6 @@ def test_family_member_at_an_angle_past_pi() -> None:
 # ------------------------------------------------------------------ choosing a solution: metrics, windings, filter
 
 
-def _brute_windings(robot: sweepik.Robot, q: np.ndarray) -> np.ndarray:
-    """Every configuration equal to ``q`` modulo 2 pi on the revolute joints and inside the limits: per joint, the
-    values ``q_j + 2 pi t`` (t from -2 to 2, the arms tested turn at most +-360 degrees) inside its limits, then
-    every combination of them."""
-    import itertools
-
-    per_joint = [
-        [v for t in (range(-2, 3) if rev else (0,)) if lo - 1e-9 <= (v := qj + 2 * np.pi * t) <= hi + 1e-9]
-        for qj, rev, lo, hi in zip(q, robot.is_revolute, robot.lower, robot.upper, strict=True)
-    ]
-    return np.array(list(itertools.product(*per_joint)))
-
-
-@pytest.mark.parametrize("name", ["ur5", "doosan_m0609", "kinova_jaco2", "xarm6"])
-def test_windings_are_every_turn_inside_the_limits(name: str) -> None:
-    """``windings=True``: the rows are exactly the base solutions' windings found by brute force (every
-    combination of whole turns inside the limits), each row's ``winding_of`` a base row equal to it modulo 2 pi,
-    every row passing FK; solve_many gives the same rows."""
-    robot = sweepik.load_robot(name)
-    rng = np.random.default_rng(7)
-    q = robot.lower + rng.random((4, 6)) * (robot.upper - robot.lower)
-    T = robot.fk(q)
-    batch = sweepik.solve_many(robot, T, windings=True)
-    for k in range(len(q)):
-        base = sweepik.solve(robot, T[k])
-        wound = sweepik.solve(robot, T[k], windings=True)
-        np.testing.assert_array_equal(wound.q[: len(base)], base.q)
-        np.testing.assert_array_equal(batch[k].q, wound.q)
-        np.testing.assert_array_equal(batch[k].winding_of, wound.winding_of)
-        expect = np.concatenate([_brute_windings(robot, b) for b in base.q])
-        gap = np.max(np.abs(wound.q[:, None, :] - expect[None, :, :]), axis=-1)
-        assert len(wound) == len(expect) and np.all(gap.min(axis=0) <= 1e-9) and np.all(gap.min(axis=1) <= 1e-9)
-        assert np.max(joint_distance(robot, wound.q, base.q[wound.winding_of])) <= 1e-12
-        assert np.all(robot.within_limits(wound.q))
-        assert np.max(np.abs(robot.fk(wound.q) - T[k])) <= 1e-9
-        assert np.any(np.all(np.abs(wound.q - q[k]) <= 1e-8, axis=1))  # the generating q itself, not modulo 2 pi
-
-
 @pytest.mark.parametrize("metric", ["linf", "weighted"])
 def test_nearest_with_a_tolerance_against_brute_force(metric: str) -> None:
     """``nearest(q_ref, metric, tol)`` on a UR (+-360 degrees, windings listed): the row a brute-force minimum over
