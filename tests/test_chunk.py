@@ -9,7 +9,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from sweepik import ShapeError, load_robot, solve
+from sweepik import ShapeError, load_robot, solve, solve_many
 from sweepik.engine import chunk
 from sweepik.reductions import get_reduction
 
@@ -54,3 +54,27 @@ def test_a_prismatic_theta_without_finite_limits_is_refused() -> None:
     chain = chunk.chain_poses(open_rail, open_rail.fk(np.zeros((1, 6))))
     with pytest.raises(ShapeError, match="finite limits"):
         chunk.theta_range(open_rail, red, chain, paper_limits=True)
+
+
+def test_the_c_arms_theta2_blind_spot_is_swept_by_the_d1_reduction() -> None:
+    """The C-Arm swept on theta2 is blind at theta2 = +-90 deg with the wrist near the rail's axis (``CArmTheta2.
+    blind_spot``): there the d1 reduction's sweep (compiled, like every search where the reduction has kernels)
+    supplies the solutions. Poses around it: the same solution sets as the d1 reduction alone, the generating
+    configuration among them (limits off; a family is compared by its presence)."""
+    from oracles import same_solution_set
+    from singular import recovered
+
+    robot = load_robot("carm")
+    rng = np.random.default_rng(5)
+    q = rng.uniform(robot.lower, robot.upper, (60, 6))
+    q[:, 1] = np.where(rng.random(60) < 0.5, np.pi / 2, -np.pi / 2) + rng.normal(0.0, 0.02, 60)
+    poses = robot.fk(q)
+    blind = get_reduction(robot, "carm-theta2").blind_spot(chunk.chain_poses(robot, poses))
+    assert blind is not None and blind[0].size >= 10  # (the case is exercised)
+    theta2 = solve_many(robot, poses, reduction="carm-theta2", limits=False)
+    d1 = solve_many(robot, poses, reduction="carm-d1", limits=False)
+    for k in range(len(q)):
+        assert recovered(robot, theta2[k], q[k]), k
+        assert bool(theta2[k].families) == bool(d1[k].families), k
+        if not theta2[k].families:
+            assert same_solution_set(theta2[k].q, d1[k].q, robot.is_revolute, robot.length_scale), k

@@ -31,6 +31,7 @@ from sweepik.engine.settings import (
     ACCEPT_TOL_REL,
     CLIP_REACH_REL,
     MEET_REL,
+    N_SAMPLES,
     PAPER_ACCEPT_MM,
     POLISH_BELOW_REL,
     SEED_TOL_REL,
@@ -346,7 +347,10 @@ def _blind_spot_solutions(red: Reduction, chain: Array) -> tuple[Array, IntArray
     if blind is None:
         return None
     idx, other, rng = blind
-    cand, _ = twin_copies(other, *find_candidates(other, chain[idx], rng[:, 0], rng[:, 1]))
+    if search.AVAILABLE and other.uses_kernel:  # (the compiled search; twins' copies included)
+        cand, _ = search.search(other, chain[idx], rng[:, 0], rng[:, 1], N_SAMPLES)
+    else:
+        cand, _ = twin_copies(other, *find_candidates(other, chain[idx], rng[:, 0], rng[:, 1]))
     q = other.solve_rest(chain[idx][cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
     keep = np.all(np.isfinite(q), axis=-1) & red.blind_spot_kept(q)
     pose, q, mult = cand.pose[keep], q[keep], cand.mult[keep]
