@@ -10,6 +10,7 @@ from rewrites import rewrite
 
 from sweepik import Joint, NoReductionError, Robot, bundled_robots, load_robot
 from sweepik.model.structure import near_structure
+from sweepik.reductions import decompose
 from sweepik.reductions.decompose import choose
 from sweepik.reductions.plan import Plan, plans, rank
 
@@ -107,3 +108,21 @@ def test_an_arm_whose_jacobian_is_never_full_rank_is_refused_as_a_continuum() ->
         choose(arm)
     q = np.array([0.3, -0.2, 0.1, 0.4, 0.5, 0.6])
     assert np.linalg.svd(arm.jacobian(q), compute_uv=False)[-1] < 1e-12  # (the premise)
+
+
+def test_the_automatic_choice_is_made_once_per_arm(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``get_reduction(arm, "auto")`` and its companion ask for the same cached choice (a 7-joint arm held at a new
+    value every pose builds a new arm every pose: a second choice cost ~1 ms of ~10)."""
+    from sweepik import reductions
+
+    calls = []
+    real = decompose.continuum_everywhere
+    monkeypatch.setattr(decompose, "continuum_everywhere", lambda robot: calls.append(1) or real(robot))
+    iiwa = load_robot("kuka_iiwa14")
+    from sweepik.solving import held_joints
+
+    held = held_joints(iiwa, {"A3": 0.123456789})
+    assert held is not None
+    reductions.get_reduction(held.arm, "auto")
+    decompose.companion_plan(held.arm)
+    assert len(calls) == 1

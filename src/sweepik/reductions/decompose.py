@@ -228,7 +228,7 @@ def companion_plan(robot: Robot) -> Plan | None:
     of the other checked plans that gave back every configuration of the check and sweep another joint or the other
     chain, the best scored (ties: ``cheapest``); None without a near-structure or such a plan."""
     try:
-        plan, checks = choice(robot)
+        plan, checks = choice(robot, None)  # (the key `choose` uses: one cached choice)
     except NoReductionError:
         return None
     mine = (plan.reversed, plan.free)
@@ -252,7 +252,7 @@ def explain(robot: Robot) -> dict[str, Any]:
         "checks": [],
     }
     try:
-        plan, checks = choice(robot)
+        plan, checks = choice(robot, None)
     except NoReductionError as e:
         info.update(chosen=None, reason=str(e), why=None, companion=None)
         return info
