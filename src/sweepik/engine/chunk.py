@@ -145,10 +145,11 @@ def solve_chunk(
         if comp is None or strategy != "precise":
             return block
         return joined(block, _solve_chunk_by(robot, comp, poses, strategy, limits, n_samples, use_fallback, False))
-    finally:  # (what the reductions kept for these poses: dropped)
-        chain = chain_poses(robot, poses)
-        for r in (red, comp):
-            if r is not None:
+    finally:  # (what the reductions kept for these poses: dropped; most keep nothing, and pay nothing)
+        keeping = [r for r in (red, comp) if r is not None and type(r).release is not Reduction.release]
+        if keeping:
+            chain = chain_poses(robot, poses)
+            for r in keeping:
                 r.release(chain)
 
 
