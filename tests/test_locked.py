@@ -213,6 +213,62 @@ def test_locked_errors() -> None:
         sweepik.solve(panda, T, locked={"joint7": 0.1}, free_joint=6)
 
 
+@pytest.mark.parametrize("name, joint", [("kuka_iiwa14", "A3"), ("franka_panda", "joint7")])
+def test_a_lock_value_per_pose_solves_each_pose_with_its_own(name: str, joint: str) -> None:
+    """``solve_many(..., locked={joint: values})`` with one value per pose: each pose's solutions are ``solve``'s
+    with its value held (the held column is that value), every generating configuration is recovered, and
+    ``iter_solve`` yields the same; runs of one value (poses 4-6) and values in any order."""
+    robot = sweepik.load_robot(name)
+    k = robot.joint_names.index(joint)
+    q = in_limit_configurations(robot, 10, np.random.default_rng(5))
+    q[5:7, k] = q[4, k]  # (a run of one value)
+    T = robot.fk(q)
+    batch = sweepik.solve_many(robot, T, locked={joint: q[:, k]})
+    streamed = list(sweepik.iter_solve(robot, T, locked={joint: list(q[:, k])}, chunk_size=2))
+    assert len(batch) == len(streamed) == 10
+    for i in range(10):
+        one = sweepik.solve(robot, T[i], locked={joint: float(q[i, k])})
+        got = batch[i]
+        assert len(got) == len(one) == len(streamed[i]) > 0
+        assert np.allclose(np.sort(got.q, axis=0), np.sort(one.q, axis=0), atol=1e-9)
+        assert np.all(got.q[:, k] == q[i, k])
+        assert np.abs(robot.fk(got.q) - T[i]).max() < 1e-9
+        assert recovers(robot, got, q[i])
+
+
+def test_a_self_motion_sampled_over_lock_values_in_one_call() -> None:
+    """One pose and a grid of lock values: one solve per value (the pose repeated), each solution holding its
+    value and reaching the pose; the generating configuration's value is among them and recovered there."""
+    robot = sweepik.load_robot("kuka_iiwa14")
+    q0 = np.array([0.3, 0.8, 0.4, -1.2, 0.5, 0.9, -0.2])
+    grid = np.linspace(-1.2, 1.2, 13)
+    grid[6] = q0[2]
+    batch = sweepik.solve_many(robot, robot.fk(q0), locked={"A3": grid})
+    assert len(batch) == grid.size
+    for v, sols in zip(grid, batch, strict=True):
+        assert np.all(sols.q[:, 2] == v)
+        assert np.abs(robot.fk(sols.q) - robot.fk(q0)).max() < 1e-9
+    assert recovers(robot, batch[6], q0)
+    assert sum(len(s) for s in batch) > 13
+
+
+def test_lock_values_per_pose_errors() -> None:
+    panda = sweepik.load_robot("franka_panda")
+    T = panda.fk(in_limit_configurations(panda, 3, np.random.default_rng(1)))
+    for values, needle in [
+        ([0.1, 0.2], r"shape \(2,\).*one per pose \(3\)"),
+        ([0.1, float("nan"), 0.2], "pose 1: .*finite"),
+        ([0.1, 0.2, 3.1], "pose 2: .*outside its limits"),
+        (["a", "b", "c"], "numbers"),
+        (np.zeros((3, 1)), "shape"),
+    ]:
+        with pytest.raises(LockedJointError, match=needle):
+            sweepik.solve_many(panda, T, locked={"joint7": values})
+    with pytest.raises(LockedJointError, match="outside its limits"):
+        sweepik.iter_solve(panda, T, locked={"joint7": [0.1, 0.2, 0.3], "joint4": 0.0})  # (checked when called)
+    assert len(sweepik.solve_many(panda, np.zeros((0, 4, 4)), locked={"joint7": []})) == 0
+
+
 # ------------------------------------------------------------------------------------------ TOML joint form
 
 

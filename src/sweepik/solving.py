@@ -20,7 +20,7 @@ from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.sweep import N_SAMPLES
 from sweepik.engine.windings import wound_block, wound_solutions
 from sweepik.errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
-from sweepik.model.origin_axis import HeldJoints, hold_joints
+from sweepik.model.origin_axis import HeldJoints, hold_joints, lock_runs, per_pose
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit
 from sweepik.model.validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
@@ -91,7 +91,7 @@ def solve_many(
     limits: bool = True,
     n_samples: int = N_SAMPLES,
     chunk_size: int = CHUNK,
-    locked: Mapping[Any, float] | None = None,
+    locked: Mapping[Any, float | ArrayLike] | None = None,
     windings: bool = False,
 ) -> SolutionBatch:
     """All IK solutions of each pose in ``poses (N, 4, 4)`` (world frame, robot's length unit).
@@ -103,18 +103,49 @@ def solve_many(
     (``offsets``, ``q``, ``error``, ...) hold every solution without a Python object per pose. An empty batch
     (``[]`` or an array ``(0, 4, 4)``) gives an empty one, after the other arguments are checked. Other arguments
     and errors: see :func:`solve`; :func:`iter_solve` yields the same results without holding them all.
+
+    ``locked`` may give a joint one value per pose (a sequence of ``N``; docs/robots.md): each pose is solved with
+    its own value held; with one pose ``(4, 4)`` and ``K`` values, that pose is solved for each (``K`` results: a
+    self-motion sampled over a grid of lock values).
     """
     _check_strategy(strategy)
-    P = _pose_batch(poses)
     check_bool(windings, "windings")
-    held = held_joints(robot, locked)
-    arm = robot if held is None else held.arm
-    red, strat, lim, ns, cs = prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
-    cs, share = _chunking(red, len(P), cs)
-    blocks = parallel.in_order(
-        lambda s: solve_chunk(arm, red, P[s : s + cs], strat, lim, ns), range(0, len(P), cs), share
+    P, runs = _pose_runs(robot, poses, locked)
+    blocks: list[Block] = []
+    for s, e, lock in runs:
+        held = held_joints(robot, lock)
+        arm = robot if held is None else held.arm
+        prepared = prepare(arm, P[s:e], reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
+        blocks.extend(_finished(b, held, windings) for b in _solved_chunks(arm, P[s:e], prepared))
+    return SolutionBatch(robot, blocks)
+
+
+def _solved_chunks(arm: Robot, P: Array, prepared: Prepared) -> Iterator[Block]:
+    """The blocks of ``P`` solved chunk by chunk (``_chunking``), in order."""
+    red, strategy, limits, n_samples, chunk_size = prepared
+    cs, share = _chunking(red, len(P), chunk_size)
+    return parallel.in_order(
+        lambda s: solve_chunk(arm, red, P[s : s + cs], strategy, limits, n_samples), range(0, len(P), cs), share
     )
-    return SolutionBatch(robot, [_finished(b, held, windings) for b in blocks])
+
+
+def _pose_runs(robot: Robot, poses: ArrayLike, locked: object) -> tuple[Array, list[tuple[int, int, object]]]:
+    """The batch's poses ``(N, 4, 4)`` and its runs of consecutive poses solved with the same joints held
+    ``[(start, stop, locked), ...]``: one run of every pose, unless ``locked`` gives a value per pose (``lock_runs``;
+    then a single pose ``(4, 4)`` or ``(1, 4, 4)`` is repeated for each value: a self-motion sampled over a grid of
+    lock values)."""
+    if not per_pose(locked):
+        P = _pose_batch(poses)
+        return P, [(0, len(P), locked)]
+    _check_robot(robot)
+    assert isinstance(locked, Mapping)
+    arr = as_float_array(poses, "poses")
+    if arr.shape in ((4, 4), (1, 4, 4)):  # (one pose for every lock value)
+        n = max(len(v) for v in locked.values() if np.ndim(v) > 0)
+        P = np.repeat(check_poses(arr.reshape(4, 4), "poses")[None], n, axis=0)
+    else:
+        P = _pose_batch(poses)
+    return P, list(lock_runs(robot, locked, len(P)))
 
 
 def _chunking(red: Reduction, n: int, chunk_size: int) -> tuple[int, bool]:
@@ -143,7 +174,7 @@ def iter_solve(
     n_samples: int = N_SAMPLES,
     chunk_size: int = CHUNK,
     progress: Progress | None = None,
-    locked: Mapping[Any, float] | None = None,
+    locked: Mapping[Any, float | ArrayLike] | None = None,
     windings: bool = False,
 ) -> Iterator[Solutions]:
     """The solutions of each pose in ``poses (N, 4, 4)``, yielded one pose after the other as
@@ -151,18 +182,20 @@ def iter_solve(
     (the one being yielded and the next ones being solved, see ``parallel.in_order``), so memory stays bounded
     whatever ``N`` (for streaming millions of poses to a file).
 
-    Arguments are checked when it is called, before the first solution is asked for. ``progress(stage, done,
+    Arguments are checked when it is called, before the first solution is asked for (``locked`` with a value per
+    pose: every value; a decomposition of each value's held arm when its poses' turn comes). ``progress(stage, done,
     total)``, if given, is called with stage ``"solve"`` before the first chunk and after each one.
     """
     _check_strategy(strategy)
-    P = _pose_batch(poses)
     check_bool(windings, "windings")
     if progress is not None and not callable(progress):
         raise UnknownOptionError(f"progress must be callable or None, got {type(progress).__name__}")
-    held = held_joints(robot, locked)
-    arm = robot if held is None else held.arm
-    prepared = prepare(arm, P, reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
-    return _iter_checked(arm, P, *prepared, progress, held, windings)
+    P, runs = _pose_runs(robot, poses, locked)
+    options: dict[str, Any] = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples)
+    options.update(chunk_size=chunk_size, free_joint=free_joint)
+    held = held_joints(robot, runs[0][2]) if runs else None
+    first = prepare(robot if held is None else held.arm, P[: runs[0][1]], **options, held=held) if runs else None
+    return _iter_checked(robot, P, runs, first, options, progress, windings)
 
 
 class Prepared(NamedTuple):
@@ -322,27 +355,26 @@ def _free_joint_index(robot: Robot, free_joint: object, reduction: object) -> in
 def _iter_checked(
     robot: Robot,
     P: Array,
-    red: Reduction,
-    strategy: str,
-    limits: bool,
-    n_samples: int,
-    chunk_size: int,
+    runs: list[tuple[int, int, object]],
+    first: Prepared | None,
+    options: dict[str, Any],
     progress: Progress | None = None,
-    held: HeldJoints | None = None,
     windings: bool = False,
 ) -> Iterator[Solutions]:
-    total = P.shape[0]
+    """``iter_solve``'s generator: the runs of ``_pose_runs`` chunk by chunk, the first run's options ``first``
+    prepared by the caller (the arguments' checks), the others' when their turn comes."""
+    total, done = P.shape[0], 0
     if progress is not None:
         progress("solve", 0, total)
-    chunk_size, share = _chunking(red, total, chunk_size)
-    starts = range(0, total, chunk_size)
-    blocks = parallel.in_order(
-        lambda s: solve_chunk(robot, red, P[s : s + chunk_size], strategy, limits, n_samples), starts, share
-    )
-    for s, block in zip(starts, blocks, strict=True):
-        yield from _finished(block, held, windings)
-        if progress is not None:
-            progress("solve", min(s + chunk_size, total), total)
+    for r, (s, e, lock) in enumerate(runs):
+        held = held_joints(robot, lock)
+        arm = robot if held is None else held.arm
+        prepared = first if r == 0 and first is not None else prepare(arm, P[s:e], **options, held=held)
+        for block in _solved_chunks(arm, P[s:e], prepared):
+            yield from _finished(block, held, windings)
+            done += block.n
+            if progress is not None:
+                progress("solve", done, total)
 
 
 def _solve_one(

@@ -32,7 +32,7 @@ from sweepik.model.chain import rotation_about
 from sweepik.model.robot import Joint, Robot
 from sweepik.model.validate import MAX_JOINT_VALUE
 
-__all__ = ["origin_axis_form", "joint_origins", "hold_joints", "held_values", "HeldJoints"]
+__all__ = ["origin_axis_form", "joint_origins", "hold_joints", "held_values", "lock_runs", "HeldJoints"]
 
 Array = NDArray[np.float64]
 
@@ -191,6 +191,52 @@ def held_values(robot: Robot, locked: Mapping[Any, Any]) -> tuple[tuple[int, flo
             )
         out[k] = v
     return tuple(sorted(out.items()))
+
+
+def per_pose(locked: object) -> bool:
+    """Whether ``locked`` gives some joint a sequence of values (one per pose) rather than one number."""
+    return isinstance(locked, Mapping) and any(
+        isinstance(v, list | tuple | np.ndarray) and np.ndim(v) > 0 for v in locked.values()
+    )
+
+
+def lock_runs(robot: Robot, locked: Mapping[Any, Any], n: int) -> list[tuple[int, int, dict[int, float]]]:
+    """``locked`` with a value per pose for some joints (a sequence of ``n``; a number holds every pose) as runs
+    of consecutive poses that hold the same values: ``[(start, stop, {joint index: value}), ...]`` covering
+    ``0 .. n``. Every pose's values are checked here (``held_values``: a LockedJointError names the first pose whose
+    value is refused), so that a batch fails before it is solved."""
+    keys = [_joint_index(robot, key) for key in locked]
+    if len(set(keys)) < len(keys):
+        held_values(robot, locked)  # (names the joint given twice)
+    columns = []
+    for k, value in zip(keys, locked.values(), strict=True):
+        name = robot.joint_names[k]
+        if isinstance(value, list | tuple | np.ndarray) and np.ndim(value) > 0:
+            try:
+                col = np.asarray(value, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise LockedJointError(f"locked: joint {name!r} needs numbers, one per pose") from None
+            if col.shape != (n,):
+                raise LockedJointError(
+                    f"locked: joint {name!r} has values of shape {col.shape}; give one number, or one per pose ({n})"
+                )
+        else:
+            held_values(robot, {k: value})  # (one number: its checks and message)
+            col = np.full(n, float(value))
+        columns.append(col)
+    if n == 0:
+        return []
+    rows = np.stack(columns, axis=1)
+    starts = [0, *(np.nonzero(np.any(rows[1:] != rows[:-1], axis=1))[0] + 1).tolist()]
+    runs = []
+    for s, e in zip(starts, [*starts[1:], n], strict=True):
+        values = dict(zip(keys, rows[s].tolist(), strict=True))
+        try:
+            held_values(robot, values)
+        except LockedJointError as err:
+            raise LockedJointError(f"pose {s}: {err}") from None
+        runs.append((s, e, values))
+    return runs
 
 
 def hold_joints(robot: Robot, locked: Mapping[Any, Any], n_free: int | None = 6) -> HeldJoints:
