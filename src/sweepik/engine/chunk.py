@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import certify, one_pose, search
-from sweepik.engine.candidates import Candidates, Spans, twin_copies
+from sweepik.engine.candidates import Candidates, Spans
 from sweepik.engine.companion import joined
 from sweepik.engine.continuation import continuum_families
 from sweepik.engine.dedupe import any_near, finish, settle
@@ -45,7 +45,6 @@ from sweepik.engine.settle import (
     snap_reach,
     snap_to_limits,
 )
-from sweepik.engine.sweep import find_candidates
 from sweepik.errors import ShapeError
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit, orientation_weight
@@ -282,8 +281,8 @@ def _precise_candidates(
         cand, spans = search.search(red, chain, lo, hi, n_samples, params, before_redo=redo)
         cand = _limit_copies(robot, red, cand, hi - lo)
         q, err_geo, err_paper = certify.certify(robot, red, chain, poses, cand.pose, cand.theta, cand.branch, params)
-    else:
-        cand, spans = twin_copies(red, *find_candidates(red, chain, lo, hi, n_samples))
+    else:  # (a reduction without a compiled kernel: its residual called back, twins' copies included)
+        cand, spans = search.search(red, chain, lo, hi, n_samples)
         cand = _limit_copies(robot, red, cand, hi - lo)
         q = red.solve_rest(chain[cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
     found = _Found(cand.pose, q, cand.mult, err_geo, err_paper, {})
@@ -348,10 +347,7 @@ def _blind_spot_solutions(red: Reduction, chain: Array) -> tuple[Array, IntArray
     if blind is None:
         return None
     idx, other, rng = blind
-    if search.AVAILABLE and other.uses_kernel:  # (the compiled search; twins' copies included)
-        cand, _ = search.search(other, chain[idx], rng[:, 0], rng[:, 1], N_SAMPLES)
-    else:
-        cand, _ = twin_copies(other, *find_candidates(other, chain[idx], rng[:, 0], rng[:, 1]))
+    cand, _ = search.search(other, chain[idx], rng[:, 0], rng[:, 1], N_SAMPLES)  # (twins' copies included)
     q = other.solve_rest(chain[idx][cand.pose], cand.theta[:, None], cand.branch[:, None])[:, 0]
     keep = np.all(np.isfinite(q), axis=-1) & red.blind_spot_kept(q)
     pose, q, mult = cand.pose[keep], q[keep], cand.mult[keep]

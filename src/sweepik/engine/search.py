@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik._jit import ERROR_MODEL, alive, inlined, internal, unowned, writable
-from sweepik.engine import candidates, parallel
+from sweepik.engine import callback, candidates, parallel
 from sweepik.engine import sweep as _ref
 from sweepik.engine.settings import (
     BEND,
@@ -57,6 +57,8 @@ from sweepik.engine.settings import (
     MULT_MAX,
     N_SAMPLES,
     PARALLEL_MIN,
+    REDO_GROW,
+    REDO_MAX,
     STACK,
     SUB_SAMPLES,
     U_EDGE,
@@ -64,8 +66,10 @@ from sweepik.engine.settings import (
     XTOL_REL,
 )
 from sweepik.errors import UnknownOptionError
+from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import overridden_below_kernel
-from sweepik.reductions.kernels import address_of, lazy_njit, owned_kernel
+from sweepik.reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG, address_of, lazy_njit, owned_kernel
+from sweepik.reductions.pose_error import PoseErrorResidual
 from sweepik.subproblems.trig import wrap_pi
 
 try:  # numba is an optional dependency (extra "fast"); without it the NumPy engine runs
@@ -413,14 +417,15 @@ if AVAILABLE:
     @internal
     def _scan(
         res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
-        wv, wx, res_all, n_all, edge_f, edge_ok, fmask, f_all, later,
+        wv, wx, res_all, n_all, edge_f, edge_ok, fmask, f_all, later, signed,
     ):  # fmt: skip
         """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
         hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
         coordinate judges curvature (NaN: theta), ``fmask``: the samples masked as a family's (read at level 0
-        only), as in sweep._Search.scan. Level 0: ``f_all`` the sequence's residuals on every branch, ``later`` the
-        branches searched after this one; ``edge_f``, ``edge_ok`` the all-branch sub-samples of its intervals (next
-        to an edge, then not), and which are known."""
+        only); ``signed``: the residual changes sign at a simple root (not the pose error's norm,
+        ``PoseErrorResidual``: an edge at a sample is then judged as any other). Level 0: ``f_all`` the sequence's
+        residuals on every branch, ``later`` the branches searched after this one; ``edge_f``, ``edge_ok`` the
+        all-branch sub-samples of its intervals (next to an edge, then not), and which are known."""
         M = th.shape[0]
         valid = wv[:M]  # work arrays of the pose (no allocation per sequence)
         for j in range(M):  # (and the samples on a root: the ends of a resampled interval are its parent's)
@@ -463,7 +468,7 @@ if AVAILABLE:
                 bend = (not math.isnan(curv)) and lowest <= BEND * curv * h * h
                 own_edge = (open_l and th[j] == xe and not open_r) or (open_r and th[j + 1] == xe and not open_l)
                 refine = bend or (near_edge and not own_edge)
-                if level == 0 and open_l != open_r:  # (one edge: at a sample, judged in its coordinate)
+                if level == 0 and open_l != open_r and signed:  # (one edge: at a sample, judged in its coordinate)
                     refine = _edge_bent(res, p, b, th, f, valid, fmask, j, open_r, span, refine)
             if refine:
                 if top[0] >= stk_t.shape[0]:
@@ -572,6 +577,17 @@ if AVAILABLE:
                 j += 1
 
     @inlined
+    def _masked(th, f, fm, masks, b):
+        """The samples ``th`` of branch ``b`` inside a stretch of ``masks (K, 3)`` (lo, hi, branch) made NaN in ``f``
+        and marked in ``fm``, as a family's run is (``_family_runs``)."""
+        for k in range(masks.shape[0]):
+            if masks[k, 2] == b:
+                for j in range(th.shape[0]):
+                    if masks[k, 0] <= th[j] <= masks[k, 1]:
+                        f[j] = np.nan
+                        fm[j] = True
+
+    @inlined
     def _centred(res, p, ts, bs, n0, noise, span, probes, fam, fcnt, i):
         """The first ``n0`` candidates ``(ts, bs)`` of pose ``i`` centred on their flat stretch (``_center_flat``), or
         set apart as a family (``fam[i]``, ``fcnt[i]``); the others moved down. Returns how many stay (``probes[w]``:
@@ -617,16 +633,18 @@ if AVAILABLE:
         return w
 
     @inlined
-    def _scan_arrays(M):
-        """``_search``'s work arrays for ``_scan`` (the most samples of a pose: ``M``): the candidate count, the
-        stack of intervals to resample (theta, f, level and open ends, context), an empty context, the validity and
-        edge coordinates of a sequence. Explicit loops rather than np.zeros, np.full, slice copies or np.argsort:
-        each of those adds to the first compilation (docs/performance.md)."""
+    def _scan_arrays(M, K):
+        """``_search``'s work arrays for ``_scan`` (the most samples of a pose: ``M``; ``K`` candidates a pose): the
+        candidate count, the stack of intervals to resample (theta, f, level and open ends, context; ``STACK`` deep,
+        ``REDO_GROW`` times deeper with larger buffers: ``search``'s redo of a pose that overflowed), an empty
+        context, the validity and edge coordinates of a sequence. Explicit loops rather than np.zeros, np.full, slice
+        copies or np.argsort: each of those adds to the first compilation (docs/performance.md)."""
         c = np.empty(1, dtype=np.int64)
-        stk_t = np.empty((STACK, SUB_SAMPLES + 2))
-        stk_f = np.empty((STACK, SUB_SAMPLES + 2))
-        stk_i = np.empty((STACK, 3), dtype=np.int64)
-        stk_c = np.empty((STACK, 5))
+        depth = STACK * min(max(1, K // MAX_CAND), REDO_GROW)
+        stk_t = np.empty((depth, SUB_SAMPLES + 2))
+        stk_f = np.empty((depth, SUB_SAMPLES + 2))
+        stk_i = np.empty((depth, 3), dtype=np.int64)
+        stk_c = np.empty((depth, 5))
         no_ctx = np.empty(4)
         for k in range(4):
             no_ctx[k] = np.nan
@@ -673,6 +691,9 @@ if AVAILABLE:
         boolean,
         float64[:, :, ::1],
         int64[:, ::1],
+        float64[:, :, ::1],
+        int64[::1],
+        boolean,
         int64,
         int64,
     )
@@ -680,16 +701,18 @@ if AVAILABLE:
     @lazy_njit(_SEARCH_SIG, cache=True, nogil=True)
     def _search(
         res, res_all, n_all, params, grid, n_grid, branches, span, noise, out_t, out_b, out_m, cnt, fam, fcnt,
-        multiplicity, known, known_at, start, stop,
+        multiplicity, known, known_at, masks, n_masks, signed, start, stop,
     ):  # fmt: skip
         """Poses ``start .. stop - 1`` (threads run parts of a batch side by side: :mod:`sweepik.engine.parallel`),
         pose i's
         samples the first ``n_grid[i]`` of ``grid[i]`` (``sample_grid``); ``multiplicity`` False: every candidate's
         is given as 1, not worked out (``search``).
         ``res_all``: every branch's residual at once (``Reduction.kernel_residuals``), used for the uniform samples
-        when ``n_all`` (the number of branches it fills) is not 0. ``known (P, K, n_all)``: all-branch residuals the
-        caller has already, sample j of pose ``start + m`` being ``known[m, known_at[m, j]]`` where that is not -1
-        (``P = 0``: none).
+        when ``n_all`` (the number of branches it fills) is not 0. ``known (N, K, n_all)``: all-branch residuals the
+        caller has already, sample j of pose i being ``known[i, known_at[i, j]]`` where that is not -1 (no rows:
+        none). ``masks (N, K, 3)``: stretches ``(lo, hi, branch)`` of theta* whose samples pose i
+        leaves out of its search as a family's (its first ``n_masks[i]``; no rows: none), the continua traced
+        already. ``signed`` False: the residual is a pose error (``_scan``). (:mod:`sweepik.engine.rough_continua`).
 
         One function, not a loop calling a function per pose: Numba re-optimises everything a compiled function calls
         when it compiles the caller, and each level costs seconds on a fresh install."""
@@ -704,7 +727,9 @@ if AVAILABLE:
         )
         cnt, fam, fcnt, span = unowned(cnt), unowned(fam), unowned(fcnt), unowned(span)
         # work arrays, shared by the poses (each pose sets what it reads)
-        own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx = _scan_arrays(grid.shape[1])
+        own_c, own_stk_t, own_stk_f, own_stk_i, own_stk_c, own_no_ctx, own_wv, own_wx = _scan_arrays(
+            grid.shape[1], out_t.shape[1]
+        )
         own_buf_t, own_buf_f, own_buf_c, own_f_all, own_edge_f, own_edge_ok, own_f, own_top, own_probes, own_fm = (
             _pose_arrays(grid.shape[1], n_all, out_t.shape[1])
         )
@@ -724,7 +749,7 @@ if AVAILABLE:
                 edge_ok[0, j] = False
                 edge_ok[1, j] = False
             if n_all > 0:
-                _all_branch_samples(res_all, p, th, n_all, known, known_at, i - start, f_all)
+                _all_branch_samples(res_all, p, th, n_all, known, known_at, i, f_all)
             for bi in range(branches.shape[0]):
                 if c[0] > out_t.shape[1] or fcnt[i] > fam.shape[1]:  # (overflowed: redone by the NumPy engine)
                     break
@@ -733,6 +758,8 @@ if AVAILABLE:
                     f[j] = f_all[j, b] if n_all > 0 else res(p, th[j], b)
                     fm[j] = False
                 _family_runs(res, p, b, th, f, fm, span[i], fam, fcnt, i)
+                if masks.shape[0] > 0:
+                    _masked(th, f, fm, masks[i, : n_masks[i]], b)
                 top[0] = 0
                 # the sequence itself, then the resampled intervals it (and they) push on the stack
                 # level 0, not open at either end: read from ``top`` rather than written as constants (Numba would
@@ -743,7 +770,7 @@ if AVAILABLE:
                 while True:
                     _scan(res, p, b, seq_t, seq_f, level, el, er, ctx, xe, span[i], noise, xtol, out_t[i], out_b[i],
                           c, stk_t, stk_f, stk_i, stk_c, top, wv, wx, res_all, n_all, edge_f, edge_ok,
-                          fm, f_all, branches[bi + 1 :])  # fmt: skip
+                          fm, f_all, branches[bi + 1 :], signed)  # fmt: skip
                     if top[0] == 0 or c[0] > out_t.shape[1]:
                         break
                     top[0] -= 1
@@ -910,7 +937,7 @@ if AVAILABLE:
         fcnt[i] = 0
         se(res, res_all, n_all, params[i : i + 1], grid[:M].reshape((1, M)), n_grid, branches, span, noise,
            out_t[i : i + 1], out_b[i : i + 1], out_m[i : i + 1], cnt[i : i + 1], fam[i : i + 1], fcnt[i : i + 1], mult,
-           known, known_at, 0, 1)  # fmt: skip
+           known, known_at, np.empty((0, 0, 3)), np.empty(0, dtype=np.int64), True, 0, 1)  # fmt: skip
 
     @inlined
     def _known_at(grid, M, a, b, s, known_at):
@@ -1170,11 +1197,15 @@ def _plan(reduction) -> _Plan:
 
 
 def _make_plan(red) -> _Plan:
-    res_all = _kernel_residuals(red)
-    hints = _hints_kernel(red)
     j = red.free_joint
     ends = np.zeros(0) if red.periodic else np.array([red.robot.lower[j], red.robot.upper[j]], dtype=np.float64)
     branches = np.asarray(red.search_branches, dtype=np.int64)
+    if not red.uses_kernel:  # (its residual called back: :mod:`sweepik.engine.callback`)
+        residual = address_of(callback.residual, RESIDUAL_SIG)
+        residuals = address_of(callback.residuals, RESIDUALS_SIG)
+        return _Plan(residual, residuals, int(red.n_branches), branches, None, 0, ends, bool(red.periodic), None)
+    res_all = _kernel_residuals(red)
+    hints = _hints_kernel(red)
     plan = _Plan(
         residual=address_of(red.kernel[0], RESIDUAL_SIG),
         residuals=address_of(_no_residuals if res_all is None else res_all, RESIDUALS_SIG),
@@ -1279,6 +1310,8 @@ def search(
     (``candidates.twin_copies``). A reduction with a hints kernel or an ``EdgeSearch`` finds each pose's samples and
     candidates, twins' copies included, in one compiled pass, unless ``one_pass`` is False: then ``sample_grid``
     gives the samples of every pose first (the same samples: the tests compare the two)."""
+    if not reduction.uses_kernel:
+        return _called_back(reduction, poses, lo, hi, n_samples, multiplicity)
     params = np.ascontiguousarray(reduction.kernel_params(poses) if params is None else params, dtype=np.float64)
     N = poses.shape[0]
     out = _Out.empty(N)
@@ -1312,7 +1345,7 @@ def search(
     if redone:
         idx = np.nonzero(over)[0]
         masked = None if before_redo is None else before_redo(idx)
-        c2, s2 = _ref.find_candidates(reduction, poses[idx], lo[idx], hi[idx], n_samples, masked)
+        c2, s2 = _redone(reduction, plan, poses[idx], params[idx], lo[idx], hi[idx], n_samples, multiplicity, masked)
         if one is not None:  # (the one-pass kernels copied the others' candidates to their twins)
             c2 = candidates.twin_candidates(reduction, c2)
         cand = candidates.Candidates(
@@ -1336,6 +1369,80 @@ def search(
         order = np.argsort(cand.pose, kind="stable")
         cand = candidates.Candidates(cand.pose[order], cand.branch[order], cand.theta[order], cand.mult[order])
     return cand, candidates.twin_spans(reduction, spans)
+
+
+def _called_back(
+    reduction, poses: Array, lo: Array, hi: Array, n_samples: int, multiplicity: bool
+) -> tuple[candidates.Candidates, candidates.Spans]:
+    """``search`` for a reduction without a compiled kernel (:mod:`sweepik.engine.callback`): its residual at every
+    pose's samples in one vectorised call, the rest called back from the compiled search; a reduction without a
+    residual (``residual`` gives None) is searched on its pose error (``PoseErrorResidual``). The twins' copies
+    are made from its own candidates."""
+    N = poses.shape[0]
+    theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples)
+    M = theta.shape[1]
+    sampled = np.arange(M)[None, :] < n_theta[:, None]
+    grid = np.where(sampled, theta, np.nan)
+    searched, f = reduction, reduction.residual(poses, grid)
+    if f is None:
+        searched = PoseErrorResidual(reduction, orientation_weight(reduction.robot.length_unit))
+        f = searched.residual(poses, grid)
+    known = np.ascontiguousarray(np.asarray(f, dtype=np.float64).reshape(N, M, reduction.n_branches))
+    known_at = np.where(sampled, np.arange(M)[None, :], -1).astype(np.int64)
+    plan = _plan(searched)
+    out = _Out.empty(N)
+    with callback.registered(searched, poses) as params:
+        _run_search(searched, plan, params, theta, n_theta, lo, hi, multiplicity, out, known=(known, known_at))
+        over = (out.cnt > MAX_CAND) | (out.fcnt > MAX_FAM)
+        cand, spans = _gathered(out, over)
+        if over.any():
+            idx = np.nonzero(over)[0]
+            c2, s2 = _redone(searched, plan, poses[idx], params[idx], lo[idx], hi[idx], n_samples, multiplicity, None)
+            cand = candidates.Candidates(
+                np.concatenate([cand.pose, idx[c2.pose]]),
+                np.concatenate([cand.branch, c2.branch]),
+                np.concatenate([cand.theta, c2.theta]),
+                np.concatenate([cand.mult, c2.mult]),
+            )
+            spans = candidates.Spans.concat([spans, candidates.Spans(idx[s2.pose], s2.branch, s2.lo, s2.hi)])
+    cand = candidates.Candidates(
+        cand.pose.astype(np.intp), cand.branch.astype(np.intp), cand.theta, cand.mult.astype(np.intp)
+    )
+    spans = candidates.Spans(spans.pose.astype(np.intp), spans.branch, spans.lo, spans.hi)
+    return candidates.twin_copies(reduction, cand, spans)
+
+
+def _redone(
+    reduction, plan, poses, params, lo, hi, n_samples, multiplicity, masked
+) -> tuple[candidates.Candidates, candidates.Spans]:
+    """The poses that overflowed the search's buffers (their candidates, family spans or pending intervals) searched
+    again by the staged search on the same samples, with buffers ``REDO_GROW`` times larger, and larger again while
+    one still overflows (up to ``REDO_MAX`` times the first), leaving out the stretches ``masked`` (``Spans`` of
+    these poses: continua traced already)."""
+    N = poses.shape[0]
+    theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
+    n_masks = np.zeros(N, dtype=np.int64)
+    masks = np.empty((0, 0, 3))
+    if masked is not None and len(masked):
+        n_masks = np.bincount(masked.pose, minlength=N).astype(np.int64)
+        masks = np.zeros((N, int(n_masks.max()), 3))
+        order = np.argsort(masked.pose, kind="stable")
+        p = masked.pose[order]
+        slot = np.arange(p.size) - np.repeat(np.cumsum(n_masks) - n_masks, n_masks)
+        masks[p, slot] = np.stack([masked.lo[order], masked.hi[order], masked.branch[order]], axis=1)
+    grow = REDO_GROW
+    while True:
+        out = _Out.empty(N, MAX_CAND * grow, MAX_FAM * grow)
+        _run_search(reduction, plan, params, theta, n_theta, lo, hi, multiplicity, out, masks, n_masks)
+        over = (out.cnt > out.t.shape[1]) | (out.fcnt > out.fam.shape[1])
+        if not over.any():
+            return _gathered(out, over)
+        if grow >= REDO_MAX:
+            raise RuntimeError(
+                f"the search of {reduction.name!r} found more than {MAX_CAND * grow} candidates or "
+                f"{MAX_FAM * grow} families on a pose: its residual crosses zero that often along theta*"
+            )
+        grow *= REDO_GROW
 
 
 def edge_zeros(reduction, poses: Array, lo: Array, hi: Array) -> Array:
@@ -1406,13 +1513,13 @@ class _Out:
     fcnt: NDArray[np.int64]
 
     @classmethod
-    def empty(cls, N: int) -> _Out:
+    def empty(cls, N: int, K: int = MAX_CAND, F: int = MAX_FAM) -> _Out:
         return cls(
-            np.empty((N, MAX_CAND)),
-            np.empty((N, MAX_CAND), dtype=np.int64),
-            np.empty((N, MAX_CAND), dtype=np.int64),
+            np.empty((N, K)),
+            np.empty((N, K), dtype=np.int64),
+            np.empty((N, K), dtype=np.int64),
             np.zeros(N, dtype=np.int64),
-            np.empty((N, MAX_FAM, 3)),
+            np.empty((N, F, 3)),
             np.zeros(N, dtype=np.int64),
         )
 
@@ -1453,9 +1560,17 @@ def _run_one_pass(reduction, plan, one, poses, params, lo, hi, n_samples, multip
     return redo
 
 
-def _run_search(reduction, plan, params, theta, n_theta, lo, hi, multiplicity, out):
+def _run_search(
+    reduction, plan, params, theta, n_theta, lo, hi, multiplicity, out, masks=None, n_masks=None, known=None
+):
     """``_search`` over the poses' samples ``theta (N, M)`` (the first ``n_theta[i]`` of row i), on threads for a
-    batch."""
+    batch, leaving out the stretches ``masks (N, K, 3)`` (the first ``n_masks[i]`` of pose i; None: none);
+    ``known``: every branch's residual at the samples, ``(values (N, M, n_all), where (N, M))`` (``_search``'s
+    ``known`` and ``known_at``; None: none)."""
+    if masks is None or not masks.size:
+        masks, n_masks = np.empty((0, 0, 3)), np.empty(0, dtype=np.int64)
+    if known is None:
+        known = (np.empty((0, 0, 1)), np.empty((0, 0), dtype=np.int64))
     parallel.run(
         _search,
         theta.shape[0],
@@ -1476,8 +1591,11 @@ def _run_search(reduction, plan, params, theta, n_theta, lo, hi, multiplicity, o
         out.fam,
         out.fcnt,
         multiplicity,
-        np.empty((0, 0, 1)),
-        np.empty((0, 0), dtype=np.int64),
+        known[0],
+        known[1],
+        np.ascontiguousarray(masks, dtype=np.float64),
+        np.ascontiguousarray(n_masks, dtype=np.int64),
+        not isinstance(reduction, PoseErrorResidual),
     )
 
 
@@ -1489,7 +1607,8 @@ def _gathered(out: _Out, over: NDArray[np.bool_]) -> tuple[candidates.Candidates
     cand = candidates.Candidates(pose_idx, out.b[pose_idx, slot], out.t[pose_idx, slot], out.m[pose_idx, slot])
     spans = candidates.Spans.empty()
     if out.fcnt.any():
-        fp, fs = np.nonzero((np.arange(MAX_FAM)[None, :] < np.minimum(out.fcnt, MAX_FAM)[:, None]) & ~over[:, None])
+        F = out.fam.shape[1]
+        fp, fs = np.nonzero((np.arange(F)[None, :] < np.minimum(out.fcnt, F)[:, None]) & ~over[:, None])
         fam = out.fam
         spans = candidates.Spans(fp.astype(np.intp), fam[fp, fs, 2].astype(np.intp), fam[fp, fs, 0], fam[fp, fs, 1])
     return cand, spans

@@ -192,11 +192,17 @@ DIFF_LEVELS = 3
 # The compiled search's buffers (search.py)
 
 #: Candidates and family spans kept per pose (the C-Arm has at most 8 rail positions; edges and near misses add
-#: candidates). Overflow is reported and the pose is redone by the NumPy engine.
+#: candidates). A pose that overflows them is searched again with larger buffers (``REDO_GROW``).
 MAX_CAND = 256
 MAX_FAM = 16
 #: Pending resampled intervals per pose and branch (depth-first, so a few dozen suffice).
 STACK = 512
+#: A pose that overflows the buffers is searched again with buffers REDO_GROW times larger (the stack too), and
+#: larger again while it still overflows, up to REDO_MAX times (131,072 candidates: a residual crossing zero that
+#: often is an error, not an arm: a UR5 pose on a continuum the sweep sees only roughly crossed it 91,000 times
+#: before such continua were traced first, :mod:`sweepik.engine.rough_continua`).
+REDO_GROW = 8
+REDO_MAX = 512
 #: Batches at least this large are searched with parallel threads.
 PARALLEL_MIN = 64
 

@@ -59,10 +59,9 @@ from sweepik.engine.settings import (
     U_UNIFORM,
     XTOL_REL,
 )
-from sweepik.model import kinematics
-from sweepik.model.pose import pose_error_geodesic
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import Array, IntArray, Reduction
+from sweepik.reductions.pose_error import PoseErrorResidual
 
 
 def _edge_coordinate(theta: Array, edge: Array) -> Array:
@@ -579,36 +578,6 @@ def _families(
     lo = np.where(S0 > 0, _extend(reduction, poses[P], Bb, lo, theta[P, np.maximum(S0 - 1, 0)]), lo)
     hi = np.where(S1 < M - 1, _extend(reduction, poses[P], Bb, hi, theta[P, np.minimum(S1 + 1, M - 1)]), hi)
     return Spans(P.astype(np.intp), Bb.astype(np.intp), lo, hi), in_family
-
-
-class PoseErrorResidual(Reduction):
-    """Wraps a reduction without a residual: its "residual" is the pose error (position + weight x angle,
-    length unit) of each branch's configuration. Non-negative, so roots show up as local minima that touch
-    zero; the engine's extremum search and the FK certification handle them (at some cost in speed).
-    """
-
-    def __init__(self, inner: Reduction, weight: float) -> None:
-        super().__init__(inner.robot, inner.free_joint, inner.n_branches)
-        self.inner = inner
-        self.weight = weight
-        self.name = inner.name
-        self.residual_noise = 1e-14 * inner.robot.length_scale
-        self._inv_base = np.linalg.inv(inner.robot.T_world_base)
-
-    def solve_rest(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        return self.inner.solve_rest(poses, theta, branch)
-
-    def residual(self, poses: Array, theta: Array, branch: IntArray | None = None) -> Array:
-        q = self.inner.solve_rest(poses, theta, branch)
-        T = self._inv_base @ kinematics.chain_frames(self.robot, q)[..., -1, :, :]
-        target = poses.reshape(poses.shape[0], *((1,) * (q.ndim - 2)), 4, 4)
-        return pose_error_geodesic(T, target, self.weight)
-
-    def sample_hints(self, poses: Array) -> Array | None:
-        return self.inner.sample_hints(poses)
-
-    def edge_reduction(self, poses: Array, hints: Array | None) -> tuple[Reduction, Array, Array] | None:
-        return self.inner.edge_reduction(poses, hints)
 
 
 def find_candidates(
