@@ -10,7 +10,7 @@ rounding level), not a test: it takes minutes. Run from the repository root (it 
 The poses: on every bundled six-joint arm and two random arms of every ``test_any_arm`` family, 250 random in-limit
 configurations' poses, half of them with one to three joints set to 0, +-90 deg or 180 deg (slides to 0), mostly on
 the singular set; solved batched with and without limits, and the first 40 one by one; then the C-Arm's 15,900 grid
-poses. ``SWEEPIK_DISABLE_NUMBA=1``: the NumPy engine on a third of the arms, 30 poses each. ``compare`` prints the
+poses. ``compare`` prints the
 poses whose solution counts, multiplicities or families differ, and the largest difference of matched solutions,
 simple and multiple roots apart (rounding-level differences are expected from any change of arithmetic; a multiple
 root is pinned down only to its flat stretch, ~1e-5 of theta*'s range).
@@ -43,18 +43,18 @@ def configurations(robot: sweepik.Robot, n: int) -> np.ndarray:
     return q
 
 
-def arms(numpy_engine: bool) -> list[tuple[str, sweepik.Robot]]:
+def arms() -> list[tuple[str, sweepik.Robot]]:
     out = []
     for path in sorted(glob.glob("src/sweepik/io/robots/*.toml")):
         robot = sweepik.load_robot(os.path.basename(path)[:-5])
         if robot.n_joints == 6:
             out.append((robot.name, robot))
     for family in sorted(FAMILIES):
-        for seed in range(1 if numpy_engine else 2):
+        for seed in range(2):
             rng = np.random.default_rng(seed + 300)
             convention = "modified" if family == "rail_pair" else "standard"
             out.append((f"{family}[{seed}]", _arm(FAMILIES[family](rng), rng, convention)))
-    return out[::3] if numpy_engine else out
+    return out
 
 
 def record(solutions: sweepik.Solutions) -> tuple[np.ndarray, np.ndarray, list[tuple[float, float]]]:
@@ -62,10 +62,9 @@ def record(solutions: sweepik.Solutions) -> tuple[np.ndarray, np.ndarray, list[t
 
 
 def solve_all() -> dict[tuple[str, object], object]:
-    numpy_engine = bool(os.environ.get("SWEEPIK_DISABLE_NUMBA"))
-    n = 30 if numpy_engine else 250
+    n = 250
     out: dict[tuple[str, object], object] = {}
-    for name, robot in arms(numpy_engine):
+    for name, robot in arms():
         T = robot.fk(configurations(robot, n))
         try:
             for limits in (True, False):
@@ -74,9 +73,8 @@ def solve_all() -> dict[tuple[str, object], object]:
         except sweepik.SweepikError as e:
             out[(name, "error")] = repr(e)
         print(name, file=sys.stderr, flush=True)
-    if not numpy_engine:
-        carm = sweepik.load_robot("carm")
-        out[("grid", True)] = [record(s) for s in sweepik.solve_many(carm, carm.fk(grid_configurations(True)))]
+    carm = sweepik.load_robot("carm")
+    out[("grid", True)] = [record(s) for s in sweepik.solve_many(carm, carm.fk(grid_configurations(True)))]
     return out
 
 

@@ -5,7 +5,6 @@ convention, with base and tool transforms; and certification itself: a candidate
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from conftest import random_configs, random_dh_robot
 from hypothesis import given
 from hypothesis import strategies as st
@@ -14,8 +13,6 @@ from sweepik import load_robot
 from sweepik.engine import certify
 from sweepik.model.pose import pose_error_geodesic, pose_error_paper
 from sweepik.model.units import orientation_weight
-
-pytestmark = pytest.mark.skipif(not certify.AVAILABLE, reason="numba not installed")
 
 
 @given(seed=st.integers(0, 2**32 - 1), convention=st.sampled_from(["modified", "standard"]))

@@ -11,10 +11,6 @@ import os
 import subprocess
 import sys
 
-import pytest
-
-from sweepik.engine import search
-
 SCRIPT = """
 import numpy as np, sweepik
 for name, kw in (("ur5", {}), ("carm", {"reduction": "auto"}), ("fanuc_crx10ia", {}), ("carm", {}), ("puma560", {})):
@@ -24,7 +20,6 @@ for name, kw in (("ur5", {}), ("carm", {"reduction": "auto"}), ("fanuc_crx10ia",
 """
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="the NumPy engine compiles nothing")
 def test_second_process_compiles_nothing():
     env = dict(os.environ, NUMBA_DEBUG_CACHE="1")
     run = [sys.executable, "-c", SCRIPT]

@@ -12,6 +12,7 @@ from importlib import resources
 
 import numpy as np
 import pytest
+from oracles import numpy_engine
 
 from sweepik import SweepikError, load_robot, solve, solve_many
 from sweepik.engine.chunk import chain_poses as _chain_poses
@@ -311,14 +312,12 @@ def test_numerical_continuum_next_to_a_self_motion(q: list[float]) -> None:
 
 
 def test_compiled_trace_follows_the_reference() -> None:
-    """The compiled side of a trace (``_side_compiled``) and its NumPy reference (``_side``) follow the same continuum
+    """The compiled side of a trace (``continuation._side``) and its NumPy reference follow the same continuum
     to the same ends (the trace's resolution), their members solving the pose; a small buffer hands the compiled
     trace on several times."""
     import sweepik.engine.continuation as cont
     from sweepik.engine.settings import ACCEPT_TOL_REL, TRACE_HALVINGS, TRACE_STEPS
 
-    if not cont.AVAILABLE:
-        pytest.skip("compiled kernels only")
     robot = load_robot("carm")
     q0 = on_theta2_self_motion(robot, np.random.default_rng(2), 1)[0]
     world = robot.fk(q0)
@@ -328,8 +327,8 @@ def test_compiled_trace_follows_the_reference() -> None:
     try:
         cont._BUFFER = 7
         for sign in (1.0, -1.0):
-            xs_c, qs_c, done_c = cont._side_compiled(robot, world, float(q0[1]), q0, 1, sign, np.pi, h0, tol)
-            xs_p, qs_p, done_p = cont._side(robot, world, float(q0[1]), q0, 1, sign, np.pi, h0, tol)
+            xs_c, qs_c, done_c = cont._side(robot, world, float(q0[1]), q0, 1, sign, np.pi, h0, tol)
+            xs_p, qs_p, done_p = numpy_engine.trace_side(robot, world, float(q0[1]), q0, 1, sign, np.pi, h0, tol)
             assert abs(done_c - done_p) <= 2.0 * h0 * 2.0**-TRACE_HALVINGS
             assert xs_c.size > 7  # (handed on)
             assert np.all(np.diff(xs_c) * sign > 0)

@@ -5,11 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from oracles import numpy_engine
 
 import sweepik
-from sweepik.engine import dedupe, search
-
-pytestmark = pytest.mark.skipif(not search.AVAILABLE, reason="compares the compiled pass with the reference")
+from sweepik.engine import dedupe
 
 
 def _candidates(robot: sweepik.Robot, rng: np.random.Generator, n_poses: int, per_pose: int):
@@ -34,13 +33,12 @@ def _candidates(robot: sweepik.Robot, rng: np.random.Generator, n_poses: int, pe
 
 @pytest.mark.parametrize("name", ["yaskawa_hc10", "carm", "ur5", "kinova_jaco2"])
 @pytest.mark.parametrize("per_pose", [3, 20, 60])
-def test_compiled_finish_equals_reference(name: str, per_pose: int, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_compiled_finish_equals_reference(name: str, per_pose: int) -> None:
     robot = sweepik.load_robot(name)
     rng = np.random.default_rng(per_pose)
     pose, q, err = _candidates(robot, rng, 7, per_pose)
     w_c, in_c, keep_c = dedupe.finish(robot, pose, q, err)
-    monkeypatch.setattr(dedupe, "AVAILABLE", False)
-    w_r, in_r, keep_r = dedupe.finish(robot, pose, q, err)
+    w_r, in_r, keep_r = numpy_engine.finish(robot, pose, q, err)
     np.testing.assert_array_equal(w_c, w_r)
     np.testing.assert_array_equal(in_c, in_r)
     np.testing.assert_array_equal(keep_c, keep_r)
@@ -55,7 +53,7 @@ def test_compiled_finish_equals_reference(name: str, per_pose: int, monkeypatch:
 
 
 @pytest.mark.parametrize("joint", [0, 3, 5])
-def test_a_continuum_across_the_seam_deduplicates_as_the_reference(joint: int, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_continuum_across_the_seam_deduplicates_as_the_reference(joint: int) -> None:
     """Thousands of candidates of one pose along an arc of one joint that crosses +-pi (a numerical continuum's, the
     other joints constant or drifting by less than the tolerance), with near copies: the compiled pass (by buckets
     along the joint that spreads most) keeps exactly what the all-pairs reference keeps, seam pairs included."""
@@ -73,8 +71,7 @@ def test_a_continuum_across_the_seam_deduplicates_as_the_reference(joint: int, m
     err = rng.choice([1e-12, 2e-12], K)
     pose = np.zeros(K, dtype=np.intp)
     w_c, _, keep_c = dedupe.finish(robot, pose, q, err)
-    monkeypatch.setattr(dedupe, "AVAILABLE", False)
-    _, _, keep_r = dedupe.finish(robot, pose, q, err)
+    _, _, keep_r = numpy_engine.finish(robot, pose, q, err)
     np.testing.assert_array_equal(keep_c, keep_r)
     assert 0 < keep_c.sum() < K
 

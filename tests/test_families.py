@@ -10,7 +10,7 @@ import pytest
 
 import sweepik
 from sweepik import load_robot
-from sweepik.engine import chunk, search, settings
+from sweepik.engine import chunk, settings
 from sweepik.experiments.bench import grid_configurations
 
 CARM = load_robot("carm")
@@ -40,7 +40,6 @@ def test_self_motion_reported_by_both_reductions_without_duplicates(reduction: s
     np.testing.assert_allclose(sol.nearest(q), q, atol=1e-6)
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize(
     ("name", "reduction"), [("carm", "carm-d1"), ("carm", "auto"), ("ur5", "auto"), ("xarm6", None)]
 )

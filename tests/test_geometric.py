@@ -93,7 +93,6 @@ def _closed_form_reductions() -> list[sweepik.reductions.GeometricReduction]:
     ]
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize(
     "red", _closed_form_reductions(), ids=lambda r: f"{r.robot.name}-{r.plan.family}-{r.plan.case}"
 )

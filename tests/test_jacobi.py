@@ -4,11 +4,6 @@ zero-column, wide and badly scaled matrices, every cut-off the polish uses."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
-
-from sweepik.engine.search import AVAILABLE
-
-pytestmark = pytest.mark.skipif(not AVAILABLE, reason="compiled kernels only")
 
 
 def _step():  # type: ignore[no-untyped-def]

@@ -11,7 +11,7 @@ from conftest import carm_stress_configurations
 
 import sweepik
 from sweepik import load_robot
-from sweepik.engine import candidates, chunk, search
+from sweepik.engine import chunk, search
 
 CARM = load_robot("carm")
 
@@ -33,7 +33,6 @@ def test_subclass_overriding_the_residual_does_not_run_the_parents_kernel() -> N
     assert np.abs(sols.nearest(q) - q).max() < 1e-6
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 def test_all_branch_kernel_is_bitwise_the_branch_kernel() -> None:
     """carm-d1's all-branch residual kernel (used for the uniform samples) gives exactly, bit for bit, what the
     one-branch kernel gives: same roots, same extrema, same families as branch-by-branch evaluation."""
@@ -85,16 +84,15 @@ def test_carm_d1_twin_branches_have_the_same_residual_bit_for_bit() -> None:
         cfg_b = red.solve_rest(chain, theta, np.full(theta.shape, b))
         both = np.all(np.isfinite(cfg_a), axis=-1) & np.all(np.isfinite(cfg_b), axis=-1)
         assert both.any() and np.all(np.any(cfg_a[both] != cfg_b[both], axis=-1))
-    if search.AVAILABLE:
-        from sweepik.reductions import kernels
+    from sweepik.reductions import kernels
 
-        params = red.kernel_params(chain)
-        for i in range(0, len(q), 7):
-            for th in theta[i]:
-                for a, b in red.twins:
-                    fa = kernels.carm_d1_residual(params[i], float(th), a)
-                    fb = kernels.carm_d1_residual(params[i], float(th), b)
-                    assert fa == fb or (np.isnan(fa) and np.isnan(fb))
+    params = red.kernel_params(chain)
+    for i in range(0, len(q), 7):
+        for th in theta[i]:
+            for a, b in red.twins:
+                fa = kernels.carm_d1_residual(params[i], float(th), a)
+                fb = kernels.carm_d1_residual(params[i], float(th), b)
+                assert fa == fb or (np.isnan(fa) and np.isnan(fb))
 
 
 def test_carm_d1_hints_kernel_is_bitwise_sample_hints() -> None:
@@ -129,8 +127,8 @@ def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
     """A reduction's own hints kernel over a revolute theta* (hints beyond +-pi, NaN, on the grid, repeated): the
     compiled samples are the reference's, the hints wrapped into [-pi, pi] the same way."""
     import numba
+    from oracles import numpy_sweep as sweep
 
-    from sweepik.engine import sweep
     from sweepik.reductions import kernels
 
     values = np.array([0.3, 4.0, -7.5, np.nan, np.pi, -np.pi, 0.3, 1e3])
@@ -151,13 +149,12 @@ def test_hints_kernel_of_a_periodic_theta_is_wrapped_as_sample_hints() -> None:
     assert red.periodic and search._hints_kernel(red) is OwnHints.kernel_hints
     chain = CARM.fk(carm_stress_configurations(50, seed=13))
     lo, hi = chunk.theta_range(CARM, red, chain)
-    ref = candidates.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
+    ref = sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
     grid, count = search.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
     np.testing.assert_array_equal(grid, ref)  # (a hints kernel's NaN hint is a spare sample, as in the reference)
     assert (count == ref.shape[1]).all()
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="the compiled engine calls kernels by address")
 def test_a_kernel_of_the_wrong_signature_is_refused_and_one_without_is_compiled_for_the_engine() -> None:
     """A reduction's kernel is called through its address: one compiled for another signature (here a float32
     result) would read its arguments wrong and is refused with a clear error; a plain Python function too. A Numba

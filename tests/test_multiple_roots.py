@@ -8,13 +8,15 @@ from importlib import resources
 
 import numpy as np
 import pytest
+from oracles import numpy_engine
+from oracles.numpy_engine import numpy_reduction
 
 import sweepik
 from sweepik import RobotDefinitionError, load_robot, solve, solve_many
-from sweepik.engine import search
 from sweepik.engine.families import MAX_ISOLATED_SOLUTIONS
 from sweepik.io.robot_file import robot_from_dict
 from sweepik.model.pose import pose_error_geodesic
+from sweepik.reductions import get_reduction
 from sweepik.results import joint_distance
 
 CARM = load_robot("carm")
@@ -138,11 +140,11 @@ def test_near_continuum_is_not_hundreds_of_copies(scale: float, rng: np.random.G
         assert _certified(sol, TT)
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize("reduction", REDUCTIONS)
-def test_engines_agree_on_the_singular_set(
-    reduction: str, rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_kernel_and_numpy_reduction_agree_on_the_singular_set(reduction: str, rng: np.random.Generator) -> None:
+    """The reduction with its compiled kernels and without them (its NumPy residual called back from the search, its
+    configurations in NumPy: ``numpy_engine.numpy_reduction``) give the same solutions, multiplicities and families
+    on the C-Arm's singular set."""
     q = rng.uniform(CARM.lower, CARM.upper, (150, 6))
     q[:, 1] = 0.0
     q[:, 3] = rng.choice([-1.0, 1.0], 150) * np.pi / 2 - q[:, 2]
@@ -150,8 +152,7 @@ def test_engines_agree_on_the_singular_set(
     q = q[CARM.within_limits(q)]
     T = CARM.fk(q)
     fast = solve_many(CARM, T, reduction=reduction)
-    monkeypatch.setattr(search, "AVAILABLE", False)
-    ref = solve_many(CARM, T, reduction=reduction)
+    ref = solve_many(CARM, T, reduction=numpy_reduction(get_reduction(CARM, reduction)))
     for a, b, qq in zip(fast, ref, q, strict=True):
         assert _index_of(a, qq) is not None and _index_of(b, qq) is not None
         assert len(a) == len(b) and len(a.families) == len(b.families)
@@ -263,7 +264,7 @@ def test_near_pairs_compiled_is_the_reference(rng: np.random.Generator) -> None:
     keep = rng.random(w.shape[0]) > 0.1
     reach = np.full(6, 1e-4)
     got = dedupe.near_pairs(robot, pose, w, keep, reach)
-    want = dedupe._near_pairs(robot, pose, w, keep, reach)
+    want = numpy_engine.near_pairs(robot, pose, w, keep, reach)
     assert want.shape[0] > 40
     np.testing.assert_array_equal(got, want)
 

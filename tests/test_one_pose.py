@@ -14,8 +14,6 @@ import sweepik
 from sweepik import load_robot, solving
 from sweepik.engine import chunk, one_pose, search, settle
 
-pytestmark = pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
-
 
 def _poses(robot: sweepik.Robot, seed: int) -> np.ndarray:
     """Random configurations' poses, and poses on the singular set (joint 5 at 0, joint 3 at 0, both)."""

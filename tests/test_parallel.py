@@ -8,7 +8,7 @@ import threading
 import numpy as np
 import pytest
 
-from sweepik.engine import chunk, parallel, search
+from sweepik.engine import chunk, parallel
 
 
 def _record(out, seen, start, stop):
@@ -38,7 +38,6 @@ def test_kernel_error_is_raised():
         parallel.run(fail, 1000, 1)
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="Numba's thread setting")
 def test_numba_thread_setting_is_honoured():
     import numba
 
@@ -85,7 +84,6 @@ def test_in_order_threads_see_the_callers_setting():
     assert parallel.threads() == n  # (the setting is the chunk threads' own)
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="Numba's thread setting")
 def test_in_order_with_one_thread_runs_in_the_calling_thread():
     import numba
 

@@ -287,11 +287,7 @@ def test_compiled_wrap_is_the_numpy_wrap_bit_for_bit() -> None:
     """``_wrap.wrap_pi`` (compiled code's wrap, with a fast path for |pi - x| < 2 pi) gives exactly what the NumPy
     expression gives: at the fast path's ends, at multiples of pi, at +-0, an ulp from the ends, far out, inf, NaN."""
     numba = pytest.importorskip("numba")
-    from sweepik.engine import search
     from sweepik.subproblems.trig import wrap_pi
-
-    if not search.AVAILABLE:
-        pytest.skip("the NumPy engine runs without compiled code")
 
     @numba.njit
     def wrapped(xs: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -1,10 +1,9 @@
-"""The vectorised bracketed root finder (sweepik.engine.rootfind)."""
+"""The vectorised bracketed root finder of the NumPy reference sweep (tests/oracles/rootfind.py)."""
 
 from __future__ import annotations
 
 import numpy as np
-
-from sweepik.engine.rootfind import find_roots
+from oracles.rootfind import find_roots
 
 
 def test_find_roots_vectorised_to_full_precision() -> None:

@@ -1,5 +1,6 @@
-"""The compiled sweep search (sweepik.engine.search) against the NumPy reference engine (sweepik.engine.sweep): the same
-candidates, families and samples, staged or in one pass, with or without multiplicities, and the edge samples."""
+"""The compiled sweep search (sweepik.engine.search) against its NumPy reference (tests/oracles/numpy_sweep.py): the
+same candidates, families and samples, staged or in one pass, with or without multiplicities, and the edge samples; a
+reduction written in NumPy (no kernel: its residual called back) solves as its compiled kernel does."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ from typing import Any
 import numpy as np
 import pytest
 from conftest import carm_stress_configurations
+from oracles import numpy_sweep as sweep
+from oracles.numpy_engine import numpy_reduction
 
 import sweepik
 from sweepik import load_robot, solve_many
@@ -17,13 +20,13 @@ from sweepik.results import joint_distance
 CARM = load_robot("carm")
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize("reduction", ["carm-d1", "carm-theta2"])
-def test_compiled_and_numpy_engines_agree(reduction: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    T = CARM.fk(carm_stress_configurations(600, seed=3))
+def test_a_reduction_without_its_kernel_solves_as_with_it(reduction: str) -> None:
+    """The reduction's NumPy methods (its residual called back from the search, its configurations, its families'
+    members in NumPy) give the solutions its compiled kernels give."""
+    T = CARM.fk(carm_stress_configurations(300, seed=3))
     fast = solve_many(CARM, T, reduction=reduction)
-    monkeypatch.setattr(search, "AVAILABLE", False)
-    ref = solve_many(CARM, T, reduction=reduction)
+    ref = solve_many(CARM, T, reduction=numpy_reduction(sweepik.reductions.get_reduction(CARM, reduction)))
     for a, b in zip(fast, ref, strict=True):
         assert len(a) == len(b)
         assert len(a.families) == len(b.families)
@@ -32,13 +35,11 @@ def test_compiled_and_numpy_engines_agree(reduction: str, monkeypatch: pytest.Mo
             assert d.min(axis=1).max() <= 1e-8
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="the compiled merge (the reference is the NumPy engine's grid)")
 def test_compiled_sample_grid_is_the_numpy_one() -> None:
     """``search.sample_grid`` (compiled merge) gives the reference's samples of each pose alone, bit for bit, with
     no sample for a NaN hint (the reference makes it a spare midpoint, so that its rows have one length): hints
     inside and outside the range, NaN hints, hints on the uniform grid and repeated (runs of equal samples spread),
     real reductions. A pose's samples therefore do not depend on the batch it is solved in."""
-    from sweepik.engine import sweep
 
     def check(red: sweepik.reductions.Reduction, chain: np.ndarray, lo: np.ndarray, hi: np.ndarray, n: int) -> int:
         grid, count = search.sample_grid(red, chain, lo, hi, n)
@@ -47,7 +48,7 @@ def test_compiled_sample_grid_is_the_numpy_one() -> None:
         dropped = 0
         for i in range(chain.shape[0]):
             own = None if hints is None else hints[i : i + 1, np.isfinite(hints[i])]
-            ref = candidates.merge_grid(lo[i : i + 1], hi[i : i + 1], n, own)[0]
+            ref = sweep.merge_grid(lo[i : i + 1], hi[i : i + 1], n, own)[0]
             assert count[i] == ref.size
             np.testing.assert_array_equal(grid[i, : count[i]], ref)
             assert np.isnan(grid[i, count[i] :]).all()
@@ -65,7 +66,7 @@ def test_compiled_sample_grid_is_the_numpy_one() -> None:
             dropped += check(red, chain, lo, hi, sweep.N_SAMPLES)
         else:  # (a hints kernel writes as many for every pose: the reference's grid exactly)
             grid, count = search.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES)
-            np.testing.assert_array_equal(grid, candidates.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES))
+            np.testing.assert_array_equal(grid, sweep.sample_grid(red, chain, lo, hi, sweep.N_SAMPLES))
             assert (count == grid.shape[1]).all()
     assert dropped > 0  # (xArm 6's poses differ in their number of hints)
 
@@ -83,7 +84,6 @@ def test_compiled_sample_grid_is_the_numpy_one() -> None:
     assert check(Hinted(CARM), np.broadcast_to(np.eye(4), (N, 4, 4)), lo, hi, n) > 0
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 def test_margins_made_per_call_share_their_pair_plans_engine_plan() -> None:
     """The generic sweeps' margins are a reduction made afresh for each solve: the engine's plan of them (kernels,
     branches, limits) is worked out once per pair plan (``plan_key``), and is the one a fresh plan would be."""
@@ -102,13 +102,10 @@ def test_margins_made_per_call_share_their_pair_plans_engine_plan() -> None:
         assert search._plan(_Margins(other, np.zeros((1, 0)))) is not search._plan(m1)
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 def test_search_without_multiplicities_finds_the_same_candidates() -> None:
     """``search.search(..., multiplicity=False)`` (the margins' search) gives the same candidates and spans, each
     with multiplicity 1; with multiplicities, poses with a double root (theta2 = +-90 deg, theta3 = 0, the paper's
     excluded grid points) and random ones have some above 1 and some of 1, so the comparison sees what it ignores."""
-    from sweepik.engine import sweep
-
     red = sweepik.reductions.get_reduction(CARM, "carm-d1")
     q = carm_stress_configurations(100, seed=5)
     q[:30, 1] = np.pi / 2
@@ -132,7 +129,6 @@ def _same_search(a: Any, b: Any) -> None:
         np.testing.assert_array_equal(x, y)
 
 
-@pytest.mark.skipif(not search.AVAILABLE, reason="numba not installed")
 @pytest.mark.parametrize(
     ("name", "reduction"),
     [
@@ -150,10 +146,8 @@ def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeyp
     (its swing samples, its margins' zeros, its candidates: ``search.EdgeSearch``), theta* revolute or prismatic
     (the C-Arm's rail, automatic decomposition), and a reduction with a hints kernel (carm-d1). Random poses, and
     poses on the singular set (joint 5 at 0, joint 3 at 0, both). With the buffers cut to one candidate, every pose
-    overflows and is redone by the NumPy engine, in both; cut to the median count (carm-d1), some are: the same
-    candidates in the same order, twins' copies included."""
-    from sweepik.engine import sweep
-
+    with more overflows and is searched again with larger buffers, in both; cut to the median count (carm-d1), some
+    are: the same candidates in the same order, twins' copies included."""
     robot = load_robot(name)
     red = sweepik.reductions.get_reduction(robot, reduction)
     assert search._plan(red).one_pass is not None  # (the one-pass search is what is tested)
@@ -191,18 +185,12 @@ def test_one_pass_search_is_the_staged_search(name: str, reduction: str, monkeyp
 
 
 @pytest.mark.parametrize("engine", ["compiled", "numpy"])
-def test_edge_samples_far_from_zero_are_no_candidates(engine: str, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_edge_samples_far_from_zero_are_no_candidates(engine: str) -> None:
     """A sample next to a branch-domain edge or at the range's ends is a candidate only where its residual is within
     ``FAR_NOISE`` x noise of zero (as an extremum): a root there would make it small. Every candidate the search
     gives is then that close to zero; before, over half the CRX-10iA's candidates were such samples, far from it.
     (Next to a family's samples they stay candidates: the C-Arm's grid poses are unchanged, see docs/performance.md.)
     """
-    from sweepik.engine import sweep
-
-    if engine == "compiled" and not search.AVAILABLE:
-        pytest.skip("numba not installed")
-    if engine == "numpy":
-        monkeypatch.setattr(search, "AVAILABLE", False)
     robot = load_robot("fanuc_crx10ia")
     red = sweepik.reductions.get_reduction(robot, None)
     chain = chunk.chain_poses(robot, robot.fk(np.random.default_rng(4).uniform(robot.lower, robot.upper, (30, 6))))
@@ -223,9 +211,6 @@ def test_edge_intervals_left_alone_hide_no_roots(name: str, monkeypatch: pytest.
     densely (in the edge's coordinate, where a pair would sit), the residual changes sign exactly as often as its two
     ends show (once or not at all), and comes no nearer zero than they do unless it crosses. Random poses and poses
     on the singular set (joints at 0 and 90 deg)."""
-    from sweepik.engine import sweep
-
-    monkeypatch.setattr(search, "AVAILABLE", False)
     robot = load_robot(name)
     red = sweepik.reductions.get_reduction(robot, None)
     rng = np.random.default_rng(8)
@@ -270,7 +255,6 @@ def test_domain_edge_samples_lie_inside_their_domains(name: str) -> None:
     domain on either side). Random poses and poses on the singular sets."""
     from singular import singular_configurations
 
-    from sweepik.engine import sweep
     from sweepik.engine.settings import EDGE_PROBE_REL
 
     robot = load_robot(name)
@@ -281,10 +265,7 @@ def test_domain_edge_samples_lie_inside_their_domains(name: str) -> None:
     Q = np.concatenate([rng.uniform(robot.lower, robot.upper, (100, 6)), singular_configurations(robot, 100, rng)])
     chain = chunk.chain_poses(robot, robot.fk(Q))
     margins, lo, hi = red.edge_reduction(chain, red.sample_hints(chain))
-    if search.AVAILABLE:
-        cand, _ = search.search(margins, chain, lo, hi, sweep.N_SAMPLES, None, multiplicity=False)
-    else:  # (the NumPy engine's margin zeros, as ``edge_zeros`` takes them)
-        cand, _ = sweep.find_candidates(margins, chain, lo, hi, sweep.N_SAMPLES)
+    cand, _ = search.search(margins, chain, lo, hi, sweep.N_SAMPLES, None, multiplicity=False)
     if margins.periodic:
         cand = candidates.Candidates(cand.pose, cand.branch, candidates.wrapped(cand.theta), cand.mult)
     reach = EDGE_PROBE_REL * (hi - lo)

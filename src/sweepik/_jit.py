@@ -5,20 +5,19 @@ from __future__ import annotations
 
 from typing import Any, Final
 
+import numba
 import numpy as np
+from numba.core import cgutils, types
+from numba.extending import intrinsic
 from numpy.typing import ArrayLike, NDArray
 
-_njit: Any
-try:
-    from numba import njit as _njit
-except ImportError:  # pragma: no cover - without numba the NumPy engine is used
-    _njit = None
+_njit: Any = numba.njit  # (untyped: Numba's stubs do not list every option sweepik passes)
 
 __all__ = ["internal", "inlined", "unowned", "alive", "function_at", "writable", "ERROR_MODEL"]
 
 #: Numba's error model for every compiled function of sweepik: IEEE results for a division by zero (inf, NaN), as
-#: the NumPy reference engine gives them, rather than a ZeroDivisionError raised from deep inside a kernel (which
-#: would abort a whole batch where the NumPy engine gives a NaN sample or a candidate that fails certification).
+#: NumPy gives them, rather than a ZeroDivisionError raised from deep inside a kernel (which would abort a whole
+#: batch where a NaN sample or a candidate that fails certification is the right outcome).
 ERROR_MODEL: Final = "numpy"
 #: The options of ``internal`` and ``inlined``.
 _INTERNAL = {"cache": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True, "error_model": ERROR_MODEL}
@@ -29,8 +28,6 @@ def internal(fn: Any) -> Any:
     without the wrappers that let Python and C call it (``no_cpython_wrapper``, ``no_cfunc_wrapper``), which cost
     ~0.05 s each on a fresh install. Calling it from Python fails. Its Python function must not be compiled by
     another dispatcher too (Numba's disk cache keys on the function and the signature, not on these options)."""
-    if _njit is None:  # pragma: no cover
-        return fn
     return _njit(**_INTERNAL, forceinline=False)(fn)
 
 
@@ -45,38 +42,31 @@ def inlined(fn: Any) -> Any:
 
     Numba passes ``forceinline`` on to the functions first compiled while compiling an inlined one, unless they set
     it: ``internal`` sets it False, and so does a large subproblem (``sp5``, ``sp6``)."""
-    if _njit is None:  # pragma: no cover
-        return fn
     return _njit(**_INTERNAL, forceinline=True)(fn)
 
 
-unowned: Any = None
-alive: Any = None
-if _njit is not None:
-    from numba.core import cgutils, types
-    from numba.extending import intrinsic
+@intrinsic
+def unowned(typingctx: Any, a: Any) -> Any:
+    """Compiled code only: ``a`` (an array) as a view that is not reference-counted (no meminfo), so that passing it
+    or a view of it to a first-class function (a reduction's kernel) costs no atomic increment and decrement of
+    its reference count (Numba brackets every such call with them: about a fifth of the engine's time). Only for
+    an array that outlives every use of the view: an argument of the compiled function (its caller holds it)."""
+    if not isinstance(a, types.Array):
+        return None
 
-    @intrinsic
-    def unowned(typingctx: Any, a: Any) -> Any:
-        """Compiled code only: ``a`` (an array) as a view that is not reference-counted (no meminfo), so that passing it
-        or a view of it to a first-class function (a reduction's kernel) costs no atomic increment and decrement of
-        its reference count (Numba brackets every such call with them: about a fifth of the engine's time). Only for
-        an array that outlives every use of the view: an argument of the compiled function (its caller holds it)."""
-        if not isinstance(a, types.Array):
-            return None
+    def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
+        ary = context.make_array(sig.args[0])(context, builder, value=args[0])
+        ary.meminfo = cgutils.get_null_value(ary.meminfo.type)
+        return ary._getvalue()
 
-        def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
-            ary = context.make_array(sig.args[0])(context, builder, value=args[0])
-            ary.meminfo = cgutils.get_null_value(ary.meminfo.type)
-            return ary._getvalue()
+    return a(a), codegen
 
-        return a(a), codegen
 
-    @internal
-    def alive(*arrays: Any) -> int:
-        """Nothing: a use of arrays a compiled function allocated, after the last use of their ``unowned`` views, so
-        that they are freed after it."""
-        return len(arrays)
+@internal
+def alive(*arrays: Any) -> int:
+    """Nothing: a use of arrays a compiled function allocated, after the last use of their ``unowned`` views, so
+    that they are freed after it."""
+    return len(arrays)
 
 
 def function_at(sig: Any) -> Any:
@@ -89,8 +79,6 @@ def function_at(sig: Any) -> Any:
     it through its C wrapper; from the address it is called directly, with Numba's own calling convention. The address
     must be that of a compiled function of exactly this signature that outlives the call (the dispatcher holds it).
     """
-    if _njit is None:  # pragma: no cover
-        return None
     fnty = types.FunctionType(sig)
 
     @intrinsic

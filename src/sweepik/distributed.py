@@ -34,7 +34,7 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sweepik.engine.sweep import N_SAMPLES
+from sweepik.engine.settings import N_SAMPLES
 from sweepik.errors import ShapeError, SweepikError, UnknownOptionError
 from sweepik.io.store import (
     StoreError,
@@ -85,13 +85,11 @@ def _dask() -> Any:
 def _solve_task(robot: Robot, poses: ArrayLike, options: Mapping[str, Any], start: int) -> Block:
     """The solutions of one chunk of poses ``(n, 4, 4)`` (poses ``start:start + n`` of the run), as one Block:
     ``solve_many`` on the chunk (a bad pose is named by its place in the run)."""
-    from sweepik.engine.search import AVAILABLE
+    import numba
+
     from sweepik.solving import solve_many
 
-    if AVAILABLE:  # Dask runs a task per worker thread: the compiled kernels must not fan out to every core too
-        import numba
-
-        numba.set_num_threads(1)
+    numba.set_num_threads(1)  # (Dask runs a task per worker thread: the compiled kernels must not fan out too)
     arr = as_float_array(poses, "poses")
     P = check_poses(arr, f"poses[{start}:{start + arr.shape[0]}]" if arr.ndim == 3 else "poses")
     if P.ndim != 3:

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
-from sweepik.engine.sweep import N_SAMPLES
+from sweepik.engine.settings import N_SAMPLES
 from sweepik.engine.windings import wound_block, wound_solutions
 from sweepik.errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
 from sweepik.model.origin_axis import HeldJoints, hold_joints, lock_runs, per_pose
@@ -49,9 +49,7 @@ SPLIT_MIN = 256
 #: Largest ``chunk_size`` accepted (any larger value behaves like this one).
 MAX_CHUNK = 2**31
 #: Pose-samples per chunk (chunk x ``n_samples``): a larger ``n_samples`` runs in smaller chunks, so memory stays
-#: that of the defaults (2048 poses x 64 samples). Chunking changes no solution (without Numba, on arms whose
-#: poses differ in their number of sample hints, e.g. the generic sweeps, some move by rounding, ~1e-13: the NumPy
-#: engine's grid gives a pose a spare sample for each hint another pose of its batch has).
+#: that of the defaults (2048 poses x 64 samples). Chunking changes no solution (each pose's samples are its own).
 SAMPLE_BUDGET = CHUNK * N_SAMPLES
 #: The paper's strategy sweeps theta* in 10 mm (or 1 degree) steps over its whole range: a range needing more
 #: coarse samples than this (2 km of rail in mm) is refused, as its memory (~2 kB per pose-sample) and time grow

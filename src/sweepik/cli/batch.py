@@ -27,7 +27,7 @@ from sweepik.cli.common import (
     _subparser,
     _SubParsers,
 )
-from sweepik.engine.sweep import N_SAMPLES
+from sweepik.engine.settings import N_SAMPLES
 from sweepik.model.robot import Robot
 
 #: Exit status of a run stopped by Ctrl-C (SIGINT), as shells report it (128 + 2).

@@ -108,43 +108,6 @@ def wrapped(theta: Array) -> Array:
     return np.pi - np.mod(np.pi - theta, 2.0 * np.pi)
 
 
-def sample_grid(reduction: Reduction, poses: Array, lo: Array, hi: Array, n_samples: int) -> Array:
-    """Sorted theta* samples ``(N, M)``: a uniform grid on [lo, hi] plus the reduction's hints inside it
-    (``grid_hints``; :func:`sweepik.engine.search.sample_grid` is the compiled version)."""
-    return merge_grid(lo, hi, n_samples, grid_hints(reduction, poses))
-
-
-def merge_grid(lo: Array, hi: Array, n_samples: int, hints: Array | None) -> Array:
-    """``sample_grid`` from the hints: the uniform grid, the hints inside [lo, hi], sorted, repeats spread."""
-    s = unit_grid(n_samples)
-    grid = lo[:, None] + (hi - lo)[:, None] * s[None, :]
-    if hints is not None and hints.size:
-        inside = np.isfinite(hints) & (hints >= lo[:, None]) & (hints <= hi[:, None])
-        # a hint outside the range becomes a midpoint of the uniform grid (a distinct, harmless extra sample)
-        spare = lo[:, None] + (hi - lo)[:, None] * ((np.arange(hints.shape[1]) + 0.5) / (n_samples - 1))[None, :]
-        hints = np.where(inside, hints, spare)
-        grid = np.concatenate([grid, hints], axis=1)
-    grid = np.sort(grid, axis=1)
-    # a sample repeated (a hint on the grid, hints outside the range all set to lo) would leave zero-width
-    # intervals, where the three-sample extremum test cannot work (a double root exactly at that sample would go
-    # unseen): each run of equal samples is spread evenly towards the next distinct sample
-    new_run = np.ones(grid.shape, dtype=bool)
-    new_run[:, 1:] = grid[:, 1:] > grid[:, :-1]
-    if new_run.all():
-        return grid
-    M = grid.shape[1]
-    idx = np.broadcast_to(np.arange(M), grid.shape)
-    start = np.maximum.accumulate(np.where(new_run, idx, 0), axis=1)
-    nxt = np.full(grid.shape, M)
-    nxt[:, :-1] = np.minimum.accumulate(np.where(new_run, idx, M)[:, :0:-1], axis=1)[:, ::-1]
-    r_i, r_j = np.nonzero(~new_run & (nxt < M))
-    if r_i.size:
-        s0, e0 = start[r_i, r_j], nxt[r_i, r_j]
-        base = grid[r_i, s0]
-        grid[r_i, r_j] = base + (grid[r_i, e0] - base) * (r_j - s0) / (e0 - s0)
-    return grid
-
-
 def twin_copies(red: Reduction, cand: Candidates, spans: Spans) -> tuple[Candidates, Spans]:
     """The roots (and family spans) found on the first branch of each class of ``red.twins``, given to the other
     branches of the class too: their residuals are the same, their configurations differ. A pose's copies follow

@@ -256,7 +256,7 @@ def _precise_candidates(
     if not closed:  # (a closed form sweeps nothing)
         lo, hi = theta_range(robot, red, chain, paper_limits=strategy == "paper" and limits)
     spans = Spans.empty()
-    compiled = red.uses_kernel and search.AVAILABLE
+    compiled = red.uses_kernel
     err_geo = err_paper = None
     redo: RoughRedo | None = None
     if closed:  # no sweep: every branch of the closed form is a candidate

@@ -17,12 +17,13 @@ A fixed joint in the Newton step is well posed along a continuum: the Jacobian h
 from __future__ import annotations
 
 import numpy as np
+from numba import float64, int64, types
 from numpy.typing import NDArray
 
-from sweepik._jit import writable
+from sweepik._jit import inlined, writable
 from sweepik.engine import parallel
 from sweepik.engine.candidates import Spans
-from sweepik.engine.certify import AVAILABLE, chain_args
+from sweepik.engine.certify import chain_args, polish_row, polish_work
 from sweepik.engine.families import certified_members, families_of, off_families
 from sweepik.engine.polish import polished, pose_and_jacobian
 from sweepik.engine.search import PARALLEL_MIN
@@ -45,7 +46,9 @@ from sweepik.engine.settings import (
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import Reduction
+from sweepik.reductions.kernels import lazy_njit
 from sweepik.results import Family, weighted_joint_distance
+from sweepik.subproblems.trig import wrap_pi
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.intp]
@@ -85,15 +88,6 @@ def correct(robot: Robot, q: Array, world: Array, joint: int | IntArray, tol: fl
     return polished(robot, q, world, weight, iterations=TRACE_NEWTON, fixed=fixed, floor=TRACE_FLOOR * tol)
 
 
-def _bridged(robot: Robot, world: Array, a: Array, b: Array, joint: int, tol: float) -> bool:
-    """The member halfway between members ``a`` and ``b`` (the joint's midpoint, the others interpolated and corrected
-    as :class:`Traced` does) solves the pose: a step of the trace may not leap over a gap in the solution set (a
-    KR 6 pose whose wrist centre sits on axis 1 at full stretch holds stretches of a continuum along joint 1 with
-    gaps between them, where the interpolated members missed the pose by 6e-5 of the arm's size)."""
-    _, err = correct(robot, (0.5 * (a + b))[None], world[None], joint, tol)
-    return bool(err[0] <= tol)
-
-
 def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) -> tuple[Array, Array, bool] | None:
     """Members of the continuum through ``q0`` with ``joint`` as parameter, both ways from ``q0[joint]`` (a revolute
     joint over one turn at most, a prismatic one within its limits): ``(theta (M,), q (M, n), closed)`` in increasing
@@ -109,12 +103,11 @@ def _trace_one(robot: Robot, world: Array, q0: Array, joint: int, tol: float) ->
             lo, hi = x0 - robot.length_scale, x0 + robot.length_scale
         total = hi - lo
     h0 = total / TRACE_STEPS
-    side = _side_compiled if AVAILABLE else _side
     sides: list[tuple[Array, Array]] = []
     closed = False
     for sign in (1.0, -1.0):
         reach = total - (sides[0][0][-1] - x0 if sides else 0.0) if periodic else (hi - x0 if sign > 0 else x0 - lo)
-        xs, qs, done = side(robot, world, x0, q0, joint, sign, reach, h0, tol)
+        xs, qs, done = _side(robot, world, x0, q0, joint, sign, reach, h0, tol)
         sides.append((xs, qs))
         back_home = weighted_joint_distance(robot, qs[-1], q0) <= TRACE_JUMP * 1e-3
         if periodic and sign > 0 and done >= reach and back_home:
@@ -135,39 +128,11 @@ def _side(
     """The members of one side of the continuum through ``q0`` (``sign``: the way ``joint`` goes), ``reach`` far at
     most, from the seed on: ``(joint values (M,), members (M, n), distance gone)``. Each step predicts the next member
     by the secant through the last two, corrects it with the joint held, and keeps it when it solves the pose, lies
-    near its prediction (``TRACE_JUMP``) and the member halfway solves the pose too (:func:`_bridged`); a failed step
-    is halved. The reference of the compiled ``_trace_side`` (without Numba)."""
-    nodes: list[tuple[float, Array]] = [(x0, q0)]
-    h, done = h0 * PROBE_STEP, 0.0
-    while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if done >= TRACE_MIN * h0 else PROBE_STEP):
-        step = min(h, reach - done)
-        x, q = nodes[-1]
-        pred = q.copy()
-        if len(nodes) > 1:  # secant through the last two members
-            xp, qp = nodes[-2]
-            pred = q + (q - qp) * (step / abs(x - xp))
-        pred[joint] = x + sign * step
-        corr, err = correct(robot, pred[None], world[None], joint, tol)
-        if len(nodes) == 1 and not err[0] <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
-            break
-        if (
-            err[0] <= tol
-            and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP
-            and _bridged(robot, world, q, corr[0], joint, tol)
-        ):
-            nodes.append((x + sign * step, corr[0]))
-            done += step
-            h = min(2.0 * h, h0)
-        else:
-            h *= 0.5
-    return np.array([x for x, _ in nodes]), np.array([q for _, q in nodes]), done
-
-
-def _side_compiled(
-    robot: Robot, world: Array, x0: float, q0: Array, joint: int, sign: float, reach: float, h0: float, tol: float
-) -> tuple[Array, Array, float]:
-    """:func:`_side` in compiled calls (``_trace_side``), each filling a buffer of members; a full one is handed on
-    and the trace resumed from its last two members."""
+    near its prediction (``TRACE_JUMP``) and the member halfway solves the pose too (a step may not leap over a gap in
+    the solution set: a KR 6 pose whose wrist centre sits on axis 1 at full stretch holds stretches of a continuum
+    along joint 1 with gaps between them, where the interpolated members missed the pose by 6e-5 of the arm's size);
+    a failed step is halved. In compiled calls (``_trace_side``), each filling a buffer of members; a full one is
+    handed on and the trace resumed from its last two members."""
     n = robot.n_joints
     scale = np.where(robot.is_revolute, 1.0, 1.0 / orientation_weight(robot.length_unit))
     args = (*chain_args(robot), np.ascontiguousarray(world, dtype=np.float64), int(joint), float(sign), float(reach))
@@ -190,146 +155,139 @@ def _side_compiled(
     return np.concatenate(parts_x), np.concatenate(parts_q), done
 
 
-#: Members a compiled trace call holds before it hands them on (``_side_compiled``).
+#: Members a compiled trace call holds before it hands them on (``_side``).
 _BUFFER = 512
 
-if AVAILABLE:
-    from numba import float64, int64, types
+_CHAIN = (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1])
 
-    from sweepik._jit import inlined
-    from sweepik.engine.certify import polish_row, polish_work
-    from sweepik.reductions.kernels import lazy_njit
-    from sweepik.subproblems.trig import wrap_pi
 
-    _CHAIN = (float64[:, ::1], float64[:, ::1], types.boolean[::1], float64[:, ::1])
+@inlined
+def _distance(a, b, rev, scale):
+    """``results.weighted_joint_distance`` of two configurations."""
+    s = 0.0
+    for i in range(a.shape[0]):
+        d = wrap_pi(a[i] - b[i]) if rev[i] else a[i] - b[i]
+        s += (d * scale[i]) ** 2
+    return np.sqrt(s)
 
-    @inlined
-    def _distance(a, b, rev, scale):
-        """``results.weighted_joint_distance`` of two configurations."""
-        s = 0.0
-        for i in range(a.shape[0]):
-            d = wrap_pi(a[i] - b[i]) if rev[i] else a[i] - b[i]
-            s += (d * scale[i]) ** 2
-        return np.sqrt(s)
 
-    @inlined
-    def _correct_row(H, P, rev, R_end, q, world, weight, held, tol, work):
-        """:func:`correct` of one configuration ``q`` in place (the ``held`` joint held): its error after."""
-        floor, settled = TRACE_FLOOR * tol, TRACE_SETTLED * tol
-        return polish_row(
-            H, P, rev, R_end, q, world, weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, floor, work, settled
-        )
-
-    @lazy_njit(
-        types.Tuple((int64, float64, float64, types.boolean))(
-            *_CHAIN,
-            float64[:, ::1],
-            int64,
-            float64,
-            float64,
-            float64,
-            float64,
-            float64[::1],
-            float64,
-            float64[::1],
-            float64[:, ::1],
-            int64,
-            float64,
-            float64,
-        ),
-        cache=True,
-        nogil=True,
+@inlined
+def _correct_row(H, P, rev, R_end, q, world, weight, held, tol, work):
+    """:func:`correct` of one configuration ``q`` in place (the ``held`` joint held): its error after."""
+    floor, settled = TRACE_FLOOR * tol, TRACE_SETTLED * tol
+    return polish_row(
+        H, P, rev, R_end, q, world, weight, held, TRACE_NEWTON, BACKTRACK, PINV_RCOND, floor, work, settled
     )
-    def _trace_side(H, P, rev, R_end, world, joint, sign, reach, h0, tol, scale, weight, xs, qs, count, h, done):
-        """:func:`_side` from the members ``xs[:count], qs[:count]`` on (the seed alone, or the last two members of a
-        trace handed on), with the step ``h`` and the distance ``done`` it had: ``(count, h, done, full)``, ``full``
-        when the buffer filled before the side ended."""
-        n = H.shape[0]
-        work = polish_work(n)
-        held = np.zeros(n, dtype=np.bool_)
-        held[joint] = True
-        pred, mid = np.empty(n), np.empty(n)
-        while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if done >= TRACE_MIN * h0 else PROBE_STEP):
-            if count == xs.shape[0]:
-                return count, h, done, True
-            step = min(h, reach - done)
-            x, q = xs[count - 1], qs[count - 1]
+
+
+@lazy_njit(
+    types.Tuple((int64, float64, float64, types.boolean))(
+        *_CHAIN,
+        float64[:, ::1],
+        int64,
+        float64,
+        float64,
+        float64,
+        float64,
+        float64[::1],
+        float64,
+        float64[::1],
+        float64[:, ::1],
+        int64,
+        float64,
+        float64,
+    ),
+    cache=True,
+    nogil=True,
+)
+def _trace_side(H, P, rev, R_end, world, joint, sign, reach, h0, tol, scale, weight, xs, qs, count, h, done):
+    """:func:`_side` from the members ``xs[:count], qs[:count]`` on (the seed alone, or the last two members of a
+    trace handed on), with the step ``h`` and the distance ``done`` it had: ``(count, h, done, full)``, ``full``
+    when the buffer filled before the side ended."""
+    n = H.shape[0]
+    work = polish_work(n)
+    held = np.zeros(n, dtype=np.bool_)
+    held[joint] = True
+    pred, mid = np.empty(n), np.empty(n)
+    while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if done >= TRACE_MIN * h0 else PROBE_STEP):
+        if count == xs.shape[0]:
+            return count, h, done, True
+        step = min(h, reach - done)
+        x, q = xs[count - 1], qs[count - 1]
+        for i in range(n):
+            pred[i] = q[i]
+        if count > 1:  # secant through the last two members
+            f = step / abs(x - xs[count - 2])
             for i in range(n):
-                pred[i] = q[i]
-            if count > 1:  # secant through the last two members
-                f = step / abs(x - xs[count - 2])
-                for i in range(n):
-                    pred[i] = q[i] + (q[i] - qs[count - 2, i]) * f
-            pred[joint] = x + sign * step
-            corr = qs[count]
+                pred[i] = q[i] + (q[i] - qs[count - 2, i]) * f
+        pred[joint] = x + sign * step
+        corr = qs[count]
+        for i in range(n):
+            corr[i] = pred[i]
+        err = _correct_row(H, P, rev, R_end, corr, world, weight, held, tol, work)
+        if count == 1 and not err <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
+            break
+        ok = err <= tol and _distance(corr, pred, rev, scale) <= TRACE_JUMP
+        if ok:  # the member halfway solves the pose too (``_bridged``)
             for i in range(n):
-                corr[i] = pred[i]
-            err = _correct_row(H, P, rev, R_end, corr, world, weight, held, tol, work)
-            if count == 1 and not err <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
-                break
-            ok = err <= tol and _distance(corr, pred, rev, scale) <= TRACE_JUMP
-            if ok:  # the member halfway solves the pose too (``_bridged``)
-                for i in range(n):
-                    mid[i] = 0.5 * (q[i] + corr[i])
-                ok = _correct_row(H, P, rev, R_end, mid, world, weight, held, tol, work) <= tol
-            if ok:
-                xs[count] = x + sign * step
-                count += 1
-                done += step
-                h = min(2.0 * h, h0)
-            else:
-                h *= 0.5
-        return count, h, done, False
+                mid[i] = 0.5 * (q[i] + corr[i])
+            ok = _correct_row(H, P, rev, R_end, mid, world, weight, held, tol, work) <= tol
+        if ok:
+            xs[count] = x + sign * step
+            count += 1
+            done += step
+            h = min(2.0 * h, h0)
+        else:
+            h *= 0.5
+    return count, h, done, False
 
 
-if AVAILABLE:
-
-    @lazy_njit(
-        (*_CHAIN, int64[::1], float64[::1], float64[:, ::1], int64[::1], float64[::1], types.boolean, int64)
-        + (float64[:, :, ::1], int64, float64, float64, float64[:, ::1], float64[::1], int64, int64),
-        cache=True,
-        nogil=True,
-    )
-    def _traced_rows(H, P, rev, R_end, offsets, xs, qs, br, x, periodic, per, world, joint, tol, weight, q, err, start,
-                     stop):  # fmt: skip
-        """:meth:`Traced.corrected` compiled, rows ``start .. stop - 1``: the member of branch ``br[k]`` at ``x[k]``
-        interpolated between its nodes (``x[k]`` moved by whole turns next to them when ``periodic``, and clipped to
-        them, as ``Traced._unwrapped`` and ``np.interp``), then corrected towards ``world[k // per]`` with the joint
-        held (``correct``); ``q[k]`` and ``err[k]`` written (left NaN and inf where there is no member)."""
-        n = H.shape[0]
-        work = polish_work(n)
-        held = np.zeros(n, dtype=np.bool_)
-        held[joint] = True
-        for k in range(start, stop):
-            b = br[k]
-            if b < 0 or b >= offsets.size - 1 or not np.isfinite(x[k]):
-                continue
-            s0, s1 = offsets[b], offsets[b + 1]
-            if s1 == s0:
-                continue
-            t = x[k]
-            if periodic:  # (by whole turns next to the nodes' middle)
-                mid = 0.5 * (xs[s0] + xs[s1 - 1])
-                t = mid - wrap_pi(mid - t)
-            t = min(max(t, xs[s0]), xs[s1 - 1])
-            i = min(max(np.searchsorted(xs[s0:s1], t, side="right") - 1, 0), max(s1 - s0 - 2, 0))
-            a = s0 + i
-            if s1 - s0 == 1 or t <= xs[a]:
-                for c in range(n):
-                    q[k, c] = qs[a, c]
-            elif t >= xs[a + 1]:
-                for c in range(n):
-                    q[k, c] = qs[a + 1, c]
-            else:
-                f = (t - xs[a]) / (xs[a + 1] - xs[a])
-                for c in range(n):
-                    q[k, c] = qs[a, c] + f * (qs[a + 1, c] - qs[a, c])
-            q[k, joint] = x[k]
-            finite = True
+@lazy_njit(
+    (*_CHAIN, int64[::1], float64[::1], float64[:, ::1], int64[::1], float64[::1], types.boolean, int64)
+    + (float64[:, :, ::1], int64, float64, float64, float64[:, ::1], float64[::1], int64, int64),
+    cache=True,
+    nogil=True,
+)
+def _traced_rows(H, P, rev, R_end, offsets, xs, qs, br, x, periodic, per, world, joint, tol, weight, q, err, start,
+                 stop):  # fmt: skip
+    """:meth:`Traced.corrected` compiled, rows ``start .. stop - 1``: the member of branch ``br[k]`` at ``x[k]``
+    interpolated between its nodes (``x[k]`` moved by whole turns next to them when ``periodic``, and clipped to
+    them, as ``Traced._unwrapped`` and ``np.interp``), then corrected towards ``world[k // per]`` with the joint
+    held (``correct``); ``q[k]`` and ``err[k]`` written (left NaN and inf where there is no member)."""
+    n = H.shape[0]
+    work = polish_work(n)
+    held = np.zeros(n, dtype=np.bool_)
+    held[joint] = True
+    for k in range(start, stop):
+        b = br[k]
+        if b < 0 or b >= offsets.size - 1 or not np.isfinite(x[k]):
+            continue
+        s0, s1 = offsets[b], offsets[b + 1]
+        if s1 == s0:
+            continue
+        t = x[k]
+        if periodic:  # (by whole turns next to the nodes' middle)
+            mid = 0.5 * (xs[s0] + xs[s1 - 1])
+            t = mid - wrap_pi(mid - t)
+        t = min(max(t, xs[s0]), xs[s1 - 1])
+        i = min(max(np.searchsorted(xs[s0:s1], t, side="right") - 1, 0), max(s1 - s0 - 2, 0))
+        a = s0 + i
+        if s1 - s0 == 1 or t <= xs[a]:
             for c in range(n):
-                finite = finite and np.isfinite(q[k, c])
-            if finite:
-                err[k] = _correct_row(H, P, rev, R_end, q[k], world[k // per], weight, held, tol, work)
+                q[k, c] = qs[a, c]
+        elif t >= xs[a + 1]:
+            for c in range(n):
+                q[k, c] = qs[a + 1, c]
+        else:
+            f = (t - xs[a]) / (xs[a + 1] - xs[a])
+            for c in range(n):
+                q[k, c] = qs[a, c] + f * (qs[a + 1, c] - qs[a, c])
+        q[k, joint] = x[k]
+        finite = True
+        for c in range(n):
+            finite = finite and np.isfinite(q[k, c])
+        if finite:
+            err[k] = _correct_row(H, P, rev, R_end, q[k], world[k // per], weight, held, tol, work)
 
 
 class Traced(Reduction):
@@ -381,22 +339,11 @@ class Traced(Reduction):
         x = writable(np.reshape(theta, -1))
         world = _world(self.robot, poses)  # (one per pose: theta's rows are poses)
         q, err = np.full((x.size, n), np.nan), np.full(x.size, np.inf)
-        if AVAILABLE:
-            offsets, xs, qs = self._packed()
-            weight = orientation_weight(self.robot.length_unit)
-            per = max(int(theta.shape[1]), 1)
-            args = (offsets, xs, qs, br, x, self.periodic, per, writable(world), j, float(self.tol), weight, q, err)
-            parallel.run(_traced_rows, x.size, PARALLEL_MIN, *chain_args(self.robot), *args)
-        else:
-            world = np.repeat(world, theta.shape[1], axis=0)
-            for b in np.unique(br).tolist():
-                rows = np.nonzero(br == b)[0]
-                th, Q = self.nodes[b]
-                xu = self._unwrapped(b, x[rows])
-                q[rows] = np.stack([np.interp(xu, th, Q[:, i]) for i in range(n)], axis=-1)
-                q[rows, j] = x[rows]
-            ok = np.all(np.isfinite(q), axis=1) & np.isfinite(x)
-            q[ok], err[ok] = correct(self.robot, q[ok], world[ok], j, self.tol)
+        offsets, xs, qs = self._packed()
+        weight = orientation_weight(self.robot.length_unit)
+        per = max(int(theta.shape[1]), 1)
+        args = (offsets, xs, qs, br, x, self.periodic, per, writable(world), j, float(self.tol), weight, q, err)
+        parallel.run(_traced_rows, x.size, PARALLEL_MIN, *chain_args(self.robot), *args)
         return q.reshape(*theta.shape, n), err.reshape(theta.shape)
 
     def _packed(self) -> tuple[NDArray[np.int64], Array, Array]:

@@ -1,7 +1,7 @@
 """Certified configurations made final: revolute values wrapped into the limits, the limit check, duplicates dropped.
 
-One algorithm, two implementations (the NumPy reference, and the compiled one the solver uses when Numba is
-present: no per-call array overhead, one pass over the candidates):
+Compiled (one pass over the candidates, no per-call array overhead; the tests hold it against a NumPy reference,
+``tests/oracles/numpy_engine.py``):
 
 1. **wrap**: each revolute value into (-pi, pi], then moved by +-2 pi where that brings it inside its limits (the
    shift only when some revolute limit lies beyond +-pi), as :meth:`Robot.wrap`;
@@ -14,16 +14,20 @@ present: no per-call array overhead, one pass over the candidates):
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import boolean, float64, int64
 from numpy.typing import NDArray
 
+from sweepik._jit import inlined, internal
 from sweepik.engine import parallel
-from sweepik.engine.search import AVAILABLE
 from sweepik.engine.settings import DEDUPE_ANGLE, DEDUPE_LENGTH_REL
+from sweepik.reductions.kernels import lazy_njit
 from sweepik.results import joint_distance
+from sweepik.subproblems.trig import wrap_pi
 
 if TYPE_CHECKING:
     from sweepik.model.robot import Robot
@@ -71,9 +75,7 @@ def limit_args(robot: Robot) -> tuple[NDArray[np.bool_], Array, Array, Array, bo
 
 
 def wrap_inside(robot: Robot, q: Array) -> tuple[Array, NDArray[np.bool_]]:
-    """``(wrapped q, inside)``: steps 1 and 2 of the module docstring (compiled when Numba is present)."""
-    if not (AVAILABLE and q.shape[0]):
-        return robot.wrapped_within_limits(q)
+    """``(wrapped q, inside)``: steps 1 and 2 of the module docstring."""
     w = np.array(q, dtype=np.float64, order="C")
     inside = np.empty(q.shape[0], dtype=np.bool_)
     _wrap_inside(w, *limit_args(robot), inside)
@@ -92,8 +94,6 @@ def finish(
     ``wrapped``: ``wrap_inside(robot, q)`` when the caller has it already."""
     w, inside = wrap_inside(robot, q) if wrapped is None else wrapped
     score = np.where(inside, err, err + robot.length_scale)
-    if not (AVAILABLE and q.shape[0]):
-        return w, inside, _dedupe(robot, pose_idx, w, score)
     keep = np.empty(q.shape[0], dtype=np.bool_)
     _dedupe_compiled(pose_idx.astype(np.int64), w, score, limit_args(robot)[0], duplicate_tolerance(robot), keep)
     return w, inside, keep
@@ -117,9 +117,7 @@ def settle(
     a certified one lies outside the limits by at most ``reach`` (per joint: the solver tries it at the limit). Of
     the other poses, ``rows`` are the certified candidates (finite, ``err_geo`` within ``thresholds[3]``), in order,
     with ``finish``'s wrapped configurations ``w``, limit check and duplicate mask: the values the solver's NumPy
-    steps give. None without Numba."""
-    if not AVAILABLE:
-        return None
+    steps give."""
     K = q.shape[0]
     pose = pose_idx.astype(np.int64)
     # parts of whole poses for the threads: a batch's candidates are mostly in pose order (a closed form's always)
@@ -196,14 +194,15 @@ def near_pairs(
     """``(P, 2)`` pairs of kept candidates of one pose (``keep``) whose every joint is within ``reach (n,)`` of the
     other's (revolute ones modulo 2 pi), in order of their first row: compiled, one pass over each pose's pairs."""
     K = w.shape[0]
-    if not (AVAILABLE and K):
-        return _near_pairs(robot, pose_idx, w, keep, reach)
     out = np.empty((max(K, 1) * 4, 2), dtype=np.int64)
     count = np.zeros(1, dtype=np.int64)
     w = np.ascontiguousarray(w, dtype=np.float64)
-    _near_compiled(pose_idx.astype(np.int64), w, keep, limit_args(robot)[0], reach, out, count)
-    if count[0] > out.shape[0]:  # (more than the buffer holds: a continuum's many candidates)
-        return _near_pairs(robot, pose_idx, w, keep, reach)
+    pose = pose_idx.astype(np.int64)
+    _near_compiled(pose, w, keep, limit_args(robot)[0], reach, out, count)
+    if count[0] > out.shape[0]:  # (more than the buffer holds, a continuum's many candidates: again, all of them)
+        out = np.empty((int(count[0]), 2), dtype=np.int64)
+        count[0] = 0
+        _near_compiled(pose, w, keep, limit_args(robot)[0], reach, out, count)
     pairs = out[: count[0]].astype(np.intp)
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))] if pairs.shape[0] > 1 else pairs
 
@@ -212,365 +211,294 @@ def any_near(robot: Robot, w: Array, reach: Array) -> bool:
     """Two rows of one pose's configurations ``w (K, n)`` lie within ``reach (n,)`` of each other, joint by joint
     (revolute ones modulo 2 pi): ``near_pairs``' question for a single pose, answered in one compiled call (the one
     compiled call's answer is checked for it on every single pose)."""
-    if not AVAILABLE:
-        one = np.zeros(w.shape[0], dtype=np.intp)
-        return bool(_near_pairs(robot, one, w, np.ones(one.size, dtype=np.bool_), reach).size)
     return bool(_any_within(np.ascontiguousarray(w, dtype=np.float64), limit_args(robot)[0], reach))
 
 
-def _near_pairs(
-    robot: Robot, pose_idx: NDArray[np.intp], w: Array, keep: NDArray[np.bool_], reach: Array
-) -> NDArray[np.intp]:
-    """``near_pairs`` in NumPy (the reference): the pairs of each pose, compared joint by joint."""
-    kept = np.nonzero(keep)[0]
-    order = kept[np.argsort(pose_idx[kept], kind="stable")]
-    p = pose_idx[order]
-    pairs = []
-    for d in range(1, order.size):  # (a pose's rows are adjacent in ``order``)
-        same = np.nonzero(p[d:] == p[:-d])[0]
-        if same.size == 0:
-            break
-        a, b = order[same], order[same + d]
-        close = np.all(joint_distance(robot, w[a], w[b]) <= reach, axis=-1)
-        pairs.append(np.sort(np.stack([a[close], b[close]], axis=1), axis=1))
-    out = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.intp)
-    return out[np.lexsort((out[:, 1], out[:, 0]))].astype(np.intp)
+@lazy_njit((float64[:, ::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean, boolean[::1]), cache=True)
+def _wrap_inside(q, rev, lower, upper, ltol, beyond, inside):  # pragma: no cover
+    for k in range(q.shape[0]):
+        inside[k] = wrap_inside_row(q[k], rev, lower, upper, ltol, beyond)
 
 
-def _dedupe(robot: Robot, pose_idx: NDArray[np.intp], q: Array, err: Array) -> NDArray[np.bool_]:
-    """Keep-mask over candidates: per pose, drop any candidate equal (modulo 2 pi) to a better one, ties going to
-    the earlier candidate (the reference of the compiled ``_dedupe_compiled``: every pair of a pose compared).
+@inlined
+def wrap_inside_row(q, rev, lower, upper, ltol, beyond):  # pragma: no cover
+    """Steps 1 and 2 for one configuration ``q (n,)``: wrapped in place; whether it is inside the limits."""
+    two_pi = 2.0 * math.pi
+    ok = True
+    for j in range(q.shape[0]):
+        x = q[j]
+        if rev[j] and math.isfinite(x):
+            x = wrap_pi(x)
+            if beyond and (x < lower[j] - ltol[j] or x > upper[j] + ltol[j]):
+                for shift in (two_pi, -two_pi):
+                    c = x + shift
+                    if lower[j] - ltol[j] <= c <= upper[j] + ltol[j]:
+                        x = c
+                        break
+            q[j] = x
+        if not (lower[j] - ltol[j] <= x <= upper[j] + ltol[j]):
+            ok = False
+    return ok
 
-    Poses with at most ``_SMALL_GROUP`` candidates (almost all) are compared together, padded to that size; a pose
-    with more (a numerical continuum) on its own, a block of rows at a time so that memory stays bounded.
-    """
-    K, n = q.shape
-    keep = np.ones(K, dtype=bool)
+
+@internal
+def _group_order(pose):  # pragma: no cover
+    """The candidates ordered by pose, keeping their order within a pose: a stable sort of ``pose``, counting
+    the candidates of each pose (no compiled np.argsort: it adds seconds to the first compilation)."""
+    K = pose.shape[0]
+    order = np.empty(K, dtype=np.int64)
     if K == 0:
-        return keep
-    tol = duplicate_tolerance(robot)
-    order = np.argsort(pose_idx, kind="stable")
-    starts = np.concatenate([[0], np.flatnonzero(np.diff(pose_idx[order])) + 1])
-    sizes = np.diff(np.concatenate([starts, [K]]))
-    small = np.nonzero((sizes > 1) & (sizes <= _SMALL_GROUP))[0]
-    if small.size:
-        # (G, m) candidate indices, padded with -1
-        col = np.arange(_SMALL_GROUP)
-        idx = np.where(col < sizes[small, None], order[np.minimum(starts[small, None] + col, K - 1)], -1)
-        keep[idx[idx >= 0]] = _keep_pairwise(robot, q, err, idx, idx, tol)[idx >= 0]
-    for g in np.nonzero(sizes > _SMALL_GROUP)[0]:
-        members = order[starts[g] : starts[g] + sizes[g]]
-        rows = max(1, _BLOCK_ELEMENTS // (members.size * n))
-        for b in range(0, members.size, rows):
-            keep[members[b : b + rows]] = _keep_pairwise(
-                robot, q, err, members[None, b : b + rows], members[None], tol
-            )[0]
-    return keep
-
-
-def _keep_pairwise(robot: Robot, q: Array, err: Array, rows: NDArray[np.intp], cols: NDArray[np.intp], tol: Array):
-    """``(G, r)``: candidate ``rows[g, i]`` has no better equal among ``cols[g]`` (index -1: padding, never equal)."""
-    d = joint_distance(robot, q[rows][:, :, None, :], q[cols][:, None, :, :])
-    same = (
-        np.all(d <= tol, axis=-1)
-        & (rows[:, :, None] >= 0)
-        & (cols[:, None, :] >= 0)
-        & (rows[:, :, None] != cols[:, None, :])
-    )
-    er, ec = err[rows][:, :, None], err[cols][:, None, :]
-    better = (ec < er) | ((ec == er) & (cols[:, None, :] < rows[:, :, None]))
-    return ~np.any(same & better, axis=-1)
-
-
-#: Poses with at most this many candidates are compared together in ``_dedupe`` (padded arrays).
-_SMALL_GROUP = 32
-#: Elements (rows x candidates x joints) of one block of a large pose's comparison in ``_dedupe``.
-_BLOCK_ELEMENTS = 1 << 22
-
-
-if AVAILABLE:
-    import math
-
-    from numba import boolean, float64, int64
-
-    from sweepik._jit import inlined, internal
-    from sweepik.reductions.kernels import lazy_njit
-    from sweepik.subproblems.trig import wrap_pi
-
-    @lazy_njit(
-        (float64[:, ::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean, boolean[::1]), cache=True
-    )
-    def _wrap_inside(q, rev, lower, upper, ltol, beyond, inside):  # pragma: no cover
-        for k in range(q.shape[0]):
-            inside[k] = wrap_inside_row(q[k], rev, lower, upper, ltol, beyond)
-
-    @inlined
-    def wrap_inside_row(q, rev, lower, upper, ltol, beyond):  # pragma: no cover
-        """Steps 1 and 2 for one configuration ``q (n,)``: wrapped in place; whether it is inside the limits."""
-        two_pi = 2.0 * math.pi
-        ok = True
-        for j in range(q.shape[0]):
-            x = q[j]
-            if rev[j] and math.isfinite(x):
-                x = wrap_pi(x)
-                if beyond and (x < lower[j] - ltol[j] or x > upper[j] + ltol[j]):
-                    for shift in (two_pi, -two_pi):
-                        c = x + shift
-                        if lower[j] - ltol[j] <= c <= upper[j] + ltol[j]:
-                            x = c
-                            break
-                q[j] = x
-            if not (lower[j] - ltol[j] <= x <= upper[j] + ltol[j]):
-                ok = False
-        return ok
-
-    @internal
-    def _group_order(pose):  # pragma: no cover
-        """The candidates ordered by pose, keeping their order within a pose: a stable sort of ``pose``, counting
-        the candidates of each pose (no compiled np.argsort: it adds seconds to the first compilation)."""
-        K = pose.shape[0]
-        order = np.empty(K, dtype=np.int64)
-        if K == 0:
-            return order
-        lo, hi = pose[0], pose[0]
-        for k in range(K):
-            lo = pose[k] if pose[k] < lo else lo
-            hi = pose[k] if pose[k] > hi else hi
-        start = np.empty(hi - lo + 1, dtype=np.int64)
-        for g in range(hi - lo + 1):
-            start[g] = 0
-        for k in range(K):
-            start[pose[k] - lo] += 1
-        total = 0
-        for g in range(hi - lo + 1):
-            total, start[g] = total + start[g], total
-        for k in range(K):
-            g = pose[k] - lo
-            order[start[g]] = k
-            start[g] += 1
         return order
+    lo, hi = pose[0], pose[0]
+    for k in range(K):
+        lo = pose[k] if pose[k] < lo else lo
+        hi = pose[k] if pose[k] > hi else hi
+    start = np.empty(hi - lo + 1, dtype=np.int64)
+    for g in range(hi - lo + 1):
+        start[g] = 0
+    for k in range(K):
+        start[pose[k] - lo] += 1
+    total = 0
+    for g in range(hi - lo + 1):
+        total, start[g] = total + start[g], total
+    for k in range(K):
+        g = pose[k] - lo
+        order[start[g]] = k
+        start[g] += 1
+    return order
 
-    @inlined
-    def _group_stop(pose, order, start):  # pragma: no cover
-        """The end of the pose's group that starts at ``start`` in ``_group_order``'s ``order``."""
-        stop = start + 1
-        while stop < order.shape[0] and pose[order[stop]] == pose[order[start]]:
-            stop += 1
-        return stop
 
-    @lazy_njit(
-        (int64[::1], float64[:, ::1], boolean[::1], boolean[::1], float64[::1], int64[:, ::1], int64[::1]), cache=True
-    )
-    def _near_compiled(pose, w, keep, rev, reach, out, count):  # pragma: no cover
-        """``near_pairs``: the pairs into ``out`` (their number into ``count``, counted past the buffer too)."""
-        K = w.shape[0]
-        order = _group_order(pose)
-        c = 0
-        start = 0
-        while start < K:
-            stop = _group_stop(pose, order, start)
-            for x in range(start, stop):
-                a = order[x]
-                if not keep[a]:
-                    continue
-                for y in range(x + 1, stop):
-                    b = order[y]
-                    if not keep[b]:
-                        continue
-                    if _rows_within(w, a, b, rev, reach):
-                        if c < out.shape[0]:
-                            out[c, 0], out[c, 1] = min(a, b), max(a, b)
-                        c += 1
-            start = stop
-        count[0] = c
+@inlined
+def _group_stop(pose, order, start):  # pragma: no cover
+    """The end of the pose's group that starts at ``start`` in ``_group_order``'s ``order``."""
+    stop = start + 1
+    while stop < order.shape[0] and pose[order[stop]] == pose[order[start]]:
+        stop += 1
+    return stop
 
-    @lazy_njit(boolean(float64[:, ::1], boolean[::1], float64[::1]), cache=True, nogil=True)
-    def _any_within(w, rev, reach):  # pragma: no cover
-        """``any_near``: some two rows of ``w`` within ``reach``."""
-        for a in range(w.shape[0]):
-            for b in range(a + 1, w.shape[0]):
-                if _rows_within(w, a, b, rev, reach):
-                    return True
-        return False
 
-    @lazy_njit(
-        (int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True, nogil=True
-    )
-    def _dedupe_compiled(pose, q, score, rev, tol, keep):  # pragma: no cover
-        _dedupe_rows(pose, q, score, rev, tol, keep)
-
-    @inlined
-    def _rows_within(q, a, b, rev, tol):  # pragma: no cover
-        """Every joint of rows ``a`` and ``b`` of ``q`` within ``tol`` (per joint) of the other's, revolute ones modulo
-        2 pi."""
-        two_pi = 2.0 * math.pi
-        for j in range(q.shape[1]):
-            d = q[a, j] - q[b, j]
-            if rev[j]:
-                # (clearly apart modulo 2 pi: the wrap, a costly float modulo, would not change that)
-                if 2.0 * tol[j] < abs(d) < two_pi - 2.0 * tol[j]:
-                    return False
-                d = wrap_pi(d)
-            if not abs(d) <= tol[j]:
-                return False
-        return True
-
-    @internal
-    def _dedupe_rows(pose, q, score, rev, tol, keep):  # pragma: no cover
-        """Step 3 (``keep``) for candidates ``q`` (wrapped) of poses ``pose`` with scores ``score``."""
-        K = q.shape[0]
-        for k in range(K):
-            keep[k] = True
-        order = _group_order(pose)
-        start = 0
-        while start < K:
-            stop = _group_stop(pose, order, start)
-            if stop - start > _LARGE_GROUP:
-                _dedupe_bucketed(q, score, rev, tol, order[start:stop], keep)
-                start = stop
+@lazy_njit(
+    (int64[::1], float64[:, ::1], boolean[::1], boolean[::1], float64[::1], int64[:, ::1], int64[::1]), cache=True
+)
+def _near_compiled(pose, w, keep, rev, reach, out, count):  # pragma: no cover
+    """``near_pairs``: the pairs into ``out`` (their number into ``count``, counted past the buffer too)."""
+    K = w.shape[0]
+    order = _group_order(pose)
+    c = 0
+    start = 0
+    while start < K:
+        stop = _group_stop(pose, order, start)
+        for x in range(start, stop):
+            a = order[x]
+            if not keep[a]:
                 continue
-            for a in range(start, stop):
-                i = order[a]
-                for b in range(start, stop):
-                    m = order[b]
-                    if b == a or not (score[m] < score[i] or (score[m] == score[i] and m < i)):
-                        continue
-                    if _rows_within(q, i, m, rev, tol):
-                        keep[i] = False
-                        break
-            start = stop
+            for y in range(x + 1, stop):
+                b = order[y]
+                if not keep[b]:
+                    continue
+                if _rows_within(w, a, b, rev, reach):
+                    if c < out.shape[0]:
+                        out[c, 0], out[c, 1] = min(a, b), max(a, b)
+                    c += 1
+        start = stop
+    count[0] = c
 
-    @inlined
-    def _drop_worse(q, score, rev, tol, a, b, keep):  # pragma: no cover
-        """Of rows ``a`` and ``b`` when equal (``_rows_within``), the worse one dropped (a tie: the later row)."""
-        if _rows_within(q, a, b, rev, tol):
-            if score[b] < score[a] or (score[b] == score[a] and b < a):
-                keep[a] = False
-            else:
-                keep[b] = False
 
-    @internal
-    def _bucket_rows(q, rev, tol, rows, j, key, bucket):  # pragma: no cover
-        """Rows ``rows`` of ``q`` in ``rows.shape[0]`` buckets along joint ``j`` (its value modulo 2 pi for a revolute
-        one, into ``key``), each at least the joint's tolerance wide (into ``bucket``); returns the number of pairs
-        the buckets leave to compare (same or neighbouring bucket, the first and last for a revolute joint)."""
-        m = rows.shape[0]
-        lo, hi = math.inf, -math.inf
-        for x in range(m):
-            key[x] = wrap_pi(q[rows[x], j]) if rev[j] else q[rows[x], j]
-            lo, hi = min(lo, key[x]), max(hi, key[x])
-        width = max(tol[j] * (1.0 + 1e-9), (hi - lo) / m)
-        count = np.zeros(m, dtype=np.int64)
-        for x in range(m):
-            bucket[x] = min(int((key[x] - lo) / width), m - 1)
-            count[bucket[x]] += 1
-        pairs = 0
-        for b in range(m):
-            pairs += count[b] * count[b] + (count[b] * count[b + 1] if b + 1 < m else 0)
+@lazy_njit(boolean(float64[:, ::1], boolean[::1], float64[::1]), cache=True, nogil=True)
+def _any_within(w, rev, reach):  # pragma: no cover
+    """``any_near``: some two rows of ``w`` within ``reach``."""
+    for a in range(w.shape[0]):
+        for b in range(a + 1, w.shape[0]):
+            if _rows_within(w, a, b, rev, reach):
+                return True
+    return False
+
+
+@lazy_njit(
+    (int64[::1], float64[:, ::1], float64[::1], boolean[::1], float64[::1], boolean[::1]), cache=True, nogil=True
+)
+def _dedupe_compiled(pose, q, score, rev, tol, keep):  # pragma: no cover
+    _dedupe_rows(pose, q, score, rev, tol, keep)
+
+
+@inlined
+def _rows_within(q, a, b, rev, tol):  # pragma: no cover
+    """Every joint of rows ``a`` and ``b`` of ``q`` within ``tol`` (per joint) of the other's, revolute ones modulo
+    2 pi."""
+    two_pi = 2.0 * math.pi
+    for j in range(q.shape[1]):
+        d = q[a, j] - q[b, j]
         if rev[j]:
-            pairs += count[0] * (count[m - 1] + count[m - 2])
-        return pairs
+            # (clearly apart modulo 2 pi: the wrap, a costly float modulo, would not change that)
+            if 2.0 * tol[j] < abs(d) < two_pi - 2.0 * tol[j]:
+                return False
+            d = wrap_pi(d)
+        if not abs(d) <= tol[j]:
+            return False
+    return True
 
-    @internal
-    def _dedupe_bucketed(q, score, rev, tol, rows, keep):  # pragma: no cover
-        """Step 3 for one pose's many candidates ``rows`` (a numerical continuum's: thousands), in about linear time:
-        the rows put in as many buckets along the joint whose buckets leave fewest pairs (``_bucket_rows``), so that
-        equal rows share a bucket or lie in neighbouring ones (the first and last ones too for a revolute joint);
-        only those pairs compared."""
-        m = rows.shape[0]
-        key = np.empty(m)
-        bucket = np.empty(m, dtype=np.int64)
-        best, fewest = 0, -1
-        for j in range(q.shape[1]):
-            pairs = _bucket_rows(q, rev, tol, rows, j, key, bucket)
-            if fewest < 0 or pairs < fewest:
-                best, fewest = j, pairs
-        _bucket_rows(q, rev, tol, rows, best, key, bucket)
-        first = np.zeros(m + 1, dtype=np.int64)
-        for x in range(m):
-            first[bucket[x] + 1] += 1
-        for b in range(m):
-            first[b + 1] += first[b]
-        fill = first[:m].copy()
-        sorted_rows = np.empty(m, dtype=np.int64)
-        for x in range(m):
-            sorted_rows[fill[bucket[x]]] = rows[x]
-            fill[bucket[x]] += 1
-        last = bucket.max()
-        for b in range(last + 1):
-            for x in range(first[b], first[b + 1]):
-                a = sorted_rows[x]
-                for y in range(x + 1, first[b + 1]):
+
+@internal
+def _dedupe_rows(pose, q, score, rev, tol, keep):  # pragma: no cover
+    """Step 3 (``keep``) for candidates ``q`` (wrapped) of poses ``pose`` with scores ``score``."""
+    K = q.shape[0]
+    for k in range(K):
+        keep[k] = True
+    order = _group_order(pose)
+    start = 0
+    while start < K:
+        stop = _group_stop(pose, order, start)
+        if stop - start > _LARGE_GROUP:
+            _dedupe_bucketed(q, score, rev, tol, order[start:stop], keep)
+            start = stop
+            continue
+        for a in range(start, stop):
+            i = order[a]
+            for b in range(start, stop):
+                m = order[b]
+                if b == a or not (score[m] < score[i] or (score[m] == score[i] and m < i)):
+                    continue
+                if _rows_within(q, i, m, rev, tol):
+                    keep[i] = False
+                    break
+        start = stop
+
+
+@inlined
+def _drop_worse(q, score, rev, tol, a, b, keep):  # pragma: no cover
+    """Of rows ``a`` and ``b`` when equal (``_rows_within``), the worse one dropped (a tie: the later row)."""
+    if _rows_within(q, a, b, rev, tol):
+        if score[b] < score[a] or (score[b] == score[a] and b < a):
+            keep[a] = False
+        else:
+            keep[b] = False
+
+
+@internal
+def _bucket_rows(q, rev, tol, rows, j, key, bucket):  # pragma: no cover
+    """Rows ``rows`` of ``q`` in ``rows.shape[0]`` buckets along joint ``j`` (its value modulo 2 pi for a revolute
+    one, into ``key``), each at least the joint's tolerance wide (into ``bucket``); returns the number of pairs
+    the buckets leave to compare (same or neighbouring bucket, the first and last for a revolute joint)."""
+    m = rows.shape[0]
+    lo, hi = math.inf, -math.inf
+    for x in range(m):
+        key[x] = wrap_pi(q[rows[x], j]) if rev[j] else q[rows[x], j]
+        lo, hi = min(lo, key[x]), max(hi, key[x])
+    width = max(tol[j] * (1.0 + 1e-9), (hi - lo) / m)
+    count = np.zeros(m, dtype=np.int64)
+    for x in range(m):
+        bucket[x] = min(int((key[x] - lo) / width), m - 1)
+        count[bucket[x]] += 1
+    pairs = 0
+    for b in range(m):
+        pairs += count[b] * count[b] + (count[b] * count[b + 1] if b + 1 < m else 0)
+    if rev[j]:
+        pairs += count[0] * (count[m - 1] + count[m - 2])
+    return pairs
+
+
+@internal
+def _dedupe_bucketed(q, score, rev, tol, rows, keep):  # pragma: no cover
+    """Step 3 for one pose's many candidates ``rows`` (a numerical continuum's: thousands), in about linear time:
+    the rows put in as many buckets along the joint whose buckets leave fewest pairs (``_bucket_rows``), so that
+    equal rows share a bucket or lie in neighbouring ones (the first and last ones too for a revolute joint);
+    only those pairs compared."""
+    m = rows.shape[0]
+    key = np.empty(m)
+    bucket = np.empty(m, dtype=np.int64)
+    best, fewest = 0, -1
+    for j in range(q.shape[1]):
+        pairs = _bucket_rows(q, rev, tol, rows, j, key, bucket)
+        if fewest < 0 or pairs < fewest:
+            best, fewest = j, pairs
+    _bucket_rows(q, rev, tol, rows, best, key, bucket)
+    first = np.zeros(m + 1, dtype=np.int64)
+    for x in range(m):
+        first[bucket[x] + 1] += 1
+    for b in range(m):
+        first[b + 1] += first[b]
+    fill = first[:m].copy()
+    sorted_rows = np.empty(m, dtype=np.int64)
+    for x in range(m):
+        sorted_rows[fill[bucket[x]]] = rows[x]
+        fill[bucket[x]] += 1
+    last = bucket.max()
+    for b in range(last + 1):
+        for x in range(first[b], first[b + 1]):
+            a = sorted_rows[x]
+            for y in range(x + 1, first[b + 1]):
+                _drop_worse(q, score, rev, tol, a, sorted_rows[y], keep)
+            if b < last:
+                for y in range(first[b + 1], first[b + 2]):
                     _drop_worse(q, score, rev, tol, a, sorted_rows[y], keep)
-                if b < last:
-                    for y in range(first[b + 1], first[b + 2]):
-                        _drop_worse(q, score, rev, tol, a, sorted_rows[y], keep)
-        if rev[best] and last > 1:  # (a row just below pi may lie one bucket short of the last)
-            for x in range(first[0], first[1]):
-                for y in range(first[last - 1], first[last + 1]):
-                    _drop_worse(q, score, rev, tol, sorted_rows[x], sorted_rows[y], keep)
+    if rev[best] and last > 1:  # (a row just below pi may lie one bucket short of the last)
+        for x in range(first[0], first[1]):
+            for y in range(first[last - 1], first[last + 1]):
+                _drop_worse(q, score, rev, tol, sorted_rows[x], sorted_rows[y], keep)
 
-    #: ``_settle``'s arguments (``one_pose`` calls it by its address too).
-    _SETTLE_SIG = (
-        (float64[:, ::1], float64[::1], float64[::1], int64[::1], int64[::1], float64[::1], boolean[::1])
-        + (float64[::1],)
-        + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, boolean[::1], int64[::1])
-        + (float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64[::1], int64[::1], int64, int64)
-    )
 
-    @lazy_njit(_SETTLE_SIG, cache=True, nogil=True)
-    def _settle(
-        q, eg, ep, pose, mult, thr, rev, lower, upper, ltol, beyond, reach, tol, scale,
-        due, idx, w, score, inside, keep, parts, counts, start, stop,
-    ):  # pragma: no cover  # fmt: skip
-        """``settle``'s kernel for parts ``start .. stop - 1`` (rows ``parts[p] .. parts[p + 1] - 1``; a pose's rows
-        lie in one part): marks the poses due the solver's rarer steps (``due``, one entry per pose, False on entry);
-        of the other poses, the certified rows (``idx``, their wrapped configurations ``w``, ``score``, ``inside``,
-        ``keep``), written from the part's first row on, ``counts[p]`` of them."""
-        polish_below, polish_above, polish_paper_above, accept, polish_multiple = thr[0], thr[1], thr[2], thr[3], thr[4]
-        n = q.shape[1]
-        for part in range(start, stop):
-            lo, hi = parts[part], parts[part + 1]
-            c = lo
-            for k in range(lo, hi):
-                finite = True
+#: ``_settle``'s arguments (``one_pose`` calls it by its address too).
+_SETTLE_SIG = (
+    (float64[:, ::1], float64[::1], float64[::1], int64[::1], int64[::1], float64[::1], boolean[::1])
+    + (float64[::1],)
+    + (float64[::1], float64[::1], boolean, float64[::1], float64[::1], float64, boolean[::1], int64[::1])
+    + (float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64[::1], int64[::1], int64, int64)
+)
+
+
+@lazy_njit(_SETTLE_SIG, cache=True, nogil=True)
+def _settle(
+    q, eg, ep, pose, mult, thr, rev, lower, upper, ltol, beyond, reach, tol, scale,
+    due, idx, w, score, inside, keep, parts, counts, start, stop,
+):  # pragma: no cover  # fmt: skip
+    """``settle``'s kernel for parts ``start .. stop - 1`` (rows ``parts[p] .. parts[p + 1] - 1``; a pose's rows
+    lie in one part): marks the poses due the solver's rarer steps (``due``, one entry per pose, False on entry);
+    of the other poses, the certified rows (``idx``, their wrapped configurations ``w``, ``score``, ``inside``,
+    ``keep``), written from the part's first row on, ``counts[p]`` of them."""
+    polish_below, polish_above, polish_paper_above, accept, polish_multiple = thr[0], thr[1], thr[2], thr[3], thr[4]
+    n = q.shape[1]
+    for part in range(start, stop):
+        lo, hi = parts[part], parts[part + 1]
+        c = lo
+        for k in range(lo, hi):
+            finite = True
+            for j in range(n):
+                if not math.isfinite(q[k, j]):
+                    finite = False
+                    break
+            if not finite:
+                continue
+            e = eg[k]
+            below = polish_multiple if mult[k] >= 2 else polish_below
+            if e <= below and (e > polish_above or ep[k] > polish_paper_above):
+                due[pose[k]] = True  # a Newton polish (or, failing it, the fallback reduction)
+                continue
+            if not e <= accept:
+                continue
+            for j in range(n):
+                w[c, j] = q[k, j]
+            ok = wrap_inside_row(w[c], rev, lower, upper, ltol, beyond)
+            if not ok:
+                near = True  # within reach of the limits: tried at the limit
                 for j in range(n):
-                    if not math.isfinite(q[k, j]):
-                        finite = False
+                    over = max((lower[j] - ltol[j]) - w[c, j], (w[c, j] - upper[j]) - ltol[j])
+                    if not over <= reach[j]:
+                        near = False
                         break
-                if not finite:
+                if near:
+                    due[pose[k]] = True
                     continue
-                e = eg[k]
-                below = polish_multiple if mult[k] >= 2 else polish_below
-                if e <= below and (e > polish_above or ep[k] > polish_paper_above):
-                    due[pose[k]] = True  # a Newton polish (or, failing it, the fallback reduction)
-                    continue
-                if not e <= accept:
-                    continue
+            idx[c], inside[c] = k, ok
+            score[c] = e if ok else e + scale
+            c += 1
+        m = lo
+        for a in range(lo, c):  # the rows of poses found due after them are dropped
+            if due[pose[idx[a]]]:
+                continue
+            if m < a:
+                idx[m], inside[m], score[m] = idx[a], inside[a], score[a]
                 for j in range(n):
-                    w[c, j] = q[k, j]
-                ok = wrap_inside_row(w[c], rev, lower, upper, ltol, beyond)
-                if not ok:
-                    near = True  # within reach of the limits: tried at the limit
-                    for j in range(n):
-                        over = max((lower[j] - ltol[j]) - w[c, j], (w[c, j] - upper[j]) - ltol[j])
-                        if not over <= reach[j]:
-                            near = False
-                            break
-                    if near:
-                        due[pose[k]] = True
-                        continue
-                idx[c], inside[c] = k, ok
-                score[c] = e if ok else e + scale
-                c += 1
-            m = lo
-            for a in range(lo, c):  # the rows of poses found due after them are dropped
-                if due[pose[idx[a]]]:
-                    continue
-                if m < a:
-                    idx[m], inside[m], score[m] = idx[a], inside[a], score[a]
-                    for j in range(n):
-                        w[m, j] = w[a, j]
-                m += 1
-            _dedupe_rows(pose[idx[lo:m]], w[lo:m], score[lo:m], rev, tol, keep[lo:m])
-            counts[part] = m - lo
+                    w[m, j] = w[a, j]
+            m += 1
+        _dedupe_rows(pose[idx[lo:m]], w[lo:m], score[lo:m], rev, tol, keep[lo:m])
+        counts[part] = m - lo

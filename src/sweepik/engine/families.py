@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.engine import certify, search
+from sweepik.engine import certify
 from sweepik.engine.candidates import Spans
 from sweepik.engine.settings import (
     ACCEPT_TOL_REL,
@@ -40,7 +40,7 @@ def family_members(
     robot: Robot, red: Reduction, chain: Array, pose: NDArray[np.intp], branch: NDArray[np.intp], theta: Array
 ) -> Array:
     """Members ``(K, n)`` at ``theta (K,)`` of the families (pose, branch) (compiled where possible)."""
-    if red.uses_kernel and search.AVAILABLE:
+    if red.uses_kernel:
         return certify.configurations(robot, red, chain, pose, theta, branch)
     return red.solve_rest(chain[pose], theta[:, None], branch[:, None])[:, 0]
 
@@ -97,7 +97,7 @@ def _certified(
 ) -> tuple[NDArray[np.bool_], Array]:
     """``theta (K, M)``: whether the members exist and are certified by FK (error <= ``tol``), and the members
     ``(K, M, n)`` (NaN made 0)."""
-    if red.uses_kernel and search.AVAILABLE:
+    if red.uses_kernel:
         # compiled: configuration, FK and error per member (flange frame compared with the chain pose)
         M = theta.shape[1]
         flat_p = np.repeat(pose, M)
@@ -267,7 +267,7 @@ def _limit_dips(
         return np.zeros((K, 0))
     a, b = grid[k, np.maximum(i - 1, 0)], grid[k, np.minimum(i + 1, M - 1)]
     best_x, best_e = grid[k, i], big[k, i]
-    if red.uses_kernel and search.AVAILABLE:
+    if red.uses_kernel:
         best_x, best_e = certify.dip_search(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e, DIP_STEPS)
     else:
         best_x, best_e = _golden_dips(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e)
@@ -292,7 +292,8 @@ def _golden_dips(
     best_x: Array,
     best_e: Array,
 ) -> tuple[Array, Array]:
-    """The golden-section steps of ``_limit_dips`` (the NumPy reference; ``certify.dip_search``)."""
+    """The golden-section steps of ``_limit_dips`` (for a reduction without a compiled kernel;
+    ``certify.dip_search`` otherwise)."""
     return golden_least(lambda x: _limit_excess(robot, red, chain, pose, branch, x), a, b, best_x, best_e)
 
 
@@ -435,7 +436,7 @@ def families_of(
         # between the last sample inside and the first outside, all cuts at once
         which = np.concatenate([K, K])[cut]
         a, b = inside[cut], outside[cut]
-        if red.uses_kernel and search.AVAILABLE:  # (the same steps, compiled: no array work per step)
+        if red.uses_kernel:  # (the same steps, compiled: no array work per step)
             a, b = certify.locate_cuts(
                 robot, red, chain, world, pose[which], branch[which], a, b, CUT_BISECT, limits, tol
             )

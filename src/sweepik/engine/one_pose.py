@@ -18,19 +18,23 @@ import weakref
 from typing import Any, NamedTuple
 
 import numpy as np
+from numba import boolean, float64, int64
+from numba import void as _void
 from numpy.typing import NDArray
 
-from sweepik._jit import writable
+from sweepik._jit import function_at, inlined, internal, writable
 from sweepik.engine import search
 from sweepik.engine.candidates import unit_grid
-from sweepik.engine.certify import chain_args
-from sweepik.engine.dedupe import duplicate_tolerance, limit_args
-from sweepik.engine.search import AVAILABLE, _plan
+from sweepik.engine.certify import _CERTIFY_EVERY_SIG, _CERTIFY_SIG, _certify, _certify_every_branch, chain_args
+from sweepik.engine.dedupe import _SETTLE_SIG, _rows_within, _settle, duplicate_tolerance, limit_args
+from sweepik.engine.search import _ONE_PASS_SIG, _plan
 from sweepik.model.units import orientation_weight
+from sweepik.reductions.geometric import _CONTINUUM_SIG, _continuum_rows
 from sweepik.reductions.kernels import (
     CONFIGURATION_SIG,
     CONFIGURATIONS_SIG,
     address_of,
+    as_singular,
     defining_class,
     lazy_njit,
     owned_kernel,
@@ -78,193 +82,187 @@ class Settled(NamedTuple):
     checked: bool = False
 
 
-if AVAILABLE:
-    from numba import boolean, float64, int64
-    from numba import void as _void
+_ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG = _void(*_ONE_PASS_SIG), _void(*_CERTIFY_SIG), _void(*_SETTLE_SIG)
+_EVERY_FN_SIG, _CONTINUUM_FN_SIG = _void(*_CERTIFY_EVERY_SIG), int64(*_CONTINUUM_SIG)
+_as_one_pass, _as_certify, _as_settle, _as_every, _as_continuum = (
+    function_at(s) for s in (_ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG, _EVERY_FN_SIG, _CONTINUUM_FN_SIG)
+)
+#: The kernels' addresses in ``addr``, and ``continuum_rows``' (0: no continuum check) with its fixed integers
+#: (the amplitude kernel's address, branches per position branch), ``Reduction.continuum_kernel``'s.
+#: ``_A_SING``: a closed form's ``singular_kernel`` (0: none).
+_A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG, _A_ROWS, _A_AMP, _A_DIV, _A_SING, _A_SIZE = range(9)
 
-    from sweepik._jit import function_at, inlined, internal
-    from sweepik.engine.certify import _CERTIFY_EVERY_SIG, _CERTIFY_SIG, _certify, _certify_every_branch
-    from sweepik.engine.dedupe import _SETTLE_SIG, _rows_within, _settle
-    from sweepik.engine.search import _ONE_PASS_SIG
-    from sweepik.reductions.geometric import _CONTINUUM_SIG, _continuum_rows
-    from sweepik.reductions.kernels import as_singular
 
-    _ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG = _void(*_ONE_PASS_SIG), _void(*_CERTIFY_SIG), _void(*_SETTLE_SIG)
-    _EVERY_FN_SIG, _CONTINUUM_FN_SIG = _void(*_CERTIFY_EVERY_SIG), int64(*_CONTINUUM_SIG)
-    _as_one_pass, _as_certify, _as_settle, _as_every, _as_continuum = (
-        function_at(s) for s in (_ONE_PASS_FN_SIG, _CERTIFY_FN_SIG, _SETTLE_FN_SIG, _EVERY_FN_SIG, _CONTINUUM_FN_SIG)
-    )
-    #: The kernels' addresses in ``addr``, and ``continuum_rows``' (0: no continuum check) with its fixed integers
-    #: (the amplitude kernel's address, branches per position branch), ``Reduction.continuum_kernel``'s.
-    #: ``_A_SING``: a closed form's ``singular_kernel`` (0: none).
-    _A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG, _A_ROWS, _A_AMP, _A_DIV, _A_SING, _A_SIZE = range(9)
+@internal
+def _settled(settle, q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale):
+    """One pose's certified candidates settled (``dedupe._settle`` at the address ``settle``): whether one is
+    due the solver's rarer steps, and the count, rows, wrapped configurations, limit check and duplicate mask
+    of the certified ones (buffers as long as the candidates)."""
+    K, n = q.shape
+    rows = np.empty(K, dtype=np.int64)
+    w = np.empty((K, n))
+    score = np.empty(K)
+    inside = np.empty(K, dtype=np.bool_)
+    keep = np.empty(K, dtype=np.bool_)
+    ints = np.empty(3, dtype=np.int64)  # parts (2), counts
+    ints[0], ints[1], ints[2] = 0, K, 0
+    due = np.empty(1, dtype=np.bool_)
+    due[0] = False
+    _as_settle(settle)(
+        q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, due, rows, w, score,
+        inside, keep, ints[0:2], ints[2:3], 0, 1,
+    )  # fmt: skip
+    return due[0], ints[2], rows, w, inside, keep
 
-    @internal
-    def _settled(settle, q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale):
-        """One pose's certified candidates settled (``dedupe._settle`` at the address ``settle``): whether one is
-        due the solver's rarer steps, and the count, rows, wrapped configurations, limit check and duplicate mask
-        of the certified ones (buffers as long as the candidates)."""
-        K, n = q.shape
-        rows = np.empty(K, dtype=np.int64)
-        w = np.empty((K, n))
-        score = np.empty(K)
-        inside = np.empty(K, dtype=np.bool_)
-        keep = np.empty(K, dtype=np.bool_)
-        ints = np.empty(3, dtype=np.int64)  # parts (2), counts
-        ints[0], ints[1], ints[2] = 0, K, 0
-        due = np.empty(1, dtype=np.bool_)
-        due[0] = False
-        _as_settle(settle)(
-            q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, due, rows, w, score,
-            inside, keep, ints[0:2], ints[2:3], 0, 1,
-        )  # fmt: skip
-        return due[0], ints[2], rows, w, inside, keep
 
-    @inlined
-    def _branches_meet(c, w, keep, rev, meet):
-        """Of a closed form's ``c`` settled branches, one was dropped as another's duplicate, or two kept ones are
-        within ``meet`` of each other (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``)."""
-        for a in range(c):
-            if not keep[a]:
+@inlined
+def _branches_meet(c, w, keep, rev, meet):
+    """Of a closed form's ``c`` settled branches, one was dropped as another's duplicate, or two kept ones are
+    within ``meet`` of each other (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``)."""
+    for a in range(c):
+        if not keep[a]:
+            return True
+        for b in range(a + 1, c):
+            if _rows_within(w, a, b, rev, meet):
                 return True
-            for b in range(a + 1, c):
-                if _rows_within(w, a, b, rev, meet):
-                    return True
-        return False
+    return False
 
-    @internal
-    def _final(c, rows, w, inside, keep, eg, ep, mult, only_inside):
-        """The solutions of the ``c`` settled candidates (``_settled``'s): the rows kept (with ``only_inside``, those
-        within the limits too), in order, as the solver's block holds them; and how many were kept."""
-        n = w.shape[1]
-        reachable, m = 0, 0
-        for k in range(c):
-            if keep[k]:
-                reachable += 1
-                if inside[k] or not only_inside:
-                    m += 1
-        q = np.empty((m, n))
-        e_p = np.empty(m)
-        e_g = np.empty(m)
-        ins = np.empty(m, dtype=np.bool_)
-        mu = np.empty(m, dtype=np.int64)
-        m = 0
-        for k in range(c):
-            if keep[k] and (inside[k] or not only_inside):
-                r = rows[k]
-                for j in range(n):
-                    q[m, j] = w[k, j]
-                e_p[m], e_g[m], ins[m], mu[m] = ep[r], eg[r], inside[k], mult[r]
+
+@internal
+def _final(c, rows, w, inside, keep, eg, ep, mult, only_inside):
+    """The solutions of the ``c`` settled candidates (``_settled``'s): the rows kept (with ``only_inside``, those
+    within the limits too), in order, as the solver's block holds them; and how many were kept."""
+    n = w.shape[1]
+    reachable, m = 0, 0
+    for k in range(c):
+        if keep[k]:
+            reachable += 1
+            if inside[k] or not only_inside:
                 m += 1
-        return reachable, q, e_p, e_g, ins, mu
+    q = np.empty((m, n))
+    e_p = np.empty(m)
+    e_g = np.empty(m)
+    ins = np.empty(m, dtype=np.bool_)
+    mu = np.empty(m, dtype=np.int64)
+    m = 0
+    for k in range(c):
+        if keep[k] and (inside[k] or not only_inside):
+            r = rows[k]
+            for j in range(n):
+                q[m, j] = w[k, j]
+            e_p[m], e_g[m], ins[m], mu[m] = ep[r], eg[r], inside[k], mult[r]
+            m += 1
+    return reachable, q, e_p, e_g, ins, mu
 
-    @lazy_njit(
-        (int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], float64[::1], float64[:, ::1], float64[::1])
-        + (float64[::1], float64[::1], float64[::1], float64[::1], float64[::1], int64[:, ::1], int64, int64)
-        + (float64[::1], float64, float64[:, :, ::1], float64[:, ::1], float64[:, ::1], boolean[::1])
-        + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-        + (float64[::1], float64[::1], float64, int64[::1], float64[::1], boolean),
-        cache=True,
-        nogil=True,
-    )
-    def _settle_one(
-        addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
-        limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
-        c_joints, c_thr, only_inside,
-    ):  # pragma: no cover  # fmt: skip
-        """``settle_one``'s kernel: pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``),
-        certified and settled; ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped
-        to them (``chunk._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of
-        the continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``only_inside``:
-        the solutions within the limits only (``_final``)."""
-        # (np.empty and explicit loops: np.zeros, slice copies and the like each add to the first compilation)
-        n = rev.shape[0]
-        out_t = np.empty((1, max_cand))
-        out_b = np.empty((1, max_cand), dtype=np.int64)
-        out_m = np.empty((1, max_cand), dtype=np.int64)
-        ints = np.empty(2, dtype=np.int64)  # cnt, fcnt
-        redo = np.empty(1, dtype=np.bool_)
-        ints[0], ints[1], redo[0] = 0, 0, False
-        fam = np.empty((1, max_fam, 3))
-        _as_one_pass(addr[_A_SEARCH])(
-            plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, out_t, out_b, out_m,
-            ints[0:1], fam, ints[1:2], redo, 0, 1,
-        )  # fmt: skip
-        K = ints[0]
-        status = OK
-        if redo[0] or K > max_cand or ints[1] != 0:
+
+@lazy_njit(
+    (int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], float64[::1], float64[:, ::1], float64[::1])
+    + (float64[::1], float64[::1], float64[::1], float64[::1], float64[::1], int64[:, ::1], int64, int64)
+    + (float64[::1], float64, float64[:, :, ::1], float64[:, ::1], float64[:, ::1], boolean[::1])
+    + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
+    + (float64[::1], float64[::1], float64, int64[::1], float64[::1], boolean),
+    cache=True,
+    nogil=True,
+)
+def _settle_one(
+    addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
+    limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
+    c_joints, c_thr, only_inside,
+):  # pragma: no cover  # fmt: skip
+    """``settle_one``'s kernel: pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``),
+    certified and settled; ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped
+    to them (``chunk._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of
+    the continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``only_inside``:
+    the solutions within the limits only (``_final``)."""
+    # (np.empty and explicit loops: np.zeros, slice copies and the like each add to the first compilation)
+    n = rev.shape[0]
+    out_t = np.empty((1, max_cand))
+    out_b = np.empty((1, max_cand), dtype=np.int64)
+    out_m = np.empty((1, max_cand), dtype=np.int64)
+    ints = np.empty(2, dtype=np.int64)  # cnt, fcnt
+    redo = np.empty(1, dtype=np.bool_)
+    ints[0], ints[1], redo[0] = 0, 0, False
+    fam = np.empty((1, max_fam, 3))
+    _as_one_pass(addr[_A_SEARCH])(
+        plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, out_t, out_b, out_m,
+        ints[0:1], fam, ints[1:2], redo, 0, 1,
+    )  # fmt: skip
+    K = ints[0]
+    status = OK
+    if redo[0] or K > max_cand or ints[1] != 0:
+        status, K = SEARCH_ELSEWHERE, 0
+    for k in range(K):
+        t = out_t[0, k]
+        if out_m[0, k] >= 2 and ((limits[0] - clip <= t < limits[0]) or (limits[1] < t <= limits[1] + clip)):
             status, K = SEARCH_ELSEWHERE, 0
-        for k in range(K):
-            t = out_t[0, k]
-            if out_m[0, k] >= 2 and ((limits[0] - clip <= t < limits[0]) or (limits[1] < t <= limits[1] + clip)):
-                status, K = SEARCH_ELSEWHERE, 0
-                break
-        theta = np.empty(K)
-        branch = np.empty(K, dtype=np.int64)
-        mult = np.empty(K, dtype=np.int64)
-        pose = np.empty(K, dtype=np.int64)
-        for k in range(K):
-            theta[k], branch[k], mult[k], pose[k] = out_t[0, k], out_b[0, k], out_m[0, k], 0
-        q = np.empty((K, n))
-        eg = np.empty(K)
-        ep = np.empty(K)
-        _as_certify(addr[_A_CERTIFY])(
-            addr[_A_CFG], params, world, pose, theta, branch, True, H, P, rev, R_end, weight, q, eg, ep, 0, K
-        )
-        due, c, rows, w, inside, keep = _settled(
-            addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
-        )
-        if due and status == OK:
-            status, c = DUE, 0
-        if status == OK and addr[_A_ROWS] != 0 and K > 0:
-            free = np.empty(K, dtype=np.int64)
-            nt = c_thr.shape[0] - 1
-            flagged = _as_continuum(addr[_A_ROWS])(
-                addr[_A_AMP], params, pose, theta, branch, eg, c_thr[nt], addr[_A_DIV], c_thr[:nt], c_joints, free
-            )
-            if flagged > 0:
-                status, c = CONTINUUM, 0
-        reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
-        return status, c, reachable, qf, e_p, e_g, ins, mu
-
-    @lazy_njit(
-        (int64[::1], float64[:, ::1], float64[:, :, ::1], int64, float64[:, ::1], float64[:, ::1], boolean[::1])
-        + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-        + (float64[::1], float64[::1], float64, float64[::1], float64[::1], boolean),
-        cache=True,
-        nogil=True,
+            break
+    theta = np.empty(K)
+    branch = np.empty(K, dtype=np.int64)
+    mult = np.empty(K, dtype=np.int64)
+    pose = np.empty(K, dtype=np.int64)
+    for k in range(K):
+        theta[k], branch[k], mult[k], pose[k] = out_t[0, k], out_b[0, k], out_m[0, k], 0
+    q = np.empty((K, n))
+    eg = np.empty(K)
+    ep = np.empty(K)
+    _as_certify(addr[_A_CERTIFY])(
+        addr[_A_CFG], params, world, pose, theta, branch, True, H, P, rev, R_end, weight, q, eg, ep, 0, K
     )
-    def _settle_closed(
-        addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
-        s_thr, meet, only_inside,
-    ):  # pragma: no cover  # fmt: skip
-        """``settle_closed``'s kernel: every branch of pose 0 of ``params``/``world`` (the all-branch configuration
-        kernel at ``addr[_A_CFG]``) certified and settled; ``MEET`` where a branch is dropped as another's duplicate
-        or two kept ones are within ``meet`` (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``);
-        ``SINGULAR`` where the singular kernel at ``addr[_A_SING]`` (unless 0; thresholds ``s_thr``) flags it."""
-        q = np.empty((nb, rev.shape[0]))
-        eg = np.empty(nb)
-        ep = np.empty(nb)
-        _as_every(addr[_A_CERTIFY])(addr[_A_CFG], params, world, nb, H, P, rev, R_end, weight, q, eg, ep, 0, 1)
-        pose = np.empty(nb, dtype=np.int64)
-        mult = np.empty(nb, dtype=np.int64)
-        for k in range(nb):
-            pose[k], mult[k] = 0, 1
-        due, c, rows, w, inside, keep = _settled(
-            addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
+    due, c, rows, w, inside, keep = _settled(
+        addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
+    )
+    if due and status == OK:
+        status, c = DUE, 0
+    if status == OK and addr[_A_ROWS] != 0 and K > 0:
+        free = np.empty(K, dtype=np.int64)
+        nt = c_thr.shape[0] - 1
+        flagged = _as_continuum(addr[_A_ROWS])(
+            addr[_A_AMP], params, pose, theta, branch, eg, c_thr[nt], addr[_A_DIV], c_thr[:nt], c_joints, free
         )
-        status = DUE if due else OK
-        if status == OK and _branches_meet(c, w, keep, lrev, meet):
-            status = MEET
-        if status == OK and addr[_A_SING] != 0:
-            flags = np.empty(2, dtype=np.bool_)  # degenerate, a step's amplitude low
-            as_singular(addr[_A_SING])(params, s_thr, flags[0:1], flags[1:2], 0, 1)
-            if flags[0] or flags[1]:
-                status = SINGULAR
-        if status != OK:
-            c = 0
-        reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
-        return status, c, reachable, qf, e_p, e_g, ins, mu, eg
+        if flagged > 0:
+            status, c = CONTINUUM, 0
+    reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
+    return status, c, reachable, qf, e_p, e_g, ins, mu
+
+
+@lazy_njit(
+    (int64[::1], float64[:, ::1], float64[:, :, ::1], int64, float64[:, ::1], float64[:, ::1], boolean[::1])
+    + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
+    + (float64[::1], float64[::1], float64, float64[::1], float64[::1], boolean),
+    cache=True,
+    nogil=True,
+)
+def _settle_closed(
+    addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
+    s_thr, meet, only_inside,
+):  # pragma: no cover  # fmt: skip
+    """``settle_closed``'s kernel: every branch of pose 0 of ``params``/``world`` (the all-branch configuration
+    kernel at ``addr[_A_CFG]``) certified and settled; ``MEET`` where a branch is dropped as another's duplicate
+    or two kept ones are within ``meet`` (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``);
+    ``SINGULAR`` where the singular kernel at ``addr[_A_SING]`` (unless 0; thresholds ``s_thr``) flags it."""
+    q = np.empty((nb, rev.shape[0]))
+    eg = np.empty(nb)
+    ep = np.empty(nb)
+    _as_every(addr[_A_CERTIFY])(addr[_A_CFG], params, world, nb, H, P, rev, R_end, weight, q, eg, ep, 0, 1)
+    pose = np.empty(nb, dtype=np.int64)
+    mult = np.empty(nb, dtype=np.int64)
+    for k in range(nb):
+        pose[k], mult[k] = 0, 1
+    due, c, rows, w, inside, keep = _settled(
+        addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
+    )
+    status = DUE if due else OK
+    if status == OK and _branches_meet(c, w, keep, lrev, meet):
+        status = MEET
+    if status == OK and addr[_A_SING] != 0:
+        flags = np.empty(2, dtype=np.bool_)  # degenerate, a step's amplitude low
+        as_singular(addr[_A_SING])(params, s_thr, flags[0:1], flags[1:2], 0, 1)
+        if flags[0] or flags[1]:
+            status = SINGULAR
+    if status != OK:
+        c = 0
+    reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
+    return status, c, reachable, qf, e_p, e_g, ins, mu, eg
 
 
 _NONE = np.zeros(0)
@@ -374,12 +372,10 @@ def settle_one(
 ) -> Settled | None:
     """The one pose of ``chain``/``world (1, 4, 4)`` searched over ``[lo, hi]`` (``(1,)`` each), certified and settled
     in one compiled call, as the solver's general path does it (the same values); None where ``red`` has no one-pass
-    search for ``n_samples`` (or without Numba). ``thresholds`` and ``reach``: ``dedupe.settle``'s; ``clip_rel``: the
+    search for ``n_samples``. ``thresholds`` and ``reach``: ``dedupe.settle``'s; ``clip_rel``: the
     reach (relative to ``hi - lo``) within which a multiple root outside theta*'s limits is clipped to them;
     ``seed_tol``: the pose error within which a candidate is checked for a continuum (``continuum_joints``);
     ``only_inside``: the solutions within the joint limits only (the solver's ``limits``)."""
-    if not AVAILABLE:
-        return None
     fixed = _fixed(robot, red, n_samples, thresholds, reach, seed_tol)
     if fixed is None:
         return None
@@ -408,8 +404,6 @@ def settle_closed(
     """A closed form's one pose ``world (1, 4, 4)``: every branch (in order: ``Settled.branch``) certified and settled
     in one compiled call, as ``settle_one``; ``MEET`` where two branches meet (``meet``: the reach per joint within
     which two kept ones do); None where ``red`` has no all-branch configuration kernel."""
-    if not AVAILABLE:
-        return None
 
     def make() -> tuple[Any, ...] | None:
         cfgs = owned_kernel(red, "kernel_configurations")

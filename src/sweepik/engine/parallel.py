@@ -43,11 +43,8 @@ _local = threading.local()
 def threads() -> int:
     """Threads a batch kernel may use in the calling thread (Numba's setting, see the module docstring; in a chunk's
     thread of ``in_order``, its caller's)."""
-    try:
-        import numba
-        from numba.np.ufunc import parallel
-    except ImportError:  # pragma: no cover - without numba nothing releases the GIL
-        return 1
+    import numba
+    from numba.np.ufunc import parallel
 
     # numba.get_num_threads() starts Numba's own thread pool (~60 ms) to read a setting that only
     # numba.set_num_threads changes, and set_num_threads starts that pool itself

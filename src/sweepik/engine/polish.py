@@ -5,9 +5,10 @@ while theta2 swings through pi within |Pz - d1| ~ |Px|): there a root in theta* 
 leaves ~1e-10 mm of pose error. One or two Newton steps on all six joints remove it. Next to a singular
 configuration (an elbow almost straight) the step is damped: halved until it lowers the error.
 
-With Numba the same steps run compiled (``certify.polish_rows``): the continuation of a traced family corrects a
-few hundred configurations one by one, ~1.5 ms each in NumPy (a shoulder-singular pose of a spherical-wrist arm, four
-families along joint 1: 250-450 ms, now ~55 ms). This NumPy loop is what runs without Numba.
+The steps run compiled (``certify.polish_rows``): the continuation of a traced family corrects a few hundred
+configurations one by one, ~1.5 ms each in NumPy (a shoulder-singular pose of a spherical-wrist arm, four families
+along joint 1: 250-450 ms, compiled ~55 ms). The tests hold them against a NumPy reference
+(``tests/oracles/numpy_engine.py``).
 """
 
 from __future__ import annotations
@@ -15,32 +16,25 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.engine.settings import BACKTRACK, ITERATIONS, PINV_RCOND, PINV_WIDEN
-from sweepik.model import kinematics
-from sweepik.model.pose import pose_error_geodesic
+from sweepik.engine.settings import BACKTRACK, ITERATIONS, PINV_RCOND
 from sweepik.model.robot import Robot
 
 Array = NDArray[np.float64]
 
 
 def pose_and_jacobian(robot: Robot, q: Array) -> tuple[Array, Array]:
-    """World tool poses and geometric Jacobians at the tool point of configurations ``q (K, n)``: compiled when Numba
-    is present, else :func:`sweepik.model.kinematics.geometric_jacobian`."""
+    """World tool poses and geometric Jacobians at the tool point of configurations ``q (K, n)`` (compiled)."""
     from sweepik.engine import certify
 
-    if certify.AVAILABLE:
-        return certify.pose_and_jacobian(robot, q)
-    return _pose(robot, q), kinematics.geometric_jacobian(robot, q)
+    return certify.pose_and_jacobian(robot, q)
 
 
 def geodesic_errors(robot: Robot, q: Array, target: Array, weight: float) -> Array:
-    """Geodesic errors of configurations ``q (K, n)`` to ``target (K, 4, 4)`` (compiled when Numba is present: a
-    polish of a few configurations is mostly these evaluations, ~70 us each in NumPy)."""
-    from sweepik.engine.certify import AVAILABLE, tool_poses
+    """Geodesic errors of configurations ``q (K, n)`` to ``target (K, 4, 4)`` (compiled: a polish of a few
+    configurations is mostly these evaluations, ~70 us each in NumPy)."""
+    from sweepik.engine.certify import tool_poses
 
-    if AVAILABLE:
-        return tool_poses(robot, q, target, weight)[1]
-    return pose_error_geodesic(_pose(robot, q), target, weight)
+    return tool_poses(robot, q, target, weight)[1]
 
 
 def polish(
@@ -73,52 +67,7 @@ def polished(
     Returns ``(q, geodesic errors (K,))``."""
     if q.shape[0] == 0:
         return q, np.zeros(0)
-    from sweepik.engine.certify import AVAILABLE, polish_rows
+    from sweepik.engine.certify import polish_rows
 
-    if AVAILABLE:  # (the same steps, compiled: a single configuration's polish took ~1.5 ms in NumPy, continuation
-        # corrects hundreds along a traced family)
-        held = np.zeros(q.shape, dtype=np.bool_) if fixed is None else fixed
-        return polish_rows(robot, q, target, weight, held, iterations, BACKTRACK, PINV_RCOND, floor)
-    q = q.copy()
-    err = geodesic_errors(robot, q, target, weight)
-    scale = np.array([1.0, 1.0, 1.0, weight, weight, weight])
-    active = np.arange(q.shape[0])
-    for _ in range(iterations):
-        qa, ta = q[active], target[active]
-        T, J = pose_and_jacobian(robot, qa)
-        dp = ta[:, :3, 3] - T[:, :3, 3]
-        dR = ta[:, :3, :3] @ np.swapaxes(T[:, :3, :3], -1, -2)
-        w = 0.5 * np.stack([dR[:, 2, 1] - dR[:, 1, 2], dR[:, 0, 2] - dR[:, 2, 0], dR[:, 1, 0] - dR[:, 0, 1]], -1)
-        e = np.concatenate([dp, w], axis=-1) * scale
-        Js = J * scale[:, None]
-        if fixed is not None:
-            Js = np.where(fixed[active][:, None, :], 0.0, Js)
-        improved = np.zeros(active.size, dtype=bool)
-        todo = np.arange(active.size)
-        for widen in PINV_WIDEN:
-            # pseudo-inverse per candidate: singular Jacobians (rank-deficient arms poses) stay bounded
-            step = np.einsum("kij,kj->ki", np.linalg.pinv(Js, rcond=PINV_RCOND * widen), e)
-            if fixed is not None:  # (a held joint's zero column gives a step of rounding size: none at all)
-                step = np.where(fixed[active], 0.0, step)
-            for _ in range(BACKTRACK + 1):
-                q_new = qa[todo] + step[todo]
-                err_new = geodesic_errors(robot, q_new, ta[todo], weight)
-                better = np.isfinite(err_new) & (err_new < err[active[todo]])
-                rows = active[todo[better]]
-                q[rows], err[rows] = q_new[better], err_new[better]
-                improved[todo[better]] = True
-                todo = todo[~better]
-                if todo.size == 0:
-                    break
-                step[todo] *= 0.5
-            if todo.size == 0:
-                break
-        active = active[improved & (err[active] > floor)]
-        if active.size == 0:
-            break
-    return q, err
-
-
-def _pose(robot: Robot, q: Array) -> Array:
-    """World tool poses (the NumPy path: with Numba the compiled ``certify`` kernels are used instead)."""
-    return kinematics.chain_frames(robot, q)[:, -1] @ robot.T_flange_tool
+    held = np.zeros(q.shape, dtype=np.bool_) if fixed is None else fixed
+    return polish_rows(robot, q, target, weight, held, iterations, BACKTRACK, PINV_RCOND, floor)

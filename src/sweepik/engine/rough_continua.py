@@ -22,11 +22,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.engine.candidates import Spans, sample_grid
+from sweepik.engine import search
+from sweepik.engine.candidates import Spans
 from sweepik.engine.continuation import continuum_families, correct
 from sweepik.engine.families import off_families
 from sweepik.engine.polish import geodesic_errors
-from sweepik.engine.sweep import FAMILY_MIN_RUN
+from sweepik.engine.settings import FAMILY_MIN_RUN
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import Array, IntArray, Reduction
@@ -46,7 +47,7 @@ def rough_continua(
     tol: float,
 ) -> tuple[dict[int, list[Family]], IntArray, Array, Spans]:
     """The continua along ``red``'s theta* of the chain poses ``chain (N, 4, 4)`` (world poses ``world``) on their
-    sample grids over ``[lo, hi]`` (``candidates.sample_grid``), traced: ``(families per pose, pose index, q, masked)``,
+    sample grids over ``[lo, hi]`` (``search.sample_grid``), traced: ``(families per pose, pose index, q, masked)``,
     the pose index and ``q`` of the isolated members ``continuum_families`` gives (pieces shrinking to a point at the
     limits) and ``masked``, the stretches of theta* (per pose and branch) where the branch's member is a traced
     family's member or a solution outside the limits: a search there finds nothing else. ``near``: the pose error
@@ -54,7 +55,8 @@ def rough_continua(
     out: dict[int, list[Family]] = {}
     n = robot.n_joints
     no_p, no_q = np.zeros(0, dtype=np.intp), np.zeros((0, n))
-    theta = sample_grid(red, chain, lo, hi, n_samples)  # (N, M)
+    grid, count = search.sample_grid(red, chain, lo, hi, n_samples)
+    theta = np.where(np.arange(grid.shape[1])[None, :] < count[:, None], grid, np.nan)  # (N, M)
     N, M = theta.shape
     B = red.n_branches
     q = red.solve_rest(chain, theta)  # (N, M, B, n)

@@ -32,7 +32,6 @@ from sweepik.engine.settings import (
     SNAP_ITERATIONS,
     SNAP_REACH,
 )
-from sweepik.model.pose import pose_error_geodesic, pose_error_paper
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
 from sweepik.results import joint_distance
@@ -294,8 +293,5 @@ def _new_rows(
 
 def errors_of(robot: Robot, q: Array, target: Array, weight: float) -> tuple[Array, Array]:
     """Geodesic error and the paper's J ``(K,)`` of configurations ``q (K, n)`` against ``target (K, 4, 4)``:
-    compiled as certification computes them (``certify.pose_errors``), else in NumPy."""
-    if certify.AVAILABLE:
-        return certify.pose_errors(robot, q, target, weight)
-    T = certify.flange_poses(robot, q) @ robot.T_flange_tool
-    return pose_error_geodesic(T, target, weight), pose_error_paper(T, target, weight)
+    compiled as certification computes them (``certify.pose_errors``)."""
+    return certify.pose_errors(robot, q, target, weight)

@@ -88,7 +88,8 @@ class Reduction(ABC):
     #: ill-conditioned (a candidate that even a Newton polish cannot certify); its solutions are merged in.
     fallback: str | Reduction | None = None
     #: Compiled scalar kernels ``(residual, configuration)`` with the signatures ``reductions.kernels.RESIDUAL_SIG``
-    #: and ``CONFIGURATION_SIG`` over rows of ``kernel_params(poses)`` (None: the NumPy engine is used).
+    #: and ``CONFIGURATION_SIG`` over rows of ``kernel_params(poses)`` (None: the engine calls ``residual`` back,
+    #: :mod:`sweepik.engine.callback`).
     kernel: tuple[Any, Any] | None = None
     #: Optional compiled kernel ``residuals(params, theta, out)`` (signature ``reductions.kernels.RESIDUALS_SIG``)
     #: writing every branch's residual at theta* into ``out (n_branches,)``, bit for bit what ``kernel[0]`` gives
@@ -173,7 +174,7 @@ class Reduction(ABC):
 
     def residual_rows(self, poses: Array, rows: IntArray, theta: Array, branch: IntArray) -> Array | None:
         """``residual(poses[rows], theta, branch)`` ``(K, M)``: the residual of chain poses picked by index, one branch
-        per sample. The NumPy engine asks for a few rows of the same poses over and over (refinements, probes); a
+        per sample. A search without a compiled kernel asks for a row of the same poses over and over (refinements); a
         reduction that derives per-pose parameters from them can keep those rather than derive them each time."""
         return self.residual(poses[rows], theta, branch)
 

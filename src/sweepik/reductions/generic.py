@@ -194,7 +194,7 @@ class GeometricReduction(Reduction):
         ``continuum_joints`` may flag a branch) and its thresholds; None for a sweep."""
         if not self.plan.closed_form:
             return None
-        from sweepik.reductions.kernels import SINGULAR_SIG, address_of  # (defined with Numba only)
+        from sweepik.reductions.kernels import SINGULAR_SIG, address_of
 
         if self.plan.family == "parallel":
             return address_of(geometric.parallel_singular_flags, SINGULAR_SIG), np.zeros(4)
@@ -508,8 +508,8 @@ class GeometricReduction(Reduction):
         rows: IntArray | None = None,
     ) -> tuple[Array, IntArray, Array, IntArray]:
         """The kernels' flat arguments for ``theta (N, M)`` of chain poses ``poses`` (``rows``: of ``poses[rows]``,
-        from the parameters of ``poses``, kept for the last ``poses``: the NumPy engine asks for rows of the same
-        poses over and over)."""
+        from the parameters of ``poses``, kept for the last ``poses``: a search without its kernel asks for rows of
+        the same poses over and over)."""
         N, M = theta.shape
         params = self.kernel_params(poses)
         index = np.arange(N) if rows is None else np.asarray(rows)

@@ -571,7 +571,8 @@ def _configure(cfg, params, pose, theta, branch, out):
 
 
 def evaluate(res, params, pose, theta, branch, out):
-    """``out[k] = res(params[pose[k]], theta[k], branch[k])`` (vectorised residual for the NumPy engine)."""
+    """``out[k] = res(params[pose[k]], theta[k], branch[k])`` (a vectorised residual for the reduction's NumPy
+    methods)."""
     _evaluate(address_of(res, RESIDUAL_SIG), params, pose, theta, branch, out)
 
 

@@ -13,17 +13,15 @@ import math
 from functools import cache
 from typing import Any
 
+import numba
 import numpy as np
+from numba import boolean, float64, int64, types, void
 
-from sweepik._jit import ERROR_MODEL, internal
+from sweepik._jit import ERROR_MODEL, function_at, internal
 from sweepik.errors import UnknownOptionError
 from sweepik.subproblems.trig import wrap_pi
 
-_njit: Any
-try:
-    from numba import njit as _njit
-except ImportError:  # pragma: no cover - without numba the NumPy engine is used
-    _njit = None
+_njit: Any = numba.njit  # (untyped: Numba's stubs do not list every option sweepik passes)
 
 #: Same as carm.DISC_TOL (kept here so that this module has no import cycle with carm.py).
 DISC_TOL = 1e-12
@@ -119,33 +117,30 @@ def _carm_theta2(p, th2: float, b: int) -> float:
     return _elbow_residual(c2, s2, Px / c2, Py, zx, zy, zz, eps, L1, L2)
 
 
-if _njit is not None:
-    from numba import boolean, float64, int64, void
-
-    RESIDUAL_SIG = float64(float64[::1], float64, int64)
-    #: ``residuals(params, theta, out)``: every branch's residual at theta* into ``out`` (optional, see
-    #: ``Reduction.kernel_residuals``).
-    RESIDUALS_SIG = void(float64[::1], float64, float64[::1])
-    CONFIGURATION_SIG = void(float64[::1], float64, int64, float64[::1])
-    #: ``configurations(params, theta, out)``: every branch's configuration at theta* into ``out (n_branches, n)``
-    #: (optional, see ``Reduction.kernel_configurations``).
-    CONFIGURATIONS_SIG = void(float64[::1], float64, float64[:, ::1])
-    #: ``hints(params, out)``: a reduction's sample hints of one pose (optional, see ``Reduction.kernel_hints``).
-    HINTS_SIG = void(float64[::1], float64[::1])
-    #: ``swing(amplitude, amplitudes, params, lo, hi, n, periodic, steps, out, start, stop)``: a generic sweep's swing
-    #: samples of poses ``start .. stop - 1`` (``geometric.swing_hints``; ``amplitude`` and ``amplitudes`` the
-    #: addresses of its amplitude kernels), which the engine calls pose by pose (``search.EdgeSearch``).
-    SWING_SIG = void(
-        int64, int64, float64[:, ::1], float64[::1], float64[::1], int64, boolean, int64[::1], float64[:, ::1], int64,
-        int64,
-    )  # fmt: skip
-    #: ``singular(params, thr, out, low, start, stop)``: a closed form's poses ``start .. stop - 1`` to hand to the
-    #: general path (``out``: ``degenerate``; ``low``: where ``continuum_joints`` may flag a branch; see
-    #: ``Reduction.singular_kernel``).
-    SINGULAR_SIG = void(float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64, int64)
-    _elbow = internal(_elbow)
-    _d1_position = internal(_d1_position)
-    _elbow_residual = internal(_elbow_residual)
+RESIDUAL_SIG = float64(float64[::1], float64, int64)
+#: ``residuals(params, theta, out)``: every branch's residual at theta* into ``out`` (optional, see
+#: ``Reduction.kernel_residuals``).
+RESIDUALS_SIG = void(float64[::1], float64, float64[::1])
+CONFIGURATION_SIG = void(float64[::1], float64, int64, float64[::1])
+#: ``configurations(params, theta, out)``: every branch's configuration at theta* into ``out (n_branches, n)``
+#: (optional, see ``Reduction.kernel_configurations``).
+CONFIGURATIONS_SIG = void(float64[::1], float64, float64[:, ::1])
+#: ``hints(params, out)``: a reduction's sample hints of one pose (optional, see ``Reduction.kernel_hints``).
+HINTS_SIG = void(float64[::1], float64[::1])
+#: ``swing(amplitude, amplitudes, params, lo, hi, n, periodic, steps, out, start, stop)``: a generic sweep's swing
+#: samples of poses ``start .. stop - 1`` (``geometric.swing_hints``; ``amplitude`` and ``amplitudes`` the
+#: addresses of its amplitude kernels), which the engine calls pose by pose (``search.EdgeSearch``).
+SWING_SIG = void(
+    int64, int64, float64[:, ::1], float64[::1], float64[::1], int64, boolean, int64[::1], float64[:, ::1], int64,
+    int64,
+)  # fmt: skip
+#: ``singular(params, thr, out, low, start, stop)``: a closed form's poses ``start .. stop - 1`` to hand to the
+#: general path (``out``: ``degenerate``; ``low``: where ``continuum_joints`` may flag a branch; see
+#: ``Reduction.singular_kernel``).
+SINGULAR_SIG = void(float64[:, ::1], float64[::1], boolean[::1], boolean[::1], int64, int64)
+_elbow = internal(_elbow)
+_d1_position = internal(_d1_position)
+_elbow_residual = internal(_elbow_residual)
 
 
 class LazyKernel:
@@ -199,14 +194,10 @@ carm_theta2_residual: Any
 carm_d1_residuals: Any
 carm_d1_configuration: Any
 carm_theta2_configuration: Any
-if _njit is not None:
-    _carm_d1 = _njit(cache=True, error_model=ERROR_MODEL, no_cfunc_wrapper=True)(_carm_d1)  # (_carm_d1_all calls it)
-    carm_d1_residual = LazyKernel(_carm_d1, RESIDUAL_SIG)  # (its overload for the engine's signature)
-    carm_theta2_residual = LazyKernel(_carm_theta2, RESIDUAL_SIG, cache=True)
-    carm_d1_residuals = LazyKernel(_carm_d1_all, RESIDUALS_SIG, cache=True)
-else:  # pragma: no cover
-    carm_d1_residual, carm_theta2_residual = _carm_d1, _carm_theta2
-    carm_d1_residuals = _carm_d1_all
+_carm_d1 = _njit(cache=True, error_model=ERROR_MODEL, no_cfunc_wrapper=True)(_carm_d1)  # (_carm_d1_all calls it)
+carm_d1_residual = LazyKernel(_carm_d1, RESIDUAL_SIG)  # (its overload for the engine's signature)
+carm_theta2_residual = LazyKernel(_carm_theta2, RESIDUAL_SIG, cache=True)
+carm_d1_residuals = LazyKernel(_carm_d1_all, RESIDUALS_SIG, cache=True)
 
 
 def owned_kernel(reduction: Any, name: str) -> Any:
@@ -268,24 +259,14 @@ def address_of(fn: Any, sig: Any) -> int:
     return address
 
 
-as_residual: Any = None
-as_residuals: Any = None
-as_configuration: Any = None
-as_configurations: Any = None
-as_hints: Any = None
-as_swing: Any = None
-as_singular: Any = None
-if _njit is not None:
-    from sweepik._jit import function_at
-
-    #: In compiled code, the function at an address (``address_of``) of each kernel signature.
-    as_residual = function_at(RESIDUAL_SIG)
-    as_residuals = function_at(RESIDUALS_SIG)
-    as_configuration = function_at(CONFIGURATION_SIG)
-    as_configurations = function_at(CONFIGURATIONS_SIG)
-    as_hints = function_at(HINTS_SIG)
-    as_swing = function_at(SWING_SIG)
-    as_singular = function_at(SINGULAR_SIG)
+#: In compiled code, the function at an address (``address_of``) of each kernel signature.
+as_residual = function_at(RESIDUAL_SIG)
+as_residuals = function_at(RESIDUALS_SIG)
+as_configuration = function_at(CONFIGURATION_SIG)
+as_configurations = function_at(CONFIGURATIONS_SIG)
+as_hints = function_at(HINTS_SIG)
+as_swing = function_at(SWING_SIG)
+as_singular = function_at(SINGULAR_SIG)
 
 
 def _carm_configuration(p, x: float, b: int, out, rail: bool) -> None:
@@ -365,17 +346,10 @@ def _carm_params(poses, L1: float, L2: float, snap: float, out) -> None:
         out[i, 17] = px
 
 
-carm_d1_hints: Any = _carm_d1_hints
-carm_params: Any = None
-if _njit is not None:
-    carm_d1_hints = LazyKernel(_carm_d1_hints, HINTS_SIG, cache=True)
-    # (a row per pose in one call: the same columns by NumPy slicing cost ~10 NumPy calls, ~10 us for one pose)
-    from numba import types
-
-    _poses_type = types.Array(float64, 3, "A", readonly=True)  # (takes writable and read-only poses alike)
-    carm_params = LazyKernel(_carm_params, void(_poses_type, float64, float64, float64, float64[:, ::1]), cache=True)
-    _carm_configuration = internal(_carm_configuration)
-    carm_d1_configuration = LazyKernel(_carm_d1_configuration, CONFIGURATION_SIG, cache=True)
-    carm_theta2_configuration = LazyKernel(_carm_theta2_configuration, CONFIGURATION_SIG, cache=True)
-else:  # pragma: no cover
-    carm_d1_configuration, carm_theta2_configuration = _carm_d1_configuration, _carm_theta2_configuration
+carm_d1_hints = LazyKernel(_carm_d1_hints, HINTS_SIG, cache=True)
+# (a row per pose in one call: the same columns by NumPy slicing cost ~10 NumPy calls, ~10 us for one pose)
+_poses_type = types.Array(float64, 3, "A", readonly=True)  # (takes writable and read-only poses alike)
+carm_params = LazyKernel(_carm_params, void(_poses_type, float64, float64, float64, float64[:, ::1]), cache=True)
+_carm_configuration = internal(_carm_configuration)
+carm_d1_configuration = LazyKernel(_carm_d1_configuration, CONFIGURATION_SIG, cache=True)
+carm_theta2_configuration = LazyKernel(_carm_theta2_configuration, CONFIGURATION_SIG, cache=True)

@@ -1,4 +1,5 @@
-"""Vectorised bracketed root finding (Chandrupatla's method) over many independent brackets at once.
+"""Vectorised bracketed root finding (Chandrupatla's method) over many independent brackets at once: the NumPy
+reference sweep's (:mod:`oracles.numpy_sweep`; the compiled search has its scalar twin, ``search._root``).
 
 Why not ``scipy.optimize.elementwise.find_root``: it implements the same method, but its per-call overhead
 (~1.5 ms measured on this machine for a handful of brackets) alone exceeds the single-pose latency budget
