@@ -7,14 +7,16 @@ from __future__ import annotations
 import numpy as np
 
 from sweepik import load_robot
-from sweepik.engine.candidates import Candidates, Spans, merge_grid, twin_candidates
+from sweepik.engine import search
+from sweepik.engine.candidates import Candidates, Spans, twin_candidates
 from sweepik.reductions import CArmD1
 
 
 def test_the_grid_holds_the_uniform_samples_and_the_hints_in_range() -> None:
-    """Sorted rows, strictly increasing (a hint on the grid or repeated is spread, not duplicated), every uniform
-    sample and every finite hint inside ``[lo, hi]`` present (to the spreading), the row as long as the uniform grid
-    plus the hints."""
+    """The engine's sample grid (``search.sample_grid`` over a reduction's ``sample_hints``): each pose's samples
+    sorted, strictly increasing (a hint on the grid or repeated is spread, not duplicated), inside ``[lo, hi]``,
+    every uniform sample and every finite hint inside the range present (to the spreading), no sample for a NaN
+    hint, theta*'s own limits added, NaN past the pose's count."""
     rng = np.random.default_rng(0)
     N, n = 200, 17
     lo = rng.uniform(-3.0, 0.0, N)
@@ -23,14 +25,21 @@ def test_the_grid_holds_the_uniform_samples_and_the_hints_in_range() -> None:
     hints = np.where(rng.random((N, 6)) < 0.5, uniform[:, rng.integers(0, n, 6)], rng.uniform(-4.0, 5.0, (N, 6)))
     hints[:, 5] = hints[:, 4]  # a repeated hint
     hints[rng.random((N, 6)) < 0.2] = np.nan
-    grid = merge_grid(lo, hi, n, hints)
-    assert grid.shape == (N, n + 6)
-    assert np.all(np.diff(grid, axis=1) > 0)
-    assert np.all(grid >= lo[:, None]) and np.all(grid <= hi[:, None])
-    step = ((hi - lo) / (n - 1))[:, None]
-    for want in (uniform, np.where((hints >= lo[:, None]) & (hints <= hi[:, None]), hints, np.nan)):
-        d = np.abs(grid[:, None, :] - want[:, :, None]).min(axis=2)
-        assert np.all(d[np.isfinite(want)] <= 0.5 * step.repeat(want.shape[1], 1)[np.isfinite(want)])
+
+    class Hinted(CArmD1):
+        def sample_hints(self, poses: np.ndarray) -> np.ndarray:
+            return hints
+
+    grid, count = search.sample_grid(Hinted(load_robot("carm")), np.broadcast_to(np.eye(4), (N, 4, 4)), lo, hi, n)
+    np.testing.assert_array_equal(count, n + np.isfinite(hints).sum(axis=1) + 2)  # (+ the rail's two limits)
+    step = (hi - lo) / (n - 1)
+    inside = np.where((hints >= lo[:, None]) & (hints <= hi[:, None]), hints, np.nan)
+    for i in range(N):
+        row = grid[i, : count[i]]
+        assert np.all(np.diff(row) > 0) and row[0] >= lo[i] and row[-1] <= hi[i]
+        assert np.isnan(grid[i, count[i] :]).all()
+        for want in (uniform[i], inside[i][np.isfinite(inside[i])]):
+            assert np.all(np.abs(row[None, :] - want[:, None]).min(axis=1) <= 0.5 * step[i])
 
 
 def test_twin_branches_get_the_first_branchs_roots_in_pose_order() -> None:
