@@ -15,6 +15,7 @@ forward chain before the reversed; the lower theta*.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -27,6 +28,7 @@ from sweepik.model.structure import (
     INTERSECT_TOL_REL,
     PARALLEL_TOL,
     Structure,
+    cross3,
     line_relation,
     near_structure,
     structure_of,
@@ -169,13 +171,19 @@ def _reduced(chain: Chain, W: np.ndarray, f: int, x: float) -> tuple[np.ndarray,
     return tuple(np.array(v) for v in out[1:])
 
 
+def _norm(v: np.ndarray) -> float:
+    """``np.linalg.norm`` of a 3-vector, as it computes it (``sqrt(v . v)``: the same bits), without its argument
+    handling (a held arm's plan enumeration takes thousands)."""
+    return math.sqrt(float(v.dot(v)))
+
+
 def _dist_to_line(p: np.ndarray, o: np.ndarray, h: np.ndarray) -> float:
     d = p - o
-    return float(np.linalg.norm(d - np.dot(d, h) * h))
+    return _norm(d - np.dot(d, h) * h)
 
 
 def _parallel(u: np.ndarray, v: np.ndarray) -> bool:
-    return float(np.linalg.norm(np.cross(u, v))) < PARALLEL_TOL
+    return _norm(cross3(u, v)) < PARALLEL_TOL
 
 
 def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.ndarray, ...]], tol: float):
@@ -233,20 +241,20 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
     if case == "ppp":
         if any(types):
             return no
-        ok, cond = dots(lambda g: float(np.dot(g[0], np.cross(g[1], g[2]))))
+        ok, cond = dots(lambda g: float(np.dot(g[0], cross3(g[1], g[2]))))
         return ok, cond, None
     if case == "ppr":
         if ra or rb or not rc:
             return no
-        ok, cond = dots(lambda g: float(np.linalg.norm(np.cross(g[0], g[1]))))
-        if not ok or all(_parallel(np.cross(g[0], g[1]), g[2]) for g in geo):
+        ok, cond = dots(lambda g: _norm(cross3(g[0], g[1])))
+        if not ok or all(_parallel(cross3(g[0], g[1]), g[2]) for g in geo):
             return no
         return True, cond, None
     if case == "rpp":
         if not ra or rb or rc:
             return no
-        ok, cond = dots(lambda g: float(np.linalg.norm(np.cross(g[1], g[2]))))
-        if not ok or all(_parallel(np.cross(g[1], g[2]), g[0]) for g in geo):
+        ok, cond = dots(lambda g: _norm(cross3(g[1], g[2])))
+        if not ok or all(_parallel(cross3(g[1], g[2]), g[0]) for g in geo):
             return no  # (slides in the plane of the turn: W has a continuum of solutions)
         return True, cond, None
     if case == "ac_par":
@@ -263,8 +271,8 @@ def _check(case: str, types: tuple[bool, bool, bool], samples: list[tuple[np.nda
 
 def _fixed_target(samples: list[tuple[np.ndarray, ...]], tol: float) -> bool:
     """The reduced chains of every theta* sample are one and the same (to ``tol``): theta* does not move ``W``."""
-    first = samples[0]
-    return all(all(np.allclose(u, v, rtol=0.0, atol=tol) for u, v in zip(first, g, strict=True)) for g in samples)
+    first = samples[0]  # (``np.allclose(u, v, rtol=0, atol=tol)`` of finite vectors, without its overhead)
+    return all(all(bool(np.all(np.abs(u - v) <= tol)) for u, v in zip(first, g, strict=True)) for g in samples)
 
 
 def _sp5_regular(g: tuple[np.ndarray, ...]) -> bool:
@@ -282,7 +290,7 @@ def _sp5_regular(g: tuple[np.ndarray, ...]) -> bool:
         # (-pab) . R(ha, t) tp, theta3 terms of -hb . R(hc, t) pcw and -pbc . R(hc, t) pcw
         def terms(h: np.ndarray, k: np.ndarray, p: np.ndarray) -> tuple[float, float]:
             perp = p - np.dot(k, p) * k
-            return float(np.dot(h, perp)), float(np.dot(h, np.cross(k, p)))
+            return float(np.dot(h, perp)), float(np.dot(h, cross3(k, p)))
 
         a1, a2 = terms(hb, ha, tp), terms(-pab, ha, tp)
         b1, b2 = terms(-hb, hc, pcw), terms(-pbc, hc, pcw)
