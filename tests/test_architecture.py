@@ -122,3 +122,17 @@ def test_imports_run_downward(package: str, allowed: set[str]) -> None:
         if m == package or m.startswith(package + "."):
             up = sorted(d for d in deps if not any(d == a or d.startswith(a + ".") for a in allowed))
             assert up == [], f"{m} imports {up}"
+
+
+def test_every_engine_module_has_its_test_file_and_no_numpy_twin_is_left() -> None:
+    """Tests mirror the engine (``tests/test_<module>.py`` for each of its modules), and the NumPy references of
+    compiled steps live in ``tests/oracles``, not in ``src``: no engine module switches to a NumPy path on a flag
+    (``AVAILABLE``, ``SWEEPIK_DISABLE_NUMBA``)."""
+    tests = Path(__file__).parent
+    engine = sorted(n.rsplit(".", 1)[1] for n in MODULES if n.startswith("sweepik.engine.") and "__init__" not in n)
+    assert [m for m in engine if not (tests / f"test_{m}.py").exists()] == []
+    for name, path in MODULES.items():
+        text = path.read_text()
+        assert "SWEEPIK_DISABLE_NUMBA" not in text and "engine.sweep" not in text, name
+        if name != "sweepik.reductions.lapack":  # (SciPy's LAPACK interface, not an engine switch)
+            assert not any(isinstance(n, ast.Name) and n.id == "AVAILABLE" for n in ast.walk(ast.parse(text))), name
