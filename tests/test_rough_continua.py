@@ -64,3 +64,25 @@ def test_only_a_continuum_is_masked(off: float) -> None:
         assert not fams and not len(masked)
     s = sweepik.solve(robot, T[0], limits=False)
     assert recovered(robot, s, q)
+
+
+def test_a_stretch_too_short_to_trace_is_searched_with_buffers_as_large_as_it_needs() -> None:
+    """A random slide_parallel arm (tests/test_any_arm.py) at a pose on a continuum whose fallback sweep sees it only
+    roughly: the traced continuum is masked, but one piece of it (0.05 rad of theta*, fewer samples than a run
+    needs) is not, and its noisy residual makes ~10,000 flat stretches. The compiled search, redone with buffers
+    sized to what the pose reached (not a fixed cap), reports the continuum and no isolated solution, with and without
+    limits, as the NumPy reference engine did (benchmarks/same_solutions.py: it stopped with an error at a fixed
+    cap)."""
+    from test_any_arm import FAMILIES, _arm
+
+    rng = np.random.default_rng(300)
+    robot = _arm(FAMILIES["slide_parallel"](rng), rng, "standard")
+    q = np.array([0.0, 2.576595021666786, -1.5707963267948966, 3.087291094769447, np.pi, 1.0189484723137578])
+    T = robot.fk(q)
+    for limits in (True, False):
+        s = sweepik.solve(robot, T, limits=limits)
+        assert len(s) == 0 and s.families
+        assert recovered(robot, s, q)
+        for f in s.families:  # (each family's members solve the pose)
+            m = f.at(np.linspace(f.interval[0], f.interval[1], 9))
+            assert np.abs(robot.fk(m) - T).max() <= 1e-9 * robot.length_scale

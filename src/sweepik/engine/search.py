@@ -55,7 +55,7 @@ from sweepik.engine.settings import (
     N_SAMPLES,
     PARALLEL_MIN,
     REDO_GROW,
-    REDO_MAX,
+    REDO_MAX_CAND,
     STACK,
     SUB_SAMPLES,
     U_EDGE,
@@ -1436,13 +1436,13 @@ def _redone(
     reduction, plan, poses, params, lo, hi, n_samples, multiplicity, masked
 ) -> tuple[candidates.Candidates, candidates.Spans]:
     """The poses that overflowed the search's buffers (their candidates, family spans or pending intervals) searched
-    again by the staged search on the same samples, with buffers ``REDO_GROW`` times larger, and larger again while
-    one still overflows (up to ``REDO_MAX`` times the first), leaving out the stretches ``masked`` (``Spans`` of
-    these poses: continua traced already)."""
+    again by the staged search on the same samples, leaving out the stretches ``masked`` (``Spans`` of these poses:
+    continua traced already), with buffers ``REDO_GROW`` times larger, then (for the poses that still overflow) large
+    enough for twice the counts they reached, up to ``REDO_MAX_CAND`` candidates a pose. Pose by pose in order."""
     N = poses.shape[0]
     theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
     n_masks = np.zeros(N, dtype=np.int64)
-    masks = np.empty((0, 0, 3))
+    masks = np.zeros((N, 0, 3))
     if masked is not None and len(masked):
         n_masks = np.bincount(masked.pose, minlength=N).astype(np.int64)
         masks = np.zeros((N, int(n_masks.max()), 3))
@@ -1450,19 +1450,32 @@ def _redone(
         p = masked.pose[order]
         slot = np.arange(p.size) - np.repeat(np.cumsum(n_masks) - n_masks, n_masks)
         masks[p, slot] = np.stack([masked.lo[order], masked.hi[order], masked.branch[order]], axis=1)
-    grow = REDO_GROW
-    while True:
-        out = _Out.empty(N, MAX_CAND * grow, MAX_FAM * grow)
-        _run_search(reduction, plan, params, theta, n_theta, lo, hi, multiplicity, out, masks, n_masks)
-        over = (out.cnt > out.t.shape[1]) | (out.fcnt > out.fam.shape[1])
-        if not over.any():
-            return _gathered(out, over)
-        if grow >= REDO_MAX:
+    todo, grow = np.arange(N), REDO_GROW
+    found: list[tuple[candidates.Candidates, candidates.Spans]] = []
+    while todo.size:
+        K, F = MAX_CAND * grow, MAX_FAM * grow
+        if K > REDO_MAX_CAND:
             raise RuntimeError(
-                f"the search of {reduction.name!r} found more than {MAX_CAND * grow} candidates or "
-                f"{MAX_FAM * grow} families on a pose: its residual crosses zero that often along theta*"
+                f"the search of {reduction.name!r} found more than {REDO_MAX_CAND} candidates or {F // REDO_GROW} "
+                "families on a pose: its residual crosses zero that often along theta*"
             )
-        grow *= REDO_GROW
+        out = _Out.empty(todo.size, K, F)
+        rows = (params[todo], theta[todo], n_theta[todo], lo[todo], hi[todo])
+        _run_search(reduction, plan, *rows, multiplicity, out, masks[todo], n_masks[todo])
+        over = (out.cnt > K) | (out.fcnt > F)
+        c, sp = _gathered(out, over)
+        mine = candidates.Candidates(todo[c.pose], c.branch, c.theta, c.mult)
+        found.append((mine, candidates.Spans(todo[sp.pose].astype(np.intp), sp.branch, sp.lo, sp.hi)))
+        need = max(
+            float(np.max(out.cnt[over], initial=0)) / MAX_CAND, float(np.max(out.fcnt[over], initial=0)) / MAX_FAM
+        )
+        todo, grow = todo[over], max(grow * REDO_GROW, 2 * int(np.ceil(need)))
+    cand = candidates.Candidates(
+        *(np.concatenate([getattr(c, k) for c, _ in found]) for k in ("pose", "branch", "theta", "mult"))
+    )
+    order = np.argsort(cand.pose, kind="stable")
+    cand = candidates.Candidates(cand.pose[order], cand.branch[order], cand.theta[order], cand.mult[order])
+    return cand, candidates.Spans.concat([s for _, s in found])
 
 
 def edge_zeros(reduction, poses: Array, lo: Array, hi: Array) -> Array:

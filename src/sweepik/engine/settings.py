@@ -197,12 +197,14 @@ MAX_CAND = 256
 MAX_FAM = 16
 #: Pending resampled intervals per pose and branch (depth-first, so a few dozen suffice).
 STACK = 512
-#: A pose that overflows the buffers is searched again with buffers REDO_GROW times larger (the stack too), and
-#: larger again while it still overflows, up to REDO_MAX times (131,072 candidates: a residual crossing zero that
-#: often is an error, not an arm: a UR5 pose on a continuum the sweep sees only roughly crossed it 91,000 times
-#: before such continua were traced first, :mod:`sweepik.engine.rough_continua`).
+#: A pose that overflows the buffers is searched again with buffers REDO_GROW times larger (the stack too), then,
+#: while it still overflows, large enough for twice the counts it reached, up to REDO_MAX_CAND candidates a pose
+#: (~100 MB; past it, an error: a residual crossing zero that often is not an arm's. A UR5 pose on a continuum the
+#: sweep sees only roughly crossed it 91,000 times before such continua were traced first,
+#: :mod:`sweepik.engine.rough_continua`; a stretch of a continuum too short to be traced, 0.05 rad of a random
+#: slide_parallel arm's, gives ~10,000 flat stretches).
 REDO_GROW = 8
-REDO_MAX = 512
+REDO_MAX_CAND = 1 << 22
 #: Batches at least this large are searched with parallel threads.
 PARALLEL_MIN = 64
 
