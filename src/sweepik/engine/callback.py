@@ -23,11 +23,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numba import njit, objmode
+from numba import objmode
 from numpy.typing import NDArray
 
 from sweepik.reductions.base import Reduction
-from sweepik.reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG
+from sweepik.reductions.kernels import RESIDUAL_SIG, RESIDUALS_SIG, LazyKernel
 
 __all__ = ["registered", "residual", "residuals"]
 
@@ -95,14 +95,12 @@ def _every(key: float, row: float, theta: float) -> Array:
         return np.full(n, np.nan)
 
 
-@njit(RESIDUAL_SIG)  # (not cached: Numba does not cache object-mode blocks)
 def _residual(p: Any, x: float, b: int) -> float:
     with objmode(r="float64"):
         r = _one(p[0], p[1], x, b)
     return r
 
 
-@njit(RESIDUALS_SIG)
 def _residuals(p: Any, x: float, out: Any) -> None:
     with objmode(r="float64[::1]"):
         r = _every(p[0], p[1], x)
@@ -110,7 +108,8 @@ def _residuals(p: Any, x: float, out: Any) -> None:
         out[k] = r[k]
 
 
+# (compiled on first use, ~0.3 s, not at import: not cached either, as Numba does not cache object-mode blocks)
 #: The compiled residual of any NumPy reduction (``kernels.RESIDUAL_SIG``), its ``params`` from ``registered``.
-residual = _residual
+residual = LazyKernel(_residual, RESIDUAL_SIG, cache=False)
 #: ... and every branch's at once (``kernels.RESIDUALS_SIG``).
-residuals = _residuals
+residuals = LazyKernel(_residuals, RESIDUALS_SIG, cache=False)
