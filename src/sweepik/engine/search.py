@@ -85,7 +85,7 @@ Array = NDArray[np.float64]
 
 @inlined
 def _root(res, p, b, a, c, fa, fc, xtol):
-    """Chandrupatla's bracketed root finder (scalar), as rootfind.find_roots."""
+    """Chandrupatla's bracketed root finder (scalar), as the NumPy reference's find_roots."""
     eps = 2.220446049250313e-16
     x = a if abs(fa) < abs(fc) else c
     if fa == 0.0:
@@ -138,7 +138,7 @@ def _small(res, p, x, b, noise):
 
 @inlined
 def _center_flat(res, p, x, b, noise, span, probes):
-    """As sweep._Search._center_flat, for one root: (centre, lo, hi, is a family). ``probes (2,)``: the residual
+    """As numpy_sweep._Search._center_flat, for one root: (centre, lo, hi, is a family). ``probes (2,)``: the residual
     at ``x -+ FLAT_PROBE_REL * span`` where the root is not in a flat stretch (the first probes of
     ``_multiplicity``), else NaN."""
     d0 = FLAT_PROBE_REL * span
@@ -177,7 +177,7 @@ def _flat_grow(res, p, x, b, noise, d0, limit, sgn):
 
 @inlined
 def _flat_end(res, p, x, b, noise, inner, outer, limit, sgn, short):
-    """(reach, the stretch ends openly) on one side, as in sweep._Search._center_flat."""
+    """(reach, the stretch ends openly) on one side, as in numpy_sweep._Search._center_flat."""
     at_limit = inner >= limit
     for _ in range(FLAT_BISECT if outer > inner else 0):  # (at the reach limit: nothing to bisect)
         if short and outer - inner <= FLAT_SHORT_TOL * inner:
@@ -194,7 +194,7 @@ def _flat_end(res, p, x, b, noise, inner, outer, limit, sgn, short):
 
 @inlined
 def _multiplicity(res, p, x, b, noise, span, f_lo, f_hi):
-    """As sweep._Search._multiplicity, for one root; ``f_lo, f_hi``: the residual at its first probes if known
+    """As numpy_sweep._Search._multiplicity, for one root; ``f_lo, f_hi``: the residual at its first probes if known
     (``_center_flat``'s, the same points), else NaN."""
     level = MULT_LEVEL * noise
     limit = FLAT_MAX_REL * span
@@ -241,7 +241,7 @@ def _push(out_t, out_b, cnt, x, b):
 def _extremum(res, p, b, ta, tc, tb, fa, fc, fb, span, noise, xtol, out_t, out_b, cnt):
     xe = tc
     lo, hi = ta, tb
-    for level in range(DIFF_LEVELS):  # as sweep._Search._extrema
+    for level in range(DIFF_LEVELS):  # as numpy_sweep._Search._extrema
         h = DIFF_STEP_REL * span / DIFF_SHRINK**level
         if level > 0:
             lo, hi = xe - 2.0 * DIFF_SHRINK * h, xe + 2.0 * DIFF_SHRINK * h
@@ -325,7 +325,7 @@ def _root_diff(res, p, b, a, c, ga, gc, h):
 @inlined
 def _edge_bent(res, p, b, th, f, valid, fmask, j, right, span, otherwise):
     """Level 0: whether interval j, next to one domain edge (on its ``right`` or left), is resampled, as
-    ``sweep._Search._edge_at_sample``: where the edge sits at its open-side sample (the residual just past it is
+    ``numpy_sweep._Search._edge_at_sample``: where the edge sits at its open-side sample (the residual just past it is
     not finite), by the bend test in that edge's coordinate; elsewhere ``otherwise``."""
     M = th.shape[0]
     if right:
@@ -348,7 +348,7 @@ def _edge_bent(res, p, b, th, f, valid, fmask, j, right, span, otherwise):
 @inlined
 def _dd(fa, fb, fc, hl, hr):
     """The second divided difference of three samples ``hl`` and ``hr`` apart (the scan's curvature, as the
-    reference's ``sweep._Search.scan`` works it out)."""
+    reference's ``numpy_sweep._Search.scan`` works it out)."""
     return 2.0 * ((fc - fb) / hr - (fb - fa) / hl) / (hl + hr)
 
 
@@ -450,7 +450,7 @@ def _scan(
             _push(out_t, out_b, cnt, th[j], b)
     _extrema(res, p, b, th, f, level, ctx, span, noise, xtol, out_t, out_b, cnt)
     _edge_samples(b, th, f, valid, level, fmask, noise, out_t, out_b, cnt)
-    # second divided differences (dd), in theta or in sqrt(|theta - xe|) (sweep._edge_coordinate), worked out
+    # second divided differences (dd), in theta or in sqrt(|theta - xe|) (numpy_sweep._edge_coordinate), worked out
     # as the intervals are walked: c1, c2 at the interval's samples (NaN at the ends and next to a NaN sample)
     x = th if math.isnan(xe) else wx[:M]
     if not math.isnan(xe):
