@@ -400,7 +400,7 @@ def _solve_one(
     arm = robot if held is None else held.arm
     if default and is_default(arm, reduction):
         # (the default options, the default reduction named or not: their checks done once per arm)
-        red = _default_reduction(arm)
+        red = _default_reduction(arm, held)
         if red.uses_kernel:  # (its solutions straight from the one compiled call, where it settles the pose)
             out = settled(arm, red, P, chain_poses(arm, P), limits, N_SAMPLES)
             if out is not None:
@@ -426,10 +426,11 @@ def _solve_one(
 
 
 @lru_cache(maxsize=16)
-def _default_reduction(robot: Robot) -> Reduction:
+def _default_reduction(robot: Robot, held: HeldJoints | None = None) -> Reduction:
     """``prepare``'s reduction for ``robot`` solved with the default options (a solve would spend ~6 us a call
-    checking them again); what ``prepare`` refuses is not kept, and raises again on the next call."""
-    return prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1)[0]
+    checking them again; with ``held``, ``robot`` is the held arm, chosen as ``solve_many`` chooses it:
+    ``reductions.automatic_for_held``); what ``prepare`` refuses is not kept, and raises again on the next call."""
+    return prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1, None, held)[0]
 
 
 def solve(

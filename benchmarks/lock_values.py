@@ -1,0 +1,53 @@
+"""A 7-joint arm held at a new lock value every pose against the same value every pose (issue 39's "a new lock
+value for free"): ``solve`` per pose, and ``solve_many`` with one value per pose. Run from the repository root.
+
+    python benchmarks/lock_values.py [--arm kuka_iiwa14] [--joint A3] [--n 40]
+
+Prints the mean time a pose of each, in milliseconds, and their ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import sweepik
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--arm", default="kuka_iiwa14")
+    parser.add_argument("--joint", default="A3")
+    parser.add_argument("--n", type=int, default=40)
+    args = parser.parse_args()
+    arm = sweepik.load_robot(args.arm)
+    k = arm.joint_names.index(args.joint)
+    n = args.n
+    # fresh configurations (and lock values) for each measurement: held arms and their reductions are cached
+    q = np.random.default_rng(2).uniform(arm.lower, arm.upper, (3 * n + 1, arm.n_joints))
+    T = arm.fk(q)
+    sweepik.solve(arm, T[0], locked={args.joint: float(q[0, k])})  # (kernels loaded)
+    t0 = time.perf_counter()
+    for i in range(1, n + 1):
+        sweepik.solve(arm, T[i], locked={args.joint: float(q[i, k])})
+    new = (time.perf_counter() - t0) / n
+    same_value = float(q[n + 1, k])
+    sweepik.solve(arm, T[n + 1], locked={args.joint: same_value})
+    t0 = time.perf_counter()
+    for i in range(n + 1, 2 * n + 1):
+        sweepik.solve(arm, T[i], locked={args.joint: same_value})
+    same = (time.perf_counter() - t0) / n
+    rows = slice(2 * n + 1, 3 * n + 1)
+    t0 = time.perf_counter()
+    sweepik.solve_many(arm, T[rows], locked={args.joint: q[rows, k]})
+    batch = (time.perf_counter() - t0) / n
+    print(
+        f"{args.arm}, {args.joint} held: a new value every pose {new * 1e3:.2f} ms, the same value {same * 1e3:.3f} ms "
+        f"(x{new / same:.0f}); solve_many with a new value per pose {batch * 1e3:.2f} ms a pose"
+    )
+
+
+if __name__ == "__main__":
+    main()
