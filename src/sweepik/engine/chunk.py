@@ -22,7 +22,6 @@ from sweepik.engine.families import (
     MAX_ISOLATED_SOLUTIONS,
     collapse_continua,
     families_of,
-    inner_off,
 )
 from sweepik.engine.family_join import add_crossing_families, trace_cut_continua, with_families
 from sweepik.engine.paper_sweep import paper_candidates
@@ -311,10 +310,7 @@ def _precise_candidates(
         free = red.continuum_joints(chain, cand.pose, cand.theta, cand.branch, e, seed_tol)
     if redo is not None and redo.families:
         for i, f in redo.families.items():
-            # (the sweep's families along stretches of the continuum too short to be left out: the same continuum)
-            swept = found.families.get(i, [])
-            new = inner_off(robot, swept, tuple(f))
-            found.families[i] = [g for g, o in zip(swept, new, strict=True) if o] + list(f)
+            found.families.setdefault(i, []).extend(f)
         members.append((redo.pose, redo.q))
     if free is not None:
         seeds = np.nonzero(free >= 0)[0]
