@@ -16,10 +16,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
+from sweepik.engine.closed_pose import NOT_RIGID, ClosedPose
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.settings import N_SAMPLES
 from sweepik.engine.windings import wound_block, wound_solutions
-from sweepik.errors import LockedJointError, NoReductionError, ShapeError, UnknownOptionError
+from sweepik.errors import LockedJointError, NoReductionError, ShapeError, SweepikError, UnknownOptionError
 from sweepik.model.origin_axis import HeldJoints, hold_joints, lock_runs, per_pose
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit
@@ -384,24 +385,17 @@ def _solve_one(
     n_samples: int,
     free_joint: int | str | None = None,
     locked: object = None,
+    one_call: bool = True,
 ) -> Solutions:
-    """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly."""
-    one_call = True
-    default = (
-        free_joint is None
-        and (limits is True or limits is False)
-        and type(strategy) is str
-        and strategy == "precise"
-        and type(n_samples) is int
-        and n_samples == N_SAMPLES
-        and isinstance(robot, Robot)
-    )
+    """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly (with
+    ``one_call``: by the one compiled call where it settles the pose)."""
+    default = _defaults(robot, free_joint, strategy, limits, n_samples)
     held = held_joints(robot, locked)
     arm = robot if held is None else held.arm
     if default and is_default(arm, reduction):
         # (the default options, the default reduction named or not: their checks done once per arm)
         red = _default_reduction(arm, held)
-        if red.uses_kernel:  # (its solutions straight from the one compiled call, where it settles the pose)
+        if red.uses_kernel and one_call:  # (its solutions straight from the one compiled call, where it settles)
             out = settled(arm, red, P, chain_poses(arm, P), limits, N_SAMPLES)
             if out is not None:
                 n = out.q.shape[0]
@@ -425,12 +419,49 @@ def _solve_one(
     return _expanded(block, held).solutions(0, copy=False)
 
 
+def _defaults(robot: object, free_joint: object, strategy: object, limits: object, n_samples: object) -> bool:
+    """The options are the defaults (the automatic choice of theta*, precise, limits a bool, the default samples) and
+    ``robot`` a Robot: checked here in ~0.3 us, where ``prepare`` takes ~6."""
+    return (
+        free_joint is None
+        and (limits is True or limits is False)
+        and type(strategy) is str
+        and strategy == "precise"
+        and type(n_samples) is int
+        and n_samples == N_SAMPLES
+        and isinstance(robot, Robot)
+    )
+
+
 @lru_cache(maxsize=16)
 def _default_reduction(robot: Robot, held: HeldJoints | None = None) -> Reduction:
     """``prepare``'s reduction for ``robot`` solved with the default options (a solve would spend ~6 us a call
     checking them again; with ``held``, ``robot`` is the held arm, chosen as ``solve_many`` chooses it:
     ``reductions.automatic_for_held``); what ``prepare`` refuses is not kept, and raises again on the next call."""
     return prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1, None, held)[0]
+
+
+def _closed_pose(robot: Robot, locked: object) -> ClosedPose | None:
+    """``robot``'s closed form for single poses with the default options and ``locked`` joints (None: its default
+    reduction is no such closed form, or the arm or ``locked`` is refused: the general path then raises, after the
+    pose's checks)."""
+    if locked is None:
+        return _closed_pose_of(robot, None)
+    try:
+        held = held_joints(robot, locked)
+    except (SweepikError, TypeError):  # (an unhashable value: the general path says what is wrong)
+        return None
+    return _closed_pose_of(robot, held)
+
+
+@lru_cache(maxsize=16)
+def _closed_pose_of(robot: Robot, held: HeldJoints | None) -> ClosedPose | None:
+    arm = robot if held is None else held.arm
+    try:
+        red = _default_reduction(arm, held)
+    except SweepikError:
+        return None
+    return ClosedPose.of(arm, red, held)
 
 
 def solve(
@@ -486,9 +517,25 @@ def solve(
     >>> bool(np.allclose(sols.nearest(q), q, atol=1e-9))
     True
     """
+    one_call = True
+    if (  # (the default options on an array: a closed form answers in one compiled call, ``closed_pose``)
+        type(pose) is np.ndarray
+        and reduction is None
+        and windings is False
+        and _defaults(robot, free_joint, strategy, limits, n_samples)
+        and pose.dtype == np.float64
+        and pose.shape == (4, 4)
+    ):
+        fast = _closed_pose(robot, locked)
+        flags = pose.flags
+        if fast is not None and flags.c_contiguous and flags.writeable:
+            status, sol = fast.solve(pose, limits)
+            if sol is not None:
+                return sol
+            one_call = status == NOT_RIGID  # (else the one call was made: the general path answers)
     P = check_poses(pose, "pose")
     if P.shape != (4, 4):
         raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
     wind = check_bool(windings, "windings")
-    sol = _solve_one(robot, P[None], reduction, strategy, limits, n_samples, free_joint, locked)
+    sol = _solve_one(robot, P[None], reduction, strategy, limits, n_samples, free_joint, locked, one_call)
     return wound_solutions(sol, _free_mask(robot, held_joints(robot, locked))) if wind else sol

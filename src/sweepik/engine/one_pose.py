@@ -40,7 +40,19 @@ from sweepik.reductions.kernels import (
     owned_kernel,
 )
 
-__all__ = ["OK", "SEARCH_ELSEWHERE", "DUE", "CONTINUUM", "MEET", "SINGULAR", "Settled", "settle_one", "settle_closed"]
+__all__ = [
+    "OK",
+    "SEARCH_ELSEWHERE",
+    "DUE",
+    "CONTINUUM",
+    "MEET",
+    "SINGULAR",
+    "Settled",
+    "settle_one",
+    "settle_closed",
+    "closed_fixed",
+    "every_branch_settled",
+]
 
 Array = NDArray[np.float64]
 
@@ -236,10 +248,23 @@ def _settle_closed(
     addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
     s_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
-    """``settle_closed``'s kernel: every branch of pose 0 of ``params``/``world`` (the all-branch configuration
-    kernel at ``addr[_A_CFG]``) certified and settled; ``MEET`` where a branch is dropped as another's duplicate
-    or two kept ones are within ``meet`` (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``);
-    ``SINGULAR`` where the singular kernel at ``addr[_A_SING]`` (unless 0; thresholds ``s_thr``) flags it."""
+    """``settle_closed``'s kernel (``every_branch_settled``)."""
+    return every_branch_settled(
+        addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
+        s_thr, meet, only_inside,
+    )  # fmt: skip
+
+
+@internal
+def every_branch_settled(
+    addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
+    s_thr, meet, only_inside,
+):  # pragma: no cover  # fmt: skip
+    """Every branch of pose 0 of ``params``/``world`` (the all-branch configuration kernel at ``addr[_A_CFG]``)
+    certified and settled; ``MEET`` where a branch is dropped as another's duplicate or two kept ones are within
+    ``meet`` (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``); ``SINGULAR`` where the singular kernel
+    at ``addr[_A_SING]`` (unless 0; thresholds ``s_thr``) flags it. Compiled callers only (``settle_closed``,
+    ``closed_pose``)."""
     q = np.empty((nb, rev.shape[0]))
     eg = np.empty(nb)
     ep = np.empty(nb)
@@ -404,6 +429,23 @@ def settle_closed(
     """A closed form's one pose ``world (1, 4, 4)``: every branch (in order: ``Settled.branch``) certified and settled
     in one compiled call, as ``settle_one``; ``MEET`` where two branches meet (``meet``: the reach per joint within
     which two kept ones do); None where ``red`` has no all-branch configuration kernel."""
+    fixed = closed_fixed(robot, red, thresholds, reach)
+    if fixed is None:
+        return None
+    addr, nb, theta, branch, tail, s_thr = fixed
+    p = np.ascontiguousarray(params, dtype=np.float64)
+    status, c, reachable, q, ep, eg, inside, mu, err_all = _settle_closed(
+        addr, p, writable(world), nb, *tail, s_thr, writable(meet), bool(only_inside)
+    )
+    return Settled(status, c, reachable, q, ep, eg, inside, mu, theta, branch, err_all, bool(addr[_A_SING] != 0))
+
+
+def closed_fixed(
+    robot: Any, red: Any, thresholds: tuple[float, float, float, float, float], reach: Array
+) -> tuple[Any, ...] | None:
+    """What ``every_branch_settled`` takes for the closed form ``red`` besides the pose's rows, the target, the
+    meeting reach and ``only_inside``, kept per reduction: ``(addr, nb, theta, branch, tail, s_thr)``; None where
+    ``red`` has no all-branch configuration kernel."""
 
     def make() -> tuple[Any, ...] | None:
         cfgs = owned_kernel(red, "kernel_configurations")
@@ -425,12 +467,4 @@ def settle_closed(
         branches = np.arange(nb, dtype=np.int64)
         return addr, nb, np.zeros(nb), branches, _tail(robot, thresholds, reach), s_thr
 
-    fixed = _kept(red, ("closed", thresholds), make)
-    if fixed is None:
-        return None
-    addr, nb, theta, branch, tail, s_thr = fixed
-    p = np.ascontiguousarray(params, dtype=np.float64)
-    status, c, reachable, q, ep, eg, inside, mu, err_all = _settle_closed(
-        addr, p, writable(world), nb, *tail, s_thr, writable(meet), bool(only_inside)
-    )
-    return Settled(status, c, reachable, q, ep, eg, inside, mu, theta, branch, err_all, bool(addr[_A_SING] != 0))
+    return _kept(red, ("closed", thresholds), make)

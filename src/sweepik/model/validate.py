@@ -204,9 +204,17 @@ def _gram_deviation_det(R: NDArray[np.float64]) -> tuple[NDArray[np.float64], ND
 
 
 def _one_pose_ok(arr: NDArray[np.float64]) -> bool:
-    """One pose ``(4, 4)`` passes every check of ``check_poses`` (the same tests in scalar arithmetic; a pose that
-    fails goes through those checks for their message)."""
-    (a, b, c, x), (d, e, f, y), (g, h, k, z), (r0, r1, r2, r3) = arr.tolist()
+    """One pose ``(4, 4)`` passes every check of ``check_poses`` (``rigid_values``; a pose that fails goes through
+    those checks for their message)."""
+    return rigid_values(*arr.ravel().tolist())
+
+
+def rigid_values(
+    a: float, b: float, c: float, x: float, d: float, e: float, f: float, y: float,
+    g: float, h: float, k: float, z: float, r0: float, r1: float, r2: float, r3: float,
+) -> bool:  # fmt: skip
+    """The pose with rows ``(a, b, c, x), (d, e, f, y), (g, h, k, z), (r0, r1, r2, r3)`` passes every check of
+    ``check_poses``: the same tests in scalar arithmetic (plain Python, compiled too by ``engine.closed_pose``)."""
     # (a sum is finite only if every term is; one that overflows merely sends the pose to the full checks)
     if not math.isfinite(a + b + c + x + d + e + f + y + g + h + k + z + r0 + r1 + r2 + r3):
         return False

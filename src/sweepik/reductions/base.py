@@ -243,6 +243,12 @@ class Reduction(ABC):
         ``continuum_joints`` and not this one has its candidates checked in Python (the general path)."""
         return None
 
+    def pose_row_args(self) -> tuple[Any, ...] | None:
+        """For a compiled caller (``engine.closed_pose``): the arguments of ``geometric.pose_rows`` after the poses
+        and before the output (``base, tool, reverse, r_end, w_tool, row``) when ``kernel_params`` is that kernel's
+        rows, ``geometric.N_PARAMS`` wide; None: ``kernel_params`` is the reduction's own (the Python path)."""
+        return None
+
     def singular_kernel(self) -> tuple[int, Array] | None:
         """For a compiled caller (``one_pose.settle_closed``): a closed form's ``degenerate`` poses and those where
         ``continuum_joints`` may flag a branch, in one kernel: the address of ``(params, thr, out, low, start, stop)``

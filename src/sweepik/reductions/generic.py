@@ -455,18 +455,16 @@ class GeometricReduction(Reduction):
         """The rows; ``probing``: for ``_probe``, which finds the twins and steps that the rows' ``need`` fields
         name (all of them there). Compiled (``geometric.pose_rows``); ``_params_numpy`` is the same in NumPy."""
         out = np.empty((poses.shape[0], geometric.N_PARAMS))
-        robot = self.robot
-        geometric.pose_rows(
-            np.ascontiguousarray(poses, dtype=np.float64),
-            robot.T_world_base,
-            robot.T_flange_tool,
-            bool(self.plan.reversed),
-            self._chain.R_end,
-            self._w_tool,
-            self._row if probing else self._solving_row,
-            out,
-        )
+        base, tool, reverse, r_end, w_tool, row = self._pose_row_args(self._row if probing else self._solving_row)
+        geometric.pose_rows(np.ascontiguousarray(poses, dtype=np.float64), base, tool, reverse, r_end, w_tool, row, out)
         return out
+
+    def pose_row_args(self) -> tuple[Any, ...]:
+        return self._pose_row_args(self._solving_row)
+
+    def _pose_row_args(self, row: Array) -> tuple[Any, ...]:
+        robot = self.robot
+        return robot.T_world_base, robot.T_flange_tool, bool(self.plan.reversed), self._chain.R_end, self._w_tool, row
 
     def _params_numpy(self, poses: Array, probing: bool = False) -> Array:
         """``_params`` with NumPy (a test's reference)."""

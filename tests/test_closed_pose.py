@@ -1,0 +1,162 @@
+"""A closed form's single pose in one compiled call (``engine.closed_pose``): the general path's answer bit for bit,
+on every bundled closed-form arm and on arms written otherwise (base and tool frames, millimetres, axis signs,
+offsets); targets that are not rigid transforms raise what they raised; other arrays take the general path."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+import pytest
+from rewrites import rewrite
+
+import sweepik
+from sweepik import load_robot, solving
+from sweepik.engine import chunk
+from sweepik.engine.closed_pose import ClosedPose
+from sweepik.results import Solutions
+
+CLOSED = ["puma560", "puma560_std", "ur5", "abb_irb140", "kuka_kr6_r900", "stanford", "standardbots_spark"]
+
+
+def _configurations(robot: sweepik.Robot, rng: np.random.Generator, n: int = 24) -> np.ndarray:
+    """Random configurations, a quarter with the wrist straight (joint 5 at 0), a quarter with joint 3 at 0."""
+    q = rng.uniform(np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi), (n, robot.n_joints))
+    q[: n // 4, 4] = 0.0
+    q[n // 4 : n // 2, 2] = 0.0
+    return q
+
+
+def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, T: np.ndarray, **kw: Any) -> Solutions:
+    """``solve`` without the one call (neither this module's nor ``chunk.settled``)."""
+    with monkeypatch.context() as m:
+        m.setattr(solving, "_closed_pose", lambda *args: None)
+        m.setattr(solving, "settled", lambda *args: None)
+        m.setattr(chunk, "settled", lambda *args: None)
+        return sweepik.solve(robot, T, **kw)
+
+
+def _assert_same(a: Solutions, b: Solutions) -> None:
+    for f in dataclasses.fields(Solutions):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(x, np.ndarray):
+            assert x.dtype == y.dtype, f.name
+            np.testing.assert_array_equal(x, y, err_msg=f.name)
+        elif f.name == "families":
+            assert len(x) == len(y)
+        else:
+            assert x == y, f.name
+
+
+def _answered(robot: sweepik.Robot, T: np.ndarray, limits: bool = True, locked: Any = None) -> bool:
+    fast = solving._closed_pose(robot, locked)
+    return fast is not None and fast.solve(np.ascontiguousarray(T), limits)[1] is not None
+
+
+@pytest.mark.parametrize("name", CLOSED)
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_one_call_is_the_general_path_on_arms_written_otherwise(
+    name: str, seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The arm as bundled (seed 0) and rewritten at random (seed 1: frames, units, axis signs, offsets): each pose's
+    solutions are the general path's, bit for bit, limits on and off; most poses are answered by the one call; every
+    solution reproduces the pose and the generating configuration is among them (modulo 2 pi)."""
+    robot = load_robot(name)
+    rng = np.random.default_rng(seed)
+    if seed:
+        robot = rewrite(robot, rng).robot
+    q = _configurations(robot, rng)
+    answered = 0
+    for qq, T in zip(q, robot.fk(q), strict=True):
+        for limits in (True, False):
+            sol = sweepik.solve(robot, T, limits=limits)
+            _assert_same(sol, _general(monkeypatch, robot, T, limits=limits))
+            answered += _answered(robot, T, limits)
+        sol = sweepik.solve(robot, T, limits=False)
+        scale = robot.length_scale
+        for s in sol.q:
+            F = robot.fk(s)
+            assert np.max(np.abs(F[:3, 3] - T[:3, 3])) < 1e-9 * scale and np.max(np.abs(F[:3, :3] - T[:3, :3])) < 1e-9
+        d = np.abs(sol.q - qq)
+        d[:, robot.is_revolute] = np.abs(np.angle(np.exp(1j * d[:, robot.is_revolute])))
+        assert sol.families or (len(sol) and np.min(np.max(d, axis=1)) < 1e-6)
+    assert answered >= len(q)  # (half of the 2 x 24 solves: the random quarter and more)
+
+
+@pytest.mark.parametrize(("name", "joint"), [("kuka_iiwa14", "A3"), ("franka_panda", "joint7")])
+def test_a_locked_arm_at_new_values(name: str, joint: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A seven-joint arm held at a new value each pose: the general path's solutions, the held value in place."""
+    robot = load_robot(name)
+    k = robot.joint_names.index(joint)
+    rng = np.random.default_rng(4)
+    q = rng.uniform(robot.lower, robot.upper, (10, robot.n_joints))
+    for qq, T in zip(q, robot.fk(q), strict=True):
+        locked = {joint: float(qq[k])}
+        sol = sweepik.solve(robot, T, locked=locked)
+        _assert_same(sol, _general(monkeypatch, robot, T, locked=locked))
+        assert _answered(robot, T, locked=locked)
+        assert np.all(sol.q[:, k] == qq[k]) and np.min(np.max(np.abs(sol.q - qq), axis=1)) < 1e-6
+
+
+def _bad_poses(robot: sweepik.Robot) -> list[np.ndarray]:
+    T = robot.fk(np.full(robot.n_joints, 0.3))
+    out = []
+    for i, j, v in ((0, 0, np.nan), (1, 3, np.inf), (3, 0, 0.5), (0, 1, 0.01), (2, 3, 1e31)):
+        B = T.copy()
+        B[i, j] = v
+        out.append(B)
+    M = T.copy()
+    M[:3, 0] *= -1.0  # (a reflection: det -1)
+    out.append(M)
+    return out
+
+
+@pytest.mark.parametrize("name", ["puma560", "kuka_kr6_r900"])
+def test_targets_that_are_no_rigid_transform_raise_as_before(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Not finite, a bottom row off, a rotation not orthonormal, a reflection, a translation out of range: the same
+    error, with the same message, as the general path's."""
+    robot = load_robot(name)
+    for B in _bad_poses(robot):
+        with pytest.raises(sweepik.SweepikError) as fast:
+            sweepik.solve(robot, B)
+        with pytest.raises(sweepik.SweepikError) as general:
+            _general(monkeypatch, robot, B)
+        assert type(fast.value) is type(general.value) and str(fast.value) == str(general.value)
+
+
+def test_other_arrays_and_options_take_the_general_path(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A read-only, Fortran-ordered, float32 or nested-list pose gives the same solutions (by the general path where
+    the one call does not take it); a batch shape is refused as before."""
+    robot = load_robot("ur5")
+    T = robot.fk(np.array([0.1, -1.2, 1.3, -0.4, 1.1, 0.3]))
+    want = sweepik.solve(robot, T)
+    frozen = T.copy()
+    frozen.flags.writeable = False
+    for other in (frozen, np.asfortranarray(T), T.tolist()):
+        _assert_same(sweepik.solve(robot, other), want)
+    single = sweepik.solve(robot, T.astype(np.float32))
+    assert len(single) == len(want)
+    with pytest.raises(sweepik.ShapeError, match="solve_many"):
+        sweepik.solve(robot, T[None])
+    _assert_same(sweepik.solve(robot, T, limits=True, strategy="precise"), want)
+
+
+def test_only_a_closed_form_that_checks_its_singular_set_qualifies() -> None:
+    """Sweeps, and arms whose default reduction is not such a closed form, are not taken by the one call."""
+    for name in ("carm", "kinova_jaco2", "fanuc_crx10ia"):
+        assert solving._closed_pose(load_robot(name), None) is None
+    for name in CLOSED:
+        assert isinstance(solving._closed_pose(load_robot(name), None), ClosedPose)
+
+
+def test_settled_solutions_are_the_constructors() -> None:
+    """``Solutions.settled`` sets every field the constructor sets, to the same values."""
+    robot = load_robot("ur5")
+    q = np.random.default_rng(0).uniform(-1, 1, (3, 6))
+    e, ins, mu = np.zeros(3), np.ones(3, dtype=bool), np.ones(3, dtype=np.intp)
+    args = dict(q=q, error=e, error_geodesic=e, within_limits=ins, multiplicity=mu, reason=None, pose=np.eye(4))
+    a = Solutions.settled(**args, robot=robot)  # type: ignore[arg-type]
+    b = Solutions(**args, families=(), robot=robot)  # type: ignore[arg-type]
+    assert set(vars(a)) == set(vars(b)) == {f.name for f in dataclasses.fields(Solutions)}
+    _assert_same(a, b)
