@@ -13,7 +13,7 @@ import pytest
 import sweepik
 from sweepik import load_robot, solving
 from sweepik.engine import chunk, one_pose, search, settle
-from sweepik.engine.closed_pose import ClosedPose
+from sweepik.engine.single_pose import SinglePose
 
 
 def _poses(robot: sweepik.Robot, seed: int) -> np.ndarray:
@@ -46,12 +46,12 @@ def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, poses: np.nd
     with monkeypatch.context() as m:
         m.setattr(solving, "settled", lambda *args: None)
         m.setattr(chunk, "settled", lambda *args: None)
-        m.setattr(solving, "_closed_pose", lambda *args: None)
+        m.setattr(solving, "_single_pose", lambda *args: None)
         return [sweepik.solve(robot, T, **kw) for T in poses]
 
 
 def _counted(monkeypatch: pytest.MonkeyPatch) -> Counter[int]:
-    """Counts of the one call's statuses from now on (``settle_one``, ``settle_closed``, ``ClosedPose.solve``)."""
+    """Counts of the one call's statuses from now on (``settle_one``, ``settle_closed``, ``SinglePose.solve``)."""
     seen: Counter[int] = Counter()
     for name in ("settle_one", "settle_closed"):
         real = getattr(one_pose, name)
@@ -62,14 +62,14 @@ def _counted(monkeypatch: pytest.MonkeyPatch) -> Counter[int]:
             return out
 
         monkeypatch.setattr(one_pose, name, counting)
-    real_closed = ClosedPose.solve
+    real_single = SinglePose.solve
 
-    def closed(*args: Any) -> Any:  # (a closed form's single pose: ``closed_pose``, the same statuses)
-        status, sol = real_closed(*args)
+    def single(*args: Any) -> Any:  # (``single_pose``: the same statuses)
+        status, sol = real_single(*args)
         seen[status] += 1
         return status, sol
 
-    monkeypatch.setattr(ClosedPose, "solve", closed)
+    monkeypatch.setattr(SinglePose, "solve", single)
     return seen
 
 

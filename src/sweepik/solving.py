@@ -16,9 +16,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
-from sweepik.engine.closed_pose import NOT_RIGID, ClosedPose
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.settings import N_SAMPLES
+from sweepik.engine.single_pose import NOT_RIGID, SinglePose
 from sweepik.engine.windings import wound_block, wound_solutions
 from sweepik.errors import LockedJointError, NoReductionError, ShapeError, SweepikError, UnknownOptionError
 from sweepik.model.origin_axis import HeldJoints, hold_joints, lock_runs, per_pose
@@ -441,27 +441,27 @@ def _default_reduction(robot: Robot, held: HeldJoints | None = None) -> Reductio
     return prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1, None, held)[0]
 
 
-def _closed_pose(robot: Robot, locked: object) -> ClosedPose | None:
+def _single_pose(robot: Robot, locked: object) -> SinglePose | None:
     """``robot``'s closed form for single poses with the default options and ``locked`` joints (None: its default
     reduction is no such closed form, or the arm or ``locked`` is refused: the general path then raises, after the
     pose's checks)."""
     if locked is None:
-        return _closed_pose_of(robot, None)
+        return _single_pose_of(robot, None)
     try:
         held = held_joints(robot, locked)
     except (SweepikError, TypeError):  # (an unhashable value: the general path says what is wrong)
         return None
-    return _closed_pose_of(robot, held)
+    return _single_pose_of(robot, held)
 
 
 @lru_cache(maxsize=16)
-def _closed_pose_of(robot: Robot, held: HeldJoints | None) -> ClosedPose | None:
+def _single_pose_of(robot: Robot, held: HeldJoints | None) -> SinglePose | None:
     arm = robot if held is None else held.arm
     try:
         red = _default_reduction(arm, held)
     except SweepikError:
         return None
-    return ClosedPose.of(arm, red, held)
+    return SinglePose.of(arm, red, held)
 
 
 def solve(
@@ -518,7 +518,7 @@ def solve(
     True
     """
     one_call = True
-    if (  # (the default options on an array: a closed form answers in one compiled call, ``closed_pose``)
+    if (  # (the default options on an array: one compiled call answers most poses, ``single_pose``)
         type(pose) is np.ndarray
         and reduction is None
         and windings is False
@@ -526,7 +526,7 @@ def solve(
         and pose.dtype == np.float64
         and pose.shape == (4, 4)
     ):
-        fast = _closed_pose(robot, locked)
+        fast = _single_pose(robot, locked)
         flags = pose.flags
         if fast is not None and flags.c_contiguous and flags.writeable:
             status, sol = fast.solve(pose, limits)

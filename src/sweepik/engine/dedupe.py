@@ -306,7 +306,13 @@ def _near_compiled(pose, w, keep, rev, reach, out, count):  # pragma: no cover
 
 @lazy_njit(boolean(float64[:, ::1], boolean[::1], float64[::1]), cache=True, nogil=True)
 def _any_within(w, rev, reach):  # pragma: no cover
-    """``any_near``: some two rows of ``w`` within ``reach``."""
+    """``any_near``'s kernel."""
+    return any_rows_within(w, rev, reach)
+
+
+@inlined
+def any_rows_within(w, rev, reach):  # pragma: no cover
+    """Some two rows of ``w`` within ``reach`` of each other (``_rows_within``)."""
     for a in range(w.shape[0]):
         for b in range(a + 1, w.shape[0]):
             if _rows_within(w, a, b, rev, reach):

@@ -52,6 +52,10 @@ __all__ = [
     "settle_closed",
     "closed_fixed",
     "every_branch_settled",
+    "searched_settled",
+    "sweep_fixed",
+    "SETTLE_ONE_SIG",
+    "SETTLE_CLOSED_SIG",
 ]
 
 Array = NDArray[np.float64]
@@ -167,25 +171,46 @@ def _final(c, rows, w, inside, keep, eg, ep, mult, only_inside):
     return reachable, q, e_p, e_g, ins, mu
 
 
-@lazy_njit(
+#: ``_settle_one``'s and ``_settle_closed``'s arguments (``single_pose`` takes most of them too).
+SETTLE_ONE_SIG = (
     (int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], float64[::1], float64[:, ::1], float64[::1])
     + (float64[::1], float64[::1], float64[::1], float64[::1], float64[::1], int64[:, ::1], int64, int64)
     + (float64[::1], float64, float64[:, :, ::1], float64[:, ::1], float64[:, ::1], boolean[::1])
     + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-    + (float64[::1], float64[::1], float64, int64[::1], float64[::1], boolean),
-    cache=True,
-    nogil=True,
+    + (float64[::1], float64[::1], float64, int64[::1], float64[::1], boolean)
 )
+SETTLE_CLOSED_SIG = (
+    (int64[::1], float64[:, ::1], float64[:, :, ::1], int64, float64[:, ::1], float64[:, ::1], boolean[::1])
+    + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
+    + (float64[::1], float64[::1], float64, float64[::1], float64[::1], boolean)
+)
+
+
+@lazy_njit(SETTLE_ONE_SIG, cache=True, nogil=True)
 def _settle_one(
     addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
     limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
     c_joints, c_thr, only_inside,
 ):  # pragma: no cover  # fmt: skip
-    """``settle_one``'s kernel: pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``),
-    certified and settled; ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped
-    to them (``chunk._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of
-    the continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``only_inside``:
-    the solutions within the limits only (``_final``)."""
+    """``settle_one``'s kernel (``searched_settled``)."""
+    return searched_settled(
+        addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
+        limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
+        c_joints, c_thr, only_inside,
+    )  # fmt: skip
+
+
+@internal
+def searched_settled(
+    addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
+    limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
+    c_joints, c_thr, only_inside,
+):  # pragma: no cover  # fmt: skip
+    """Pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``), certified and settled;
+    ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped to them
+    (``chunk._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of the
+    continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``only_inside``: the
+    solutions within the limits only (``_final``). Compiled callers only (``settle_one``, ``single_pose``)."""
     # (np.empty and explicit loops: np.zeros, slice copies and the like each add to the first compilation)
     n = rev.shape[0]
     out_t = np.empty((1, max_cand))
@@ -237,13 +262,7 @@ def _settle_one(
     return status, c, reachable, qf, e_p, e_g, ins, mu
 
 
-@lazy_njit(
-    (int64[::1], float64[:, ::1], float64[:, :, ::1], int64, float64[:, ::1], float64[:, ::1], boolean[::1])
-    + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-    + (float64[::1], float64[::1], float64, float64[::1], float64[::1], boolean),
-    cache=True,
-    nogil=True,
-)
+@lazy_njit(SETTLE_CLOSED_SIG, cache=True, nogil=True)
 def _settle_closed(
     addr, params, world, nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
     s_thr, meet, only_inside,
@@ -264,7 +283,7 @@ def every_branch_settled(
     certified and settled; ``MEET`` where a branch is dropped as another's duplicate or two kept ones are within
     ``meet`` (per joint, revolute ones modulo 2 pi: ``dedupe.near_pairs``); ``SINGULAR`` where the singular kernel
     at ``addr[_A_SING]`` (unless 0; thresholds ``s_thr``) flags it. Compiled callers only (``settle_closed``,
-    ``closed_pose``)."""
+    ``single_pose``)."""
     q = np.empty((nb, rev.shape[0]))
     eg = np.empty(nb)
     ep = np.empty(nb)
@@ -342,7 +361,7 @@ def _tail(robot: Any, thresholds: tuple[float, ...], reach: Array) -> tuple[Any,
     return (H, P, crev, R_end, weight, *settling)
 
 
-def _fixed(
+def sweep_fixed(
     robot: Any, red: Any, n_samples: int, thresholds: tuple[float, ...], reach: Array, seed_tol: float
 ) -> _Fixed | None:
     """The fixed arguments of ``_settle_one`` for ``red`` (None: it has no one-pass search for ``n_samples``, or
@@ -401,7 +420,7 @@ def settle_one(
     reach (relative to ``hi - lo``) within which a multiple root outside theta*'s limits is clipped to them;
     ``seed_tol``: the pose error within which a candidate is checked for a continuum (``continuum_joints``);
     ``only_inside``: the solutions within the joint limits only (the solver's ``limits``)."""
-    fixed = _fixed(robot, red, n_samples, thresholds, reach, seed_tol)
+    fixed = sweep_fixed(robot, red, n_samples, thresholds, reach, seed_tol)
     if fixed is None:
         return None
     lo, hi = writable(lo), writable(hi)

@@ -1,6 +1,6 @@
-"""A closed form's single pose in one compiled call (``engine.closed_pose``): the general path's answer bit for bit,
-on every bundled closed-form arm and on arms written otherwise (base and tool frames, millimetres, axis signs,
-offsets); targets that are not rigid transforms raise what they raised; other arrays take the general path."""
+"""A single pose in one compiled call (``engine.single_pose``): the general path's answer bit for bit, on the bundled
+closed forms and sweeps and on arms written otherwise (base and tool frames, millimetres, axis signs, offsets);
+targets that are not rigid transforms raise what they raised; other arrays take the general path."""
 
 from __future__ import annotations
 
@@ -14,10 +14,11 @@ from rewrites import rewrite
 import sweepik
 from sweepik import load_robot, solving
 from sweepik.engine import chunk
-from sweepik.engine.closed_pose import ClosedPose
+from sweepik.engine.single_pose import SinglePose
 from sweepik.results import Solutions
 
 CLOSED = ["puma560", "puma560_std", "ur5", "abb_irb140", "kuka_kr6_r900", "stanford", "standardbots_spark"]
+SWEPT = ["kinova_jaco2", "fanuc_crx10ia", "xarm6", "yaskawa_hc10"]
 
 
 def _configurations(robot: sweepik.Robot, rng: np.random.Generator, n: int = 24) -> np.ndarray:
@@ -31,7 +32,7 @@ def _configurations(robot: sweepik.Robot, rng: np.random.Generator, n: int = 24)
 def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, T: np.ndarray, **kw: Any) -> Solutions:
     """``solve`` without the one call (neither this module's nor ``chunk.settled``)."""
     with monkeypatch.context() as m:
-        m.setattr(solving, "_closed_pose", lambda *args: None)
+        m.setattr(solving, "_single_pose", lambda *args: None)
         m.setattr(solving, "settled", lambda *args: None)
         m.setattr(chunk, "settled", lambda *args: None)
         return sweepik.solve(robot, T, **kw)
@@ -50,11 +51,11 @@ def _assert_same(a: Solutions, b: Solutions) -> None:
 
 
 def _answered(robot: sweepik.Robot, T: np.ndarray, limits: bool = True, locked: Any = None) -> bool:
-    fast = solving._closed_pose(robot, locked)
+    fast = solving._single_pose(robot, locked)
     return fast is not None and fast.solve(np.ascontiguousarray(T), limits)[1] is not None
 
 
-@pytest.mark.parametrize("name", CLOSED)
+@pytest.mark.parametrize("name", CLOSED + SWEPT)
 @pytest.mark.parametrize("seed", [0, 1])
 def test_the_one_call_is_the_general_path_on_arms_written_otherwise(
     name: str, seed: int, monkeypatch: pytest.MonkeyPatch
@@ -66,7 +67,7 @@ def test_the_one_call_is_the_general_path_on_arms_written_otherwise(
     rng = np.random.default_rng(seed)
     if seed:
         robot = rewrite(robot, rng).robot
-    q = _configurations(robot, rng)
+    q = _configurations(robot, rng, 24 if name in CLOSED else 8)
     answered = 0
     for qq, T in zip(q, robot.fk(q), strict=True):
         for limits in (True, False):
@@ -142,12 +143,13 @@ def test_other_arrays_and_options_take_the_general_path(monkeypatch: pytest.Monk
     _assert_same(sweepik.solve(robot, T, limits=True, strategy="precise"), want)
 
 
-def test_only_a_closed_form_that_checks_its_singular_set_qualifies() -> None:
-    """Sweeps, and arms whose default reduction is not such a closed form, are not taken by the one call."""
-    for name in ("carm", "kinova_jaco2", "fanuc_crx10ia"):
-        assert solving._closed_pose(load_robot(name), None) is None
-    for name in CLOSED:
-        assert isinstance(solving._closed_pose(load_robot(name), None), ClosedPose)
+def test_which_reductions_qualify() -> None:
+    """Closed forms and sweeps of a revolute theta* whose checks are compiled qualify; the C-Arm (a prismatic theta*,
+    its own reduction) and arms solved with a companion (the Doosan M0609, the I2RT YAM) do not."""
+    for name in ("carm", "doosan_m0609", "i2rt_yam"):
+        assert solving._single_pose(load_robot(name), None) is None
+    for name in CLOSED + SWEPT:
+        assert isinstance(solving._single_pose(load_robot(name), None), SinglePose)
 
 
 def test_settled_solutions_are_the_constructors() -> None:

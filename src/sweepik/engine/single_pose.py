@@ -1,0 +1,222 @@
+"""A single pose, from the target to its solutions, with the least Python around one compiled call.
+
+``solve`` on one pose spent ~16 us of Python around the compiled work of a closed form (~5 us: every branch, its
+forward-kinematics check, the settling), and ~30 us around a sweep's ~70: the pose's checks in scalar arithmetic, the
+parameter rows (a second compiled call), theta*'s range, the settling's wrappers and checks, ``Solutions``'
+dataclass init. Here one kernel checks that the target is a rigid transform (``validate.rigid_values``), builds its
+parameter row (``geometric.pose_rows``) and runs the one-call path's compiled steps (``one_pose``'s
+``every_branch_settled`` for a closed form, ``searched_settled`` and the close-pair check for a sweep), so the answer
+is the one-call path's to the last bit. Whatever that path would not settle (a singular pose, branches that meet,
+families, a polish due, a target that fails the scalar check) it hands back with its status, and ``solve`` takes the
+general way.
+
+A reduction qualifies (``SinglePose.of``) when it is solved alone (no companion), has no blind spots or special
+solutions of its own and its parameter rows come from ``geometric.pose_rows`` (``Reduction.pose_row_args``); a closed
+form when it has an all-branch configuration kernel and checks its singular set in compiled code
+(``Reduction.singular_kernel``); a sweep when theta* is revolute (its range the circle), it has a one-pass search and
+checks its continua in compiled code, and has no fallback.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import boolean, float64
+from numpy.typing import NDArray
+
+from sweepik._jit import inlined, writable
+from sweepik.engine import search
+from sweepik.engine.dedupe import any_rows_within
+from sweepik.engine.one_pose import (
+    _A_SING,
+    MEET,
+    OK,
+    SETTLE_CLOSED_SIG,
+    SETTLE_ONE_SIG,
+    closed_fixed,
+    every_branch_settled,
+    searched_settled,
+    sweep_fixed,
+)
+from sweepik.engine.settings import CLIP_REACH_REL, MAX_ISOLATED_SOLUTIONS, MEET_REL, N_SAMPLES, SEED_TOL_REL
+from sweepik.engine.settle import per_joint, settle_bounds, snap_reach
+from sweepik.model.origin_axis import HeldJoints
+from sweepik.model.robot import Robot
+from sweepik.model.validate import check_poses, rigid_values
+from sweepik.reductions import GeometricReduction, Reduction
+from sweepik.reductions.geometric import N_PARAMS, pose_rows
+from sweepik.reductions.kernels import defining_class, lazy_njit
+from sweepik.results import Solutions, no_solution_reason
+
+__all__ = ["SinglePose", "NOT_RIGID"]
+
+Array = NDArray[np.float64]
+
+#: The kernels' status for a target that fails ``validate.rigid_values`` (``check_poses`` then says why, or accepts
+#: it: a sum that overflowed).
+NOT_RIGID = -1
+
+_rigid_values = inlined(rigid_values)
+
+
+@inlined
+def _rigid(T):  # pragma: no cover
+    """``validate.rigid_values`` of ``T (4, 4)``."""
+    return _rigid_values(
+        T[0, 0], T[0, 1], T[0, 2], T[0, 3], T[1, 0], T[1, 1], T[1, 2], T[1, 3],
+        T[2, 0], T[2, 1], T[2, 2], T[2, 3], T[3, 0], T[3, 1], T[3, 2], T[3, 3],
+    )  # fmt: skip
+
+
+@inlined
+def _not_rigid(n):  # pragma: no cover
+    """The kernels' answer for a target that is not a rigid transform: nothing settled."""
+    none = np.empty(0)
+    return NOT_RIGID, 0, 0, np.empty((0, n)), none, none, np.empty(0, np.bool_), np.empty(0, np.int64)
+
+
+@inlined
+def _row(chain, base, tool, reverse, r_end, w_tool, row):  # pragma: no cover
+    """The parameter row ``(1, N_PARAMS)`` of the chain pose ``chain (4, 4)`` (``pose_rows``)."""
+    params = np.empty((1, N_PARAMS))
+    pose_rows(chain.reshape((1, 4, 4)), base, tool, reverse, r_end, w_tool, row, params)
+    return params
+
+
+#: ``pose_rows``' arguments after the poses and before the output.
+_ROW_SIG = (float64[:, ::1], float64[:, ::1], boolean, float64[:, ::1], float64[::1], float64[::1])
+_TARGET_SIG = (float64[:, ::1], float64[:, ::1])
+
+
+@lazy_njit(_TARGET_SIG + _ROW_SIG + SETTLE_CLOSED_SIG[:1] + SETTLE_CLOSED_SIG[3:], cache=True, nogil=True)
+def _closed_pose(
+    world, chain, base, tool, reverse, r_end, w_tool, row, addr, nb, H, P, rev, R_end, weight, thr, lrev, lower,
+    upper, ltol, beyond, reach, tol, scale, s_thr, meet, only_inside,
+):  # pragma: no cover  # fmt: skip
+    """A closed form's target ``world (4, 4)`` (its chain pose ``chain``) checked, its row built (``pose_rows``'
+    arguments ``base`` .. ``row``) and every branch settled (``every_branch_settled``'s arguments after them):
+    ``(status, certified, reachable, q, error, error_geodesic, within_limits, multiplicity)``."""
+    if not _rigid(world):
+        return _not_rigid(rev.shape[0])
+    params = _row(chain, base, tool, reverse, r_end, w_tool, row)
+    st, c, reachable, q, ep, eg, ins, mu, _ = every_branch_settled(
+        addr, params, world.reshape((1, 4, 4)), nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond,
+        reach, tol, scale, s_thr, meet, only_inside,
+    )  # fmt: skip
+    return st, c, reachable, q, ep, eg, ins, mu
+
+
+@lazy_njit(
+    _TARGET_SIG + _ROW_SIG + SETTLE_ONE_SIG[:6] + SETTLE_ONE_SIG[11:18] + SETTLE_ONE_SIG[19:35] + (float64[::1],)
+    + SETTLE_ONE_SIG[35:],
+    cache=True,
+    nogil=True,
+)  # fmt: skip
+def _swept_pose(
+    world, chain, base, tool, reverse, r_end, w_tool, row, addr, plan, branches, m_branches, steps, noise, s, ends,
+    twins, max_cand, max_fam, limits, clip, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach,
+    tol, scale, c_joints, c_thr, meet, only_inside,
+):  # pragma: no cover  # fmt: skip
+    """A sweep's target (as ``_closed_pose``) searched over the circle, certified and settled (``searched_settled``'s
+    arguments); ``MEET`` where two of its solutions lie within ``meet`` (``dedupe.any_near``: the general path merges
+    them)."""
+    if not _rigid(world):
+        return _not_rigid(rev.shape[0])
+    params = _row(chain, base, tool, reverse, r_end, w_tool, row)
+    lo, hi = np.empty(1), np.empty(1)
+    lo[0], hi[0] = -math.pi, math.pi
+    st, c, reachable, q, ep, eg, ins, mu = searched_settled(
+        addr, plan, branches, m_branches, steps, noise, params, lo, hi, lo, hi, s, ends, twins, max_cand, max_fam,
+        limits, clip, world.reshape((1, 4, 4)), H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach,
+        tol, scale, c_joints, c_thr, only_inside,
+    )  # fmt: skip
+    if st == OK and q.shape[0] > 1 and any_rows_within(q, lrev, meet):
+        st = MEET
+    return st, c, reachable, q, ep, eg, ins, mu
+
+
+class SinglePose:
+    """One arm's reduction, ready for single poses: its fixed arguments worked out once (``of``), then
+    ``solve(pose, limits)`` per pose."""
+
+    __slots__ = ("robot", "held", "_kernel", "_head", "_tail", "_sweeps", "_base", "_tool")
+
+    def __init__(
+        self, arm: Robot, held: HeldJoints | None, kernel: Any, head: tuple[Any, ...], tail: tuple[Any, ...]
+    ) -> None:
+        self.robot = arm if held is None else held.robot  # (the solutions' arm)
+        self.held = held
+        self._kernel = kernel
+        self._head = head  # (pose_rows' arguments)
+        self._tail = tail  # (the settling's, but the rows, targets and buffers; then the meeting reach)
+        self._sweeps = kernel is _swept_pose
+        # (``chunk.chain_poses``' transforms, None for the identity)
+        self._base = None if arm.base_is_identity else arm.T_base_world
+        self._tool = None if arm.tool_is_identity else arm.T_tool_flange
+
+    @classmethod
+    def of(cls, robot: Robot, red: Reduction, held: HeldJoints | None = None) -> SinglePose | None:
+        """``robot`` (with ``held``: the held arm, ``held.arm``) solved by ``red`` this way, or None where ``red``
+        does not qualify (module docstring)."""
+        rc = type(red)
+        if getattr(red, "companion", None) is not None:
+            return None
+        for hook in ("special_solutions", "blind_spot"):
+            if defining_class(rc, hook) is not Reduction:
+                return None
+        head = red.pose_row_args()
+        if head is None:
+            return None
+        base, tool, reverse, r_end, w_tool, row = head
+        head = (writable(base), writable(tool), bool(reverse), writable(r_end), writable(w_tool), writable(row))
+        bounds, reach, meet = settle_bounds(robot), snap_reach(robot), writable(per_joint(robot, MEET_REL))
+        if red.closed_form:
+            closed = closed_fixed(robot, red, bounds, reach)
+            if closed is None or closed[0][_A_SING] == 0:
+                return None  # (its singular set checked in Python: the general path)
+            addr, nb, _, _, tail, s_thr = closed
+            return cls(robot, held, _closed_pose, head, (addr, nb, *tail, s_thr, meet))
+        return cls._swept(robot, red, held, head, bounds, reach, meet)
+
+    @classmethod
+    def _swept(
+        cls, robot: Robot, red: Reduction, held: HeldJoints | None, head: tuple[Any, ...], bounds: Any, reach: Any,
+        meet: Array,
+    ) -> SinglePose | None:  # fmt: skip
+        """``of`` for a sweep."""
+        if not red.periodic or red.fallback is not None:
+            return None
+        if defining_class(type(red), "continuum_poses") is not Reduction:
+            return None
+        fixed = sweep_fixed(robot, red, N_SAMPLES, bounds, reach, SEED_TOL_REL * robot.length_scale)
+        if fixed is None or fixed.hint_range not in (None, GeometricReduction._range):  # (the circle either way)
+            return None
+        tail = (*fixed.middle, fixed.limits, float(CLIP_REACH_REL * 2.0 * math.pi), *fixed.tail, meet)
+        return cls(robot, held, _swept_pose, head + fixed.head, tail)
+
+    def solve(self, pose: Array, limits: bool) -> tuple[int, Solutions | None]:
+        """``(status, solutions)``: the solutions of ``pose`` (a C-contiguous, writable float64 ``(4, 4)``) as
+        ``solve`` gives them (status ``OK``), or None where the general path must answer, with the status that says
+        why (``one_pose``'s, or ``NOT_RIGID``; ``OK`` with more than ``MAX_ISOLATED_SOLUTIONS`` certified). Raises
+        ``check_poses``' errors for a target that is not a rigid transform."""
+        chain = pose
+        if self._base is not None or self._tool is not None:  # (as ``chunk.chain_poses``: the same bits)
+            with np.errstate(all="ignore"):  # (a target not finite: the kernel says so, ``check_poses`` raises)
+                chain = pose[None] if self._base is None else self._base @ pose[None]
+                chain = (chain if self._tool is None else chain @ self._tool)[0]
+        if self._sweeps:  # (the buffers read here: a test may cut them)
+            head, tail = self._head, self._tail
+            out = self._kernel(pose, chain, *head, *tail[:3], search.MAX_CAND, search.MAX_FAM, *tail[3:], limits)
+        else:
+            out = self._kernel(pose, chain, *self._head, *self._tail, limits)
+        status, c, reachable, q, ep, eg, ins, mu = out
+        if status != OK or c > MAX_ISOLATED_SOLUTIONS:
+            if status == NOT_RIGID:
+                check_poses(pose)
+            return status, None
+        reason = None if q.shape[0] else no_solution_reason(reachable)
+        if self.held is not None:
+            q = self.held.expand(q)
+        return status, Solutions.settled(q, ep, eg, ins, mu, reason, pose.copy(), self.robot)
