@@ -7,9 +7,9 @@ Every six-joint arm of ``ssik.list_arms()`` is rebuilt in sweepik (``tests/catal
 artifact's limits) and classed by the plan sweepik chooses (``sweepik.analyze``): a closed form with a spherical
 wrist, the UR type (three parallel axes), another closed form, a sweep, the general method. Per arm, ``--n`` fresh
 configurations uniform within the limits; each pose is solved once by ``sweepik.solve`` (the defaults: limits on),
-by the artifact's ``solve`` (its defaults: limits on) and by EAIK where it knows a decomposition; the first five
-poses of each solver are not timed (kernels load). Prints one line per arm, then the class medians. Benchmarks are
-not tests: timings on a shared machine vary by +-10-25 %.
+by the artifact's ``solve`` (limits on, no 2 pi windings: as sweepik's defaults) and by EAIK and IK-Geo where they
+apply (closed forms); the first five poses of each solver are not timed (kernels load). Prints one line per arm,
+then the class medians. Benchmarks are not tests: timings on a shared machine vary by +-10-25 %.
 """
 
 from __future__ import annotations
@@ -31,6 +31,8 @@ import sweepik  # noqa: E402
 from sweepik.experiments.peers import peers_for  # noqa: E402
 
 WARM = 5
+#: The closed-form solvers timed beside them where they apply (``peers.peers_for``).
+PEERS = ("EAIK", "IK-Geo")
 
 
 def arm_class(robot: sweepik.Robot) -> str:
@@ -81,19 +83,21 @@ def main() -> None:
         lo, hi = np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi)
         poses = robot.fk(rng.uniform(lo, hi, (args.n + WARM, 6)))
         ours = median_us(lambda T: sweepik.solve(robot, T), poses)  # noqa: B023
-        theirs = median_us(lambda T: m.solve(T), poses)  # noqa: B023
-        eaik = peers_for(robot).get("EAIK")
-        e = None if eaik is None else median_us(eaik[0], poses)
-        by_class.setdefault(kind, []).append((ours, theirs, e))
-        extra = "" if e is None else f", EAIK {e:.1f}"
+        theirs = median_us(lambda T: m.solve(T, enumerate_windings=False), poses)  # noqa: B023
+        peers = peers_for(robot)
+        others = {p: median_us(peers[p][0], poses) for p in PEERS if p in peers}
+        by_class.setdefault(kind, []).append((ours, theirs, others))
+        extra = "".join(f", {p} {t:.1f}" for p, t in others.items())
         print(f"{name:28s} {kind:18s} sweepik {ours:8.1f} us, ssik {theirs:8.1f} us (x{theirs / ours:.2f}){extra}")
         sys.stdout.flush()
     print()
     for kind, rows in sorted(by_class.items()):
         ours = statistics.median(r[0] for r in rows)
         theirs = statistics.median(r[1] for r in rows)
-        es = [r[2] for r in rows if r[2] is not None]
-        extra = f", EAIK {statistics.median(es):.1f} us ({len(es)} arms)" if es else ""
+        extra = ""
+        for p in PEERS:
+            ts = [r[2][p] for r in rows if p in r[2]]
+            extra += f", {p} {statistics.median(ts):.1f} us ({len(ts)} arms)" if ts else ""
         print(f"{kind} ({len(rows)} arms): sweepik {ours:.1f} us, ssik {theirs:.1f} us: 1/{theirs / ours:.2f}{extra}")
 
 
