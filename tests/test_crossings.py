@@ -10,7 +10,7 @@ import zlib
 import numpy as np
 import pytest
 from scipy.optimize import brentq
-from singular import recovered
+from singular import families_certified, recovered
 
 import sweepik
 from sweepik.model.pose import pose_error_geodesic
@@ -113,3 +113,70 @@ def test_vertex_least_reaches_a_vertex_and_settles_a_rounded_one() -> None:
     a, m, b = np.array([0.25]), np.array([0.3]), np.array([0.35])
     x, e = vertex_least(rounded, a, m, b, rounded(a), rounded(m), rounded(b))
     assert e[0] > 0.0 and abs(x[0] - 0.3137) < 1e-3
+
+
+def test_the_compiled_second_singular_value_is_lapacks() -> None:
+    """``continuation.second_singular`` (Jacobi rotations, warm along a family's members) against NumPy's SVD of the
+    same scaled Jacobians (``scaled_singular``): on KR 6 configurations at random and along its wrist circle (a
+    family: the least singular value zero), 1e-10 relative to the largest."""
+    from sweepik.engine.continuation import scaled_singular, second_singular
+
+    robot = sweepik.load_robot("kuka_kr6_r900")
+    rng = np.random.default_rng(2)
+    q = rng.uniform(robot.lower, robot.upper, (40, 6))
+    circle = np.repeat(q[:1], 30, axis=0)
+    circle[:, 4] = 0.0
+    circle[:, 3] += np.linspace(0.0, 1.0, 30)
+    circle[:, 5] -= np.linspace(0.0, 1.0, 30)
+    for Q, cold in ((q, np.ones(len(q), dtype=bool)), (circle, np.arange(len(circle)) == 0)):
+        s, _ = scaled_singular(robot, Q)
+        np.testing.assert_allclose(second_singular(robot, Q, cold), s[:, -2] / s[:, 0], rtol=0, atol=1e-10)
+
+
+def test_the_batch_grids_are_each_familys_own() -> None:
+    """``crossings.crossing_grids`` over the families of many poses at once (members of one reduction's families in
+    one call, the singular values in one call) gives each family the values of its own probe (``_second_singular``
+    on its grid), bit for bit, or None where they hold no dip to search: C-Arm grid poses with families (swept
+    ones) and KR 6 poses whose wrist centre lies on axis 1 (traced continua as well)."""
+    from sweepik.engine.crossings import _dips, _grid, _second_singular, crossing_grids
+    from sweepik.experiments.bench import grid_configurations
+
+    cases = []
+    carm = sweepik.load_robot("carm")
+    q = grid_configurations(include_singular=False)[::7][:600]
+    cases.append((carm, [f for s in sweepik.solve_many(carm, carm.fk(q)) for f in s.families]))
+    kr6 = sweepik.load_robot("kuka_kr6_r900")
+    rng = np.random.default_rng(11)
+    poses = [kr6.fk(_shoulder_singular(kr6, rng)) for _ in range(3)]
+    cases.append((kr6, [f for T in poses for f in sweepik.solve(kr6, T).families]))
+    for robot, fams in cases:
+        assert len(fams) >= 3
+        grids = crossing_grids(robot, fams)
+        for f, g in zip(fams, grids, strict=True):
+            if not f.interval[1] > f.interval[0]:
+                assert g is None
+                continue
+            own = _second_singular(robot, f, _grid(f))
+            if g is None:  # (no dip to search: left out)
+                assert not _dips(own[None]).any()
+            else:
+                np.testing.assert_array_equal(g, own)
+
+
+def test_continua_crossing_where_a_member_is_at_pi_are_found() -> None:
+    """The Stanford arm at q2 = -90 deg, d3 = 0, q5 = 0: its two continua along q2 (members with q2 at +-pi) each
+    cross a continuum along q4. The direction across a family at a crossing needs the family's tangent, taken
+    between members either side of it: modulo 2 pi, not across a turn (a wrapped joint at +-pi stepped by 2 pi sent
+    the seeds along the wrong joint, and one crossing continuum was lost). Both are found, every member of every
+    family solves the pose, and the two along q4 are distinct."""
+    from sweepik.engine.families import off_families
+
+    robot = sweepik.load_robot("stanford")
+    q = np.array([-0.47646912326117485, -np.pi / 2, 0.0, 2.036223930072506, 0.0, 0.29396685086745444])
+    T = robot.fk(q)
+    sol = sweepik.solve(robot, T, limits=False)
+    families_certified(robot, sol, T)
+    assert sum(f.free_joint == 1 for f in sol.families) == 2
+    along = [f for f in sol.families if f.free_joint == 3]
+    assert len(along) == 2
+    assert off_families(robot, [(along[1].sample(15), (along[0],))])[0].sum() >= 13

@@ -136,3 +136,26 @@ def test_family_cuts_are_where_bisection_puts_them(name: str, monkeypatch: pytes
             on = ok(mid)
             ra, rb = np.where(on, mid, ra), np.where(on, rb, mid)
         assert np.all(np.abs(got_a - ra) <= 2.0 * target), np.max(np.abs(got_a - ra) / target)
+
+
+def test_members_of_many_families_at_once_are_each_familys() -> None:
+    """``families.certified_members_of`` (the families of one reduction in one call: the crossing search's grids)
+    gives each family's members as ``certified_members`` does, bit for bit, nudges included: C-Arm families at
+    theta2 = 90 deg (whose members where the wrist crosses joint 2's axis are nudged off the blind point)."""
+    from sweepik.engine.families import certified_members, certified_members_of
+
+    rng = np.random.default_rng(8)
+    q = np.tile(np.array([1000.0, np.pi / 2, 0.3, -0.5, 0.0, 0.2]), (6, 1))
+    q[:, 0] += rng.uniform(-300.0, 300.0, 6)
+    q[:, 2:4] += rng.uniform(-0.3, 0.3, (6, 2))
+    fams = [f for s in sweepik.solve_many(CARM, CARM.fk(q)) for f in s.families]
+    assert len(fams) >= 6 and len({id(f.reduction) for f in fams}) == 1
+    theta = np.array([np.linspace(*f.interval, 33) for f in fams])
+    theta[:, 16] = [f.chain_pose[2, 3] for f in fams]  # (d1 = Pz: the wrist on joint 2's axis, if inside)
+    theta = np.clip(theta, *np.array([f.interval for f in fams]).T[:, :, None])
+    lo, hi = np.array([f.interval for f in fams]).T
+    many = certified_members_of(
+        fams[0].reduction, np.array([f.chain_pose for f in fams]), np.array([f.branch for f in fams]), theta, lo, hi
+    )
+    for f, th, m in zip(fams, theta, many, strict=True):
+        np.testing.assert_array_equal(m, certified_members(f.reduction, f.chain_pose, f.branch, th, *f.interval))

@@ -30,6 +30,23 @@ def _step():  # type: ignore[no-untyped-def]
     return step, singular_values
 
 
+def _values():  # type: ignore[no-untyped-def]
+    import numba
+
+    from sweepik.engine.jacobi import singular_values
+
+    @numba.njit(cache=False)
+    def values(As, warm):  # type: ignore[no-untyped-def]
+        K, m, n = As.shape
+        B, V = np.empty((m, n)), np.empty((n, n))
+        out = np.empty((K, min(m, n)))
+        for k in range(K):
+            singular_values(As[k], B, V, out[k], warm and k > 0)
+        return out
+
+    return values
+
+
 def _matrices(rng: np.random.Generator, count: int) -> list[np.ndarray]:
     out = []
     for k in range(count):
@@ -83,3 +100,25 @@ def test_zero_and_nan_matrices() -> None:
     A = np.eye(6)
     A[2, 2] = np.nan
     assert not np.all(np.isfinite(step(A, np.ones(6), 1e-10)))  # (NaN in, not a silent finite answer)
+
+
+def test_singular_values_decreasing_as_numpy_cold_and_warm() -> None:
+    """``jacobi.singular_values``: NumPy's, decreasing, over 14 decades and for rank-deficient matrices; started from
+    the last matrix's rotations (``warm``) along a path of neighbouring matrices, the same values; NaN in, NaN out."""
+    values = _values()
+    rng = np.random.default_rng(5)
+    for A in _matrices(rng, 200):
+        ref = np.linalg.svd(A, compute_uv=False)
+        got = values(A[None], False)[0]
+        assert np.all(np.diff(got) <= 0.0)
+        assert np.allclose(got, ref, rtol=1e-12, atol=1e-15 * ref[0])
+    A0, D = rng.normal(size=(6, 6)), rng.normal(size=(6, 6))
+    path = np.array([A0 + t * D for t in np.linspace(0.0, 1e-2, 20)])
+    path[:, :, 0] = path[:, :, 1] + path[:, :, 2]  # (rank 5: a continuum's Jacobian)
+    cold, warm = values(path, False), values(path, True)
+    ref = np.linalg.svd(path, compute_uv=False)
+    assert np.allclose(warm, cold, rtol=1e-12, atol=1e-14 * ref[:, :1])
+    assert np.allclose(warm, ref, rtol=1e-12, atol=1e-14 * ref[:, :1])
+    bad = np.eye(6)
+    bad[3, 3] = np.nan
+    assert np.all(np.isnan(values(bad[None], False)))

@@ -177,18 +177,25 @@ class Family:
         C-Arm's wrist crossing joint 2's axis), the member ~1e-9 of the interval away is given, the solution there
         being its limit."""
         th = np.asarray(theta, dtype=np.float64)
+        flat = self.theta_inside(th.reshape(-1))
+        red = self.reduction
+        q = red.robot.wrap(self.members(red, self.chain_pose, self.branch, flat, *self.interval))
+        if self.held is not None:
+            q = self.held.expand(q)
+        return q.reshape(*th.shape, -1)
+
+    def theta_inside(self, theta: ArrayLike) -> Array:
+        """The theta* values inside ``interval`` at which :meth:`at` takes its members for ``theta``: a revolute
+        joint's angle by whole turns onto the interval, then clipped to it (a value ~1e-9 of the interval outside it
+        is its end); SweepikError for a value outside."""
+        th = np.asarray(theta, dtype=np.float64)
         lo, hi = self.interval
         tol = _FAMILY_EDGE_TOL * max(hi - lo, 1.0)
         if self.reduction.periodic:  # an angle by whole turns onto the interval (a joint's range can pass +-pi)
             th = lo - tol + np.mod(th - (lo - tol), 2.0 * np.pi)
         if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
             raise SweepikError(f"theta* = {th.tolist()} is outside the family's interval [{lo:.12g}, {hi:.12g}]")
-        flat = np.clip(th.reshape(-1), lo, hi)
-        red = self.reduction
-        q = red.robot.wrap(self.members(red, self.chain_pose, self.branch, flat, lo, hi))
-        if self.held is not None:
-            q = self.held.expand(q)
-        return q.reshape(*th.shape, -1)
+        return np.clip(th, lo, hi)
 
     def sample(self, count: int = 50) -> Array:
         """``(count, n)`` member configurations evenly spaced over the interval (``count`` an integer >= 1)."""

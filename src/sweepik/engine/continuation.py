@@ -25,6 +25,7 @@ from sweepik.engine import parallel
 from sweepik.engine.candidates import Spans
 from sweepik.engine.certify import chain_args, polish_row, polish_work
 from sweepik.engine.families import certified_members, families_of, off_families
+from sweepik.engine.jacobi import singular_values
 from sweepik.engine.polish import polished, pose_and_jacobian
 from sweepik.engine.search import PARALLEL_MIN
 from sweepik.engine.settings import (
@@ -57,11 +58,36 @@ IntArray = NDArray[np.intp]
 def scaled_singular(robot: Robot, q: Array) -> tuple[Array, Array]:
     """Singular values ``(K, 6)`` (decreasing) and right singular vectors ``(K, n, n)`` (rows) of the Jacobian at
     configurations ``q (K, n)``, lengths over the arm's length scale (a slide's column: per length scale)."""
+    _, s, vt = np.linalg.svd(_scaled_jacobians(robot, q))
+    return s, vt
+
+
+def second_singular(robot: Robot, q: Array, cold: NDArray[np.bool_]) -> Array:
+    """``(K,)``: the second least singular value over the largest of ``scaled_singular``'s Jacobians at ``q (K, n)``,
+    compiled (``jacobi.singular_values``: ~1.5 us a configuration where LAPACK's ``gesdd`` through NumPy took ~15;
+    the crossing search asks for tens of thousands on a batch with families). Each row's rotations start from the
+    last row's (neighbouring members of a family: one or two sweeps), but where ``cold``."""
+    out = np.empty(q.shape[0])
+    _second_ratios(_scaled_jacobians(robot, q), np.ascontiguousarray(cold, dtype=np.bool_), out)
+    return out
+
+
+def _scaled_jacobians(robot: Robot, q: Array) -> Array:
     J = pose_and_jacobian(robot, q)[1]
     J[:, :3, :] /= robot.length_scale
     J[:, :, ~robot.is_revolute] *= robot.length_scale
-    _, s, vt = np.linalg.svd(J)
-    return s, vt
+    return J
+
+
+@lazy_njit((float64[:, :, ::1], types.boolean[::1], float64[::1]), cache=True, nogil=True)
+def _second_ratios(J, cold, out):  # pragma: no cover
+    """``second_singular``'s kernel."""
+    K, m, n = J.shape
+    r = min(m, n)
+    B, V, s = np.empty((m, n)), np.empty((n, n)), np.empty(r)
+    for k in range(K):  # (warm from the last row, unless cold or its values were NaN)
+        singular_values(J[k], B, V, s, k > 0 and not cold[k] and out[k - 1] == out[k - 1])
+        out[k] = s[r - 2] / s[0]
 
 
 def _singular_along(robot: Robot, q: Array, joint: int) -> NDArray[np.bool_]:

@@ -20,7 +20,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.engine.continuation import scaled_singular
+from sweepik.engine.continuation import scaled_singular, second_singular
+from sweepik.engine.families import certified_members, certified_members_of
 from sweepik.engine.settings import (
     CROSS_RANK,
     CROSS_SAMPLES,
@@ -30,6 +31,7 @@ from sweepik.engine.settings import (
     VERTEX_REL,
     VERTEX_WIDTH,
 )
+from sweepik.model.pose import wrap_angle
 from sweepik.model.robot import Robot
 from sweepik.results import Family
 
@@ -40,13 +42,51 @@ IntArray = NDArray[np.intp]
 def _second_singular(robot: Robot, family: Family, theta: Array) -> Array:
     """Second smallest singular value over the largest of the (scaled) Jacobian at the family's members ``theta``
     (infinite where a member is not finite)."""
-    q = _probe(family, theta)
-    out = np.full(theta.shape, np.inf)
+    return _singular_of(robot, [_probe(family, theta)])[0]
+
+
+def _singular_of(robot: Robot, probes: list[Array]) -> list[Array]:
+    """``_second_singular`` of each family's members ``probes[k] (M_k, n)``, in one compiled call."""
+    q = np.concatenate(probes) if len(probes) > 1 else probes[0]
     ok = np.all(np.isfinite(q), axis=-1)
+    out = np.full(q.shape[0], np.inf)
     if ok.any():
-        s, _ = scaled_singular(robot, q[ok])
-        out[ok] = s[:, -2] / s[:, 0]
+        rows = np.nonzero(ok)[0]
+        family = np.repeat(np.arange(len(probes)), [len(p) for p in probes])[rows]
+        cold = np.concatenate([[True], family[1:] != family[:-1]])  # (each family's values as in a call of its own)
+        out[rows] = second_singular(robot, np.ascontiguousarray(q[rows]), cold)
+    return np.split(out, np.cumsum([len(p) for p in probes[:-1]]).astype(np.intp))
+
+
+def _grid_probes(families: list[Family]) -> list[Array]:
+    """``_probe`` of each family at its ``CROSS_SAMPLES`` grid (``_grid``); the families of one reduction without
+    members of their own (``certified_members``, no joints held) at once (``certified_members_of``): the same
+    values."""
+    out: list[Array] = [np.zeros((0, 0))] * len(families)
+    groups: dict[int, list[int]] = {}
+    for k, f in enumerate(families):
+        red = f.reduction
+        if f.members is certified_members and f.held is None and getattr(red, "corrected", None) is None:
+            groups.setdefault(id(red), []).append(k)
+        else:
+            out[k] = _probe(f, _grid(f))
+    for ks in groups.values():
+        fs = [families[k] for k in ks]
+        red = fs[0].reduction
+        lo, hi = np.array([f.interval for f in fs], dtype=np.float64).T
+        theta = np.array([f.theta_inside(_grid(f)) for f in fs])
+        chains = np.array([f.chain_pose for f in fs])
+        branch = np.array([f.branch for f in fs], dtype=np.intp)
+        q = red.robot.wrap(certified_members_of(red, chains, branch, theta, lo, hi))
+        for j, k in enumerate(ks):
+            out[k] = q[j]
     return out
+
+
+def _grid(f: Family) -> Array:
+    """The ``CROSS_SAMPLES`` theta* values over the family's interval, ends included."""
+    lo, hi = f.interval
+    return np.linspace(lo, hi, CROSS_SAMPLES)
 
 
 def _probe(family: Family, theta: Array) -> Array:
@@ -108,29 +148,54 @@ def vertex_least(
     return m, em
 
 
-def crossing_seeds(robot: Robot, families: tuple[Family, ...]) -> tuple[Array, IntArray]:
+def crossing_grids(robot: Robot, families: list[Family]) -> list[Array | None]:
+    """The second singular value (``_second_singular``) of each family at its ``CROSS_SAMPLES`` members over its
+    interval, every family's in one pass (a batch's families: one compiled call for the members of each reduction's,
+    one for the singular values, where a call per family spent ~0.3 ms in Python); None for a family of one point or
+    one without a dip to search (``_dips``)."""
+    ks = [k for k, f in enumerate(families) if f.interval[1] > f.interval[0]]
+    out: list[Array | None] = [None] * len(families)
+    if ks:
+        grids = _singular_of(robot, _grid_probes([families[k] for k in ks]))
+        searched: list[bool] = np.asarray(_dips(np.array(grids)).any(axis=1)).tolist()
+        for k, s2, keep in zip(ks, grids, searched, strict=True):
+            out[k] = s2 if keep else None
+    return out
+
+
+def _dips(S: Array) -> NDArray[np.bool_]:
+    """``(F, M)``: the least samples of the families' second singular values ``S (F, M)`` worth searching for a
+    crossing: a local least (finite, with finite neighbours) at a crossing already (at most ``CROSS_SINGULAR``: a
+    crossing on a sample, e.g. at 0 or 90 deg, where the value is rounding) or whose V through its neighbours reaches
+    down to ``VERTEX_REL`` of it (a crossing between the samples: a V, |theta - crossing| x slope; its vertex, from
+    the steeper side's slope and the other side's sample, at zero; a smooth least value above zero: well above it),
+    on a family whose median is above ``CROSS_RANK`` (else it loses a second rank all along)."""
+    inf = np.full((S.shape[0], 1), np.inf)
+    padded = np.concatenate([inf, S, inf], axis=1)
+    left, right = padded[:, :-2], padded[:, 2:]
+    with np.errstate(invalid="ignore"):
+        least = (S <= left) & (S <= right) & np.isfinite(S) & np.isfinite(left + right)
+        high, low = np.maximum(left, right), np.minimum(left, right)
+        drop = np.maximum(high - S, 1e-300)  # (per sample step)
+        vertex = S - 0.5 * (S - low + drop)
+        reaches = (vertex <= VERTEX_REL * S) | (S <= CROSS_SINGULAR)
+        return least & reaches & (np.median(S, axis=1) > CROSS_RANK)[:, None]
+
+
+def crossing_seeds(
+    robot: Robot, families: tuple[Family, ...], grids: list[Array | None] | None = None
+) -> tuple[Array, IntArray]:
     """Seeds of the continua crossing ``families`` (one pose's): ``(q (K, n), joint (K,))``, two per crossing found
-    (one each side), for ``continuum_families``."""
+    (one each side), for ``continuum_families``. ``grids``: their ``crossing_grids``, if known."""
     seeds: list[Array] = []
     joints: list[int] = []
     scale = np.where(robot.is_revolute, 1.0, robot.length_scale)
-    for f in families:
+    for f, s2 in zip(families, crossing_grids(robot, list(families)) if grids is None else grids, strict=True):
         lo, hi = f.interval
-        if not hi > lo:
+        if s2 is None:
             continue
-        grid = np.linspace(lo, hi, CROSS_SAMPLES)
-        s2 = _second_singular(robot, f, grid)
-        if not np.median(s2) > CROSS_RANK:
-            continue
-        padded = np.concatenate([[np.inf], s2, [np.inf]])
-        left, right = padded[:-2], padded[2:]
-        dips = np.nonzero((s2 <= left) & (s2 <= right) & np.isfinite(s2) & np.isfinite(left + right))[0]
-        # a crossing between the samples: a V, |theta - crossing| x slope; its vertex, from the steeper side's slope
-        # and the other side's sample, at zero (a smooth least value above zero: well above it)
-        high, low = np.maximum(left[dips], right[dips]), np.minimum(left[dips], right[dips])
-        drop = np.maximum(high - s2[dips], 1e-300)  # (per sample step)
-        vertex = s2[dips] - 0.5 * (s2[dips] - low + drop)
-        dips = dips[vertex <= VERTEX_REL * s2[dips]]
+        grid = _grid(f)
+        dips = np.nonzero(_dips(s2[None])[0])[0]
         if dips.size == 0:
             continue
 
@@ -146,7 +211,10 @@ def crossing_seeds(robot: Robot, families: tuple[Family, ...]) -> tuple[Array, I
             continue
         h = 1e-6 * (hi - lo)
         qc = f.at(x)
-        tangent = (f.at(np.minimum(x + h, hi)) - f.at(np.maximum(x - h, lo))) / scale
+        step = f.at(np.minimum(x + h, hi)) - f.at(np.maximum(x - h, lo))
+        rev = robot.is_revolute  # (members are wrapped: a joint at +-pi must not step by a turn)
+        step[:, rev] = wrap_angle(step[:, rev])
+        tangent = step / scale
         tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-300)
         _, vt = scaled_singular(robot, qc)
         for c in range(x.size):

@@ -49,31 +49,57 @@ def certified_members(red: Reduction, chain_pose: Array, branch: int, theta: Arr
     """Members ``(K, n)`` at ``theta (K,)`` (inside ``[lo, hi]``) of one family (chain pose ``(4, 4)``, branch),
     each certified by FK: one that is not is replaced by the member ``NUDGE_REL (hi - lo)`` further in, or back
     (if neither is a solution, it is left as it is)."""
-
+    if getattr(red, "corrected", None) is None:
+        lo_, hi_ = np.array([lo], dtype=np.float64), np.array([hi], dtype=np.float64)
+        return certified_members_of(red, chain_pose[None], np.array([branch], dtype=np.intp), theta[None], lo_, hi_)[0]
     robot = red.robot
     tol = ACCEPT_TOL_REL * robot.length_scale  # (the solver's own acceptance of a solution)
+    branches = np.full(theta.size, branch, dtype=np.intp)
 
     def members(x: Array) -> tuple[Array, NDArray[np.bool_]]:
-        pose, branches = np.zeros(x.size, np.intp), np.full(x.size, branch, dtype=np.intp)
-        own = _own_errors(red, chain_pose[None], x[None], branches[None])
-        if own is not None:
-            return own[0][0], np.all(np.isfinite(own[0][0]), axis=-1) & (own[1][0] <= tol)
-        q = family_members(robot, red, chain_pose[None], pose, branches, x)
-        return q, _solve_chain(robot, q, chain_pose, tol)
+        own = _own_errors(red, chain_pose[None], x[None], branches[None, : x.size])
+        assert own is not None
+        return own[0][0], np.all(np.isfinite(own[0][0]), axis=-1) & (own[1][0] <= tol)
 
     q, ok = members(theta)
-    if ok.all():
-        return q
     bad = np.nonzero(~ok)[0]
     step = NUDGE_REL * max(hi - lo, 1.0)
     for sign in (1.0, -1.0):
+        if bad.size == 0:
+            break
         x = np.clip(theta[bad] + sign * step, lo, hi)
         qn, okn = members(x)
         q[bad[okn]] = qn[okn]
         bad = bad[~okn]
+    return q
+
+
+def certified_members_of(
+    red: Reduction, chains: Array, branch: NDArray[np.intp], theta: Array, lo: Array, hi: Array
+) -> Array:
+    """``certified_members`` of ``F`` families of one reduction at once (one without members of its own,
+    ``Traced.corrected``): chain poses ``(F, 4, 4)``, branches, ``theta (F, M)``, intervals ``lo``, ``hi (F,)``;
+    members ``(F, M, n)``, each the value ``certified_members`` gives."""
+    robot = red.robot
+    tol = ACCEPT_TOL_REL * robot.length_scale  # (the solver's own acceptance of a solution)
+    F, M = theta.shape
+    pose, br, x = np.repeat(np.arange(F), M), np.repeat(branch, M), theta.ravel()
+
+    def members(rows: NDArray[np.intp], xr: Array) -> tuple[Array, NDArray[np.bool_]]:
+        q = family_members(robot, red, chains, pose[rows], br[rows], xr)
+        return q, _solve_chain(robot, q, chains[pose[rows]], tol)
+
+    q, ok = members(np.arange(x.size), x)
+    bad = np.nonzero(~ok)[0]
+    step = NUDGE_REL * np.maximum(hi - lo, 1.0)
+    for sign in (1.0, -1.0):
         if bad.size == 0:
             break
-    return q
+        f = pose[bad]
+        qn, okn = members(bad, np.clip(x[bad] + sign * step[f], lo[f], hi[f]))
+        q[bad[okn]] = qn[okn]
+        bad = bad[~okn]
+    return q.reshape(F, M, -1)
 
 
 def _solve_chain(robot: Robot, q: Array, chain: Array, tol: float) -> NDArray[np.bool_]:

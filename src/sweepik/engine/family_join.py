@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine.continuation import Traced, continuum_families, correct
-from sweepik.engine.crossings import crossing_seeds
+from sweepik.engine.crossings import crossing_grids, crossing_seeds
 from sweepik.engine.families import (
     inner_off,
     off_families,
@@ -120,10 +120,12 @@ def add_crossing_families(
     cross (:mod:`.crossings`) and added to ``fams`` when not on a family found already."""
     tol = ACCEPT_TOL_REL * robot.length_scale
     known: dict[int, tuple[Family, ...]] = {}
-    seed_p, seed_q, seed_j = [], [], []
     for i in sorted(set(fams) | set(fallback)):
         known[i] = tuple(fams.get(i, ())) + (fallback[i].families if i in fallback else ())
-        q, j = crossing_seeds(robot, known[i])
+    grids = iter(crossing_grids(robot, [f for fs in known.values() for f in fs]))  # (the batch's at once)
+    seed_p, seed_q, seed_j = [], [], []
+    for i, fs in known.items():
+        q, j = crossing_seeds(robot, fs, [next(grids) for _ in fs])
         if j.size:
             seed_p.append(np.full(j.size, i, dtype=np.intp))
             seed_q.append(q)

@@ -1,6 +1,7 @@
 """The least-squares step ``pinv(A) @ e`` of a small matrix (a 6 x n Jacobian) through its singular value
 decomposition by one-sided Jacobi rotations (Hestenes), compiled, for the Newton steps of the polish and of traced
-continua.
+continua; and the singular values themselves (``singular_values``: the crossing search's second least one along a
+family, ``engine.crossings``).
 
 Why not ``np.linalg.pinv`` inside the kernels: for a 6 x 6 matrix its LAPACK call (``gesdd``, with Numba's copies
 and work arrays) costs ~12 us on this machine, about ten times the arithmetic; a traced continuum's correction made
@@ -117,3 +118,31 @@ def pinv_step(A, e, rcond, B, V, out):
     """``out (n,) = pinv(A) @ e`` for ``A (m, n)``, ``e (m,)`` (``B (m, n)``, ``V (n, n)``: work arrays)."""
     decompose(A, B, V)
     solve(B, V, e, rcond, out)
+
+
+@inlined
+def singular_values(A, B, V, out, warm=False):
+    """``out (min(m, n),)``: the singular values of ``A (m, n)``, decreasing (``np.linalg.svd``'s), from
+    :func:`decompose` (``B``, ``V``: work arrays; ``warm``: as there): the norms of ``B``'s columns, the largest
+    ``min(m, n)``."""
+    m, n = A.shape
+    decompose(A, B, V, warm)
+    r = min(m, n)
+    for k in range(r):
+        out[k] = -1.0
+    for k in range(n):  # (an insertion into the largest r so far)
+        s2 = 0.0
+        for i in range(m):
+            s2 += B[i, k] * B[i, k]
+        x = math.sqrt(s2)
+        if x != x:  # (a NaN in A: no values)
+            for i in range(r):
+                out[i] = math.nan
+            return
+        j = r - 1
+        if not x > out[j]:
+            continue
+        while j > 0 and x > out[j - 1]:
+            out[j] = out[j - 1]
+            j -= 1
+        out[j] = x
