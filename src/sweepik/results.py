@@ -148,6 +148,21 @@ def _nearest_on_family(robot: Robot, fam: Family, ref: Array, metric: DistanceFu
     return np.asarray(best, dtype=np.float64), bd
 
 
+def thetas_inside(lo: Any, hi: Any, periodic: bool, theta: Array) -> Array:
+    """theta* values ``theta`` of families with intervals ``[lo, hi]`` (broadcast against ``theta``) as their members
+    are taken: a revolute joint's angle by whole turns onto the interval, then clipped to it (a value within
+    ``_FAMILY_EDGE_TOL`` of the interval outside it is its end); SweepikError for a value outside."""
+    tol = _FAMILY_EDGE_TOL * np.maximum(hi - lo, 1.0)
+    th = theta
+    if periodic:  # an angle by whole turns onto the interval (a joint's range can pass +-pi)
+        th = lo - tol + np.mod(th - (lo - tol), 2.0 * np.pi)
+    if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
+        raise SweepikError(
+            f"theta* = {th.tolist()} is outside the family's interval [{np.min(lo):.12g}, {np.max(hi):.12g}]"
+        )
+    return np.asarray(np.clip(th, lo, hi))
+
+
 @dataclass(frozen=True, eq=False)
 class Family:
     """A continuum of solutions (self-motion): every theta* in ``interval`` gives a solution.
@@ -185,17 +200,10 @@ class Family:
         return q.reshape(*th.shape, -1)
 
     def theta_inside(self, theta: ArrayLike) -> Array:
-        """The theta* values inside ``interval`` at which :meth:`at` takes its members for ``theta``: a revolute
-        joint's angle by whole turns onto the interval, then clipped to it (a value ~1e-9 of the interval outside it
-        is its end); SweepikError for a value outside."""
-        th = np.asarray(theta, dtype=np.float64)
+        """The theta* values inside ``interval`` at which :meth:`at` takes its members for ``theta``
+        (:func:`thetas_inside`); SweepikError for a value outside."""
         lo, hi = self.interval
-        tol = _FAMILY_EDGE_TOL * max(hi - lo, 1.0)
-        if self.reduction.periodic:  # an angle by whole turns onto the interval (a joint's range can pass +-pi)
-            th = lo - tol + np.mod(th - (lo - tol), 2.0 * np.pi)
-        if np.any(~np.isfinite(th)) or np.any(th < lo - tol) or np.any(th > hi + tol):
-            raise SweepikError(f"theta* = {th.tolist()} is outside the family's interval [{lo:.12g}, {hi:.12g}]")
-        return np.clip(th, lo, hi)
+        return thetas_inside(np.float64(lo), np.float64(hi), self.reduction.periodic, np.asarray(theta, np.float64))
 
     def sample(self, count: int = 50) -> Array:
         """``(count, n)`` member configurations evenly spaced over the interval (``count`` an integer >= 1)."""

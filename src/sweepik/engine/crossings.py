@@ -33,7 +33,7 @@ from sweepik.engine.settings import (
 )
 from sweepik.model.pose import wrap_angle
 from sweepik.model.robot import Robot
-from sweepik.results import Family
+from sweepik.results import Family, thetas_inside
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.intp]
@@ -74,7 +74,7 @@ def _grid_probes(families: list[Family]) -> list[Array]:
         fs = [families[k] for k in ks]
         red = fs[0].reduction
         lo, hi = np.array([f.interval for f in fs], dtype=np.float64).T
-        theta = np.array([f.theta_inside(_grid(f)) for f in fs])
+        theta = thetas_inside(lo[:, None], hi[:, None], red.periodic, np.linspace(lo, hi, CROSS_SAMPLES, axis=1))
         chains = np.array([f.chain_pose for f in fs])
         branch = np.array([f.branch for f in fs], dtype=np.intp)
         q = red.robot.wrap(certified_members_of(red, chains, branch, theta, lo, hi))
