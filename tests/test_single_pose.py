@@ -162,3 +162,14 @@ def test_settled_solutions_are_the_constructors() -> None:
     b = Solutions(**args, families=(), robot=robot)  # type: ignore[arg-type]
     assert set(vars(a)) == set(vars(b)) == {f.name for f in dataclasses.fields(Solutions)}
     _assert_same(a, b)
+
+
+def test_the_default_reduction_named_takes_the_one_call_too(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``reduction="auto"`` on an arm whose file names no reduction is its default: the one call answers, the same
+    solutions; another reduction's name goes the general way."""
+    robot = load_robot("ur5")
+    T = robot.fk(np.array([0.1, -1.2, 1.3, -0.4, 1.1, 0.3]))
+    assert isinstance(solving._single_pose(robot, None, "auto"), SinglePose)
+    _assert_same(sweepik.solve(robot, T, reduction="auto"), sweepik.solve(robot, T))
+    carm = load_robot("carm")
+    assert solving._single_pose(carm, None, "auto") is None and solving._single_pose(carm, None, "carm-d1") is None

@@ -441,15 +441,17 @@ def _default_reduction(robot: Robot, held: HeldJoints | None = None) -> Reductio
     return prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1, None, held)[0]
 
 
-def _single_pose(robot: Robot, locked: object) -> SinglePose | None:
-    """``robot``'s closed form for single poses with the default options and ``locked`` joints (None: its default
-    reduction is no such closed form, or the arm or ``locked`` is refused: the general path then raises, after the
-    pose's checks)."""
-    if locked is None:
-        return _single_pose_of(robot, None)
-    try:
-        held = held_joints(robot, locked)
-    except (SweepikError, TypeError):  # (an unhashable value: the general path says what is wrong)
+def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> SinglePose | None:
+    """``robot``'s default reduction (``reduction``: None, or a name of it) ready for single poses with the default
+    options and ``locked`` joints (None: it does not qualify, ``SinglePose.of``, or the arm, ``locked`` or
+    ``reduction`` is refused: the general path then raises, after the pose's checks)."""
+    held = None
+    if locked is not None:
+        try:
+            held = held_joints(robot, locked)
+        except (SweepikError, TypeError):  # (an unhashable value: the general path says what is wrong)
+            return None
+    if reduction is not None and not is_default(robot if held is None else held.arm, reduction):
         return None
     return _single_pose_of(robot, held)
 
@@ -520,13 +522,13 @@ def solve(
     one_call = True
     if (  # (the default options on an array: one compiled call answers most poses, ``single_pose``)
         type(pose) is np.ndarray
-        and reduction is None
+        and (reduction is None or type(reduction) is str)
         and windings is False
         and _defaults(robot, free_joint, strategy, limits, n_samples)
         and pose.dtype == np.float64
         and pose.shape == (4, 4)
     ):
-        fast = _single_pose(robot, locked)
+        fast = _single_pose(robot, locked, reduction)
         flags = pose.flags
         if fast is not None and flags.c_contiguous and flags.writeable:
             status, sol = fast.solve(pose, limits)
