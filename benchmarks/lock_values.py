@@ -1,9 +1,11 @@
 """A 7-joint arm held at a new lock value every pose against the same value every pose (issue 39's "a new lock
 value for free"): ``solve`` per pose, and ``solve_many`` with one value per pose. Run from the repository root.
 
-    python benchmarks/lock_values.py [--arm kuka_iiwa14] [--joint A3] [--n 40]
+    python benchmarks/lock_values.py [--arm kuka_iiwa14] [--joint A3] [--n 40] [--parts]
 
-Prints the mean time a pose of each, in milliseconds, and their ratio.
+Prints the mean time a pose of each, in milliseconds, and their ratio. ``--parts``: where a new value's time goes,
+each step timed on its own in the order a solve takes them (the held arm, the plan enumeration, the choice among the
+plans, the reduction, its one call's fixed arguments, the solve itself), means over ``--n`` new values.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ def main() -> None:
     parser.add_argument("--arm", default="kuka_iiwa14")
     parser.add_argument("--joint", default="A3")
     parser.add_argument("--n", type=int, default=40)
+    parser.add_argument("--parts", action="store_true")
     args = parser.parse_args()
     arm = sweepik.load_robot(args.arm)
     k = arm.joint_names.index(args.joint)
@@ -29,6 +32,9 @@ def main() -> None:
     q = np.random.default_rng(2).uniform(arm.lower, arm.upper, (3 * n + 1, arm.n_joints))
     T = arm.fk(q)
     sweepik.solve(arm, T[0], locked={args.joint: float(q[0, k])})  # (kernels loaded)
+    if args.parts:
+        parts(arm, args.joint, q[1 : n + 1], T[1 : n + 1])
+        return
     t0 = time.perf_counter()
     for i in range(1, n + 1):
         sweepik.solve(arm, T[i], locked={args.joint: float(q[i, k])})
@@ -47,6 +53,36 @@ def main() -> None:
         f"{args.arm}, {args.joint} held: a new value every pose {new * 1e3:.2f} ms, the same value {same * 1e3:.3f} ms "
         f"(x{new / same:.0f}); solve_many with a new value per pose {batch * 1e3:.2f} ms a pose"
     )
+
+
+def parts(arm: sweepik.Robot, joint: str, q: np.ndarray, T: np.ndarray) -> None:
+    """``--parts``: each step of a solve at a new lock value timed on its own (later steps find the earlier ones'
+    results cached, as a solve does)."""
+    from sweepik import solving
+    from sweepik.reductions import decompose, plan
+
+    k = arm.joint_names.index(joint)
+    names = ("held arm", "plan enumeration", "choice", "reduction", "one call's arguments", "solve")
+    total = np.zeros(len(names))
+    for qq, TT in zip(q, T, strict=True):
+        locked = {joint: float(qq[k])}
+        clock = [time.perf_counter()]
+        held = solving.held_joints(arm, locked)
+        assert held is not None
+        clock.append(time.perf_counter())
+        plan.plans(held.arm)
+        clock.append(time.perf_counter())
+        decompose.choice(held.arm, None)
+        clock.append(time.perf_counter())
+        solving._default_reduction(held.arm, held)
+        clock.append(time.perf_counter())
+        solving._single_pose(arm, locked)
+        clock.append(time.perf_counter())
+        sweepik.solve(arm, TT, locked=locked)
+        clock.append(time.perf_counter())
+        total += np.diff(clock)
+    each = ", ".join(f"{name} {t / len(q) * 1e3:.2f}" for name, t in zip(names, total, strict=True))
+    print(f"{arm.name}, {joint} held at a new value, ms a pose: {each}")
 
 
 if __name__ == "__main__":
