@@ -4,8 +4,8 @@ value for free"): ``solve`` per pose, and ``solve_many`` with one value per pose
     python benchmarks/lock_values.py [--arm kuka_iiwa14] [--joint A3] [--n 40] [--parts]
 
 Prints the mean time a pose of each, in milliseconds, and their ratio. ``--parts``: where a new value's time goes,
-each step timed on its own in the order a solve takes them (the held arm, the plan enumeration, the choice among the
-plans, the reduction, its one call's fixed arguments, the solve itself), means over ``--n`` new values.
+each step timed on its own in the order a solve takes them (the held arm, its plan, the reduction, its one call's
+fixed arguments, the solve itself), means over ``--n`` new values.
 """
 
 from __future__ import annotations
@@ -57,22 +57,18 @@ def main() -> None:
 
 def parts(arm: sweepik.Robot, joint: str, q: np.ndarray, T: np.ndarray) -> None:
     """``--parts``: each step of a solve at a new lock value timed on its own (later steps find the earlier ones'
-    results cached, as a solve does)."""
+    results cached, as a solve does): the held arm, its plan and reduction (``reductions.automatic_for_held``), the
+    one call's fixed arguments, the solve."""
     from sweepik import solving
-    from sweepik.reductions import decompose, plan
 
     k = arm.joint_names.index(joint)
-    names = ("held arm", "plan enumeration", "choice", "reduction", "one call's arguments", "solve")
+    names = ("held arm", "plan and reduction", "one call's arguments", "solve")
     total = np.zeros(len(names))
     for qq, TT in zip(q, T, strict=True):
         locked = {joint: float(qq[k])}
         clock = [time.perf_counter()]
         held = solving.held_joints(arm, locked)
         assert held is not None
-        clock.append(time.perf_counter())
-        plan.plans(held.arm)
-        clock.append(time.perf_counter())
-        decompose.choice(held.arm, None)
         clock.append(time.perf_counter())
         solving._default_reduction(held.arm, held)
         clock.append(time.perf_counter())

@@ -126,3 +126,73 @@ def test_the_automatic_choice_is_made_once_per_arm(monkeypatch: pytest.MonkeyPat
     reductions.get_reduction(held.arm, "auto")
     decompose.companion_plan(held.arm)
     assert len(calls) == 1
+
+
+def _held_arms() -> list[Robot]:
+    """The bundled seven-joint arms with one joint held, each joint at a few values (0 among them: special ones)."""
+    from sweepik.solving import held_joints
+
+    out = []
+    rng = np.random.default_rng(4)
+    for name in bundled_robots():
+        robot = load_robot(name)
+        if robot.n_joints != 7:
+            continue
+        for j in range(7):
+            zero = float(np.clip(0.0, robot.lower[j], robot.upper[j]))
+            for v in [zero, *rng.uniform(robot.lower[j], robot.upper[j], 3).tolist()]:
+                held = held_joints(robot, {j: v})
+                assert held is not None
+                out.append(held.arm)
+    return out
+
+
+def test_the_first_plan_found_lazily_is_the_one_chosen() -> None:
+    """``plan.first_plan`` (candidates checked in rank order, stopping at the first) is ``decompose.choice``'s plan on
+    every arm without a near-structure where it answers: the bundled six-joint arms, held arms of the seven-joint ones
+    (84), their rewritings; and it answers on every held arm whose choice is a closed form."""
+    from sweepik.reductions.plan import first_plan, near_structures
+
+    rng = np.random.default_rng(9)
+    arms = [load_robot(n) for n in SIX] + _held_arms()
+    arms += [rewrite(a, rng).robot for a in arms[::5]]
+    answered = 0
+    for arm in arms:
+        if near_structures(arm) or decompose.continuum_everywhere(arm) is not None:
+            continue
+        lazy = first_plan(arm)
+        chosen = decompose.choice(arm, None)[0]
+        if lazy is None:
+            assert chosen.family == "parallel" or chosen.conditional or chosen.family == "general"
+            continue
+        assert lazy == chosen
+        answered += 1
+    assert answered >= 60
+
+
+def test_a_held_arm_gets_the_plans_it_got_with_every_plan_checked() -> None:
+    """``reductions._without_near_structure`` gives a held arm the plan and companion that ``automatic_for_held`` gives
+    with every plan checked, for the signatures remembered from other lock values: none, the plan's own, its own and
+    another plan's in either order, another's alone."""
+    from sweepik.reductions import _signature, _without_near_structure
+
+    def full(arm: Robot, sigs: tuple) -> tuple[Plan, Plan | None]:
+        options = plans(arm)
+        hints = tuple(p for sig in sigs for p in options if sig is not None and _signature(p) == sig)
+        plan, _ = decompose.choice(arm, None, hints)
+        comp = next((p for p in hints if p != plan), None) if plan in hints else decompose.companion_plan(arm)
+        return plan, comp
+
+    checked = 0
+    for arm in _held_arms():
+        options = plans(arm)
+        if not options:
+            continue
+        mine = _signature(decompose.choice(arm, None)[0])
+        other = next((_signature(p) for p in options if _signature(p) != mine and p.family in ("wrist", "pair")), None)
+        for sigs in ((), (mine, None), (mine, other), (other, mine), (other, None)):
+            lazy = _without_near_structure(arm, sigs)
+            if lazy is not None:
+                assert lazy == full(arm, sigs)
+                checked += 1
+    assert checked >= 100

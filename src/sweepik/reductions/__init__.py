@@ -13,6 +13,7 @@ from sweepik.reductions.carm import CArmD1, CArmTheta2
 from sweepik.reductions.decompose import choose
 from sweepik.reductions.general import GeneralReduction
 from sweepik.reductions.generic import GeometricReduction, Plan
+from sweepik.reductions.plan import first_plan, position_plan
 
 __all__ = [
     "Reduction",
@@ -120,18 +121,48 @@ def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduct
     otherwise check every plan again."""
     key = (full, held)
     sigs = _HELD_PLANS.get(key, ())
-    options = decompose.plans(arm)
-    hints = tuple(p for sig in sigs for p in options if sig is not None and _signature(p) == sig)
-    plan, _ = decompose.choice(arm, None, hints)
-    if plan in hints:  # (the other plan chosen with it, unchecked: a companion only adds solutions)
-        comp = next((p for p in hints if p != plan), None)
+    lazy = _without_near_structure(arm, sigs)
+    if lazy is not None:
+        plan, comp = lazy
     else:
-        comp = decompose.companion_plan(arm)
+        options = decompose.plans(arm)
+        hints = tuple(p for sig in sigs for p in options if sig is not None and _signature(p) == sig)
+        plan, _ = decompose.choice(arm, None, hints)
+        if plan in hints:  # (the other plan chosen with it, unchecked: a companion only adds solutions)
+            comp = next((p for p in hints if p != plan), None)
+        else:
+            comp = decompose.companion_plan(arm)
     red = _held_reduction(arm, plan, comp)
     if len(_HELD_PLANS) > 256:  # (bounded, as the caches around it)
         _HELD_PLANS.clear()
     _HELD_PLANS[key] = (_signature(plan), None if comp is None else _signature(comp))
     return red
+
+
+def _without_near_structure(arm: Robot, sigs: tuple[_Sig | None, ...]) -> tuple[Plan, Plan | None] | None:
+    """``automatic_for_held``'s plan and companion for an arm without a near-structure (nor a continuum everywhere),
+    the same ones, without every plan checked: ``decompose.choice`` takes the first plan without a blind spot
+    (``plan.first_plan``), and the companion is the other plan chosen with it before (``sigs``) where that plan
+    applies (``plan.position_plan``), else None (``companion_plan``'s without a near-structure). None: the arm needs
+    ``plans`` (a near-structure, a parallel plan first, no plan, or a companion of a family ``position_plan`` does not
+    build)."""
+    if decompose.near_structures(arm) or decompose.continuum_everywhere(arm) is not None:
+        return None
+    plan = first_plan(arm)
+    if plan is None:
+        return None
+    mine = _signature(plan)
+    if mine not in sigs:
+        return plan, None
+    for sig in sigs:  # (the hints, in their order: the first other one that applies)
+        if sig is None or sig == mine:
+            continue
+        if sig[0] not in ("wrist", "pair"):
+            return None
+        other = position_plan(arm, *sig)
+        if other is not None:
+            return plan, other
+    return plan, None
 
 
 @lru_cache(maxsize=64)

@@ -47,6 +47,8 @@ __all__ = [
     "near_structures",
     "parallel_plans",
     "continuum_covered",
+    "first_plan",
+    "position_plan",
 ]
 
 
@@ -312,45 +314,70 @@ def _samples(robot: Robot, chain_index: int, prismatic: bool) -> list[float]:
 
 def _position_plans(robot: Robot, chain: Chain, rev_chain: bool, W: np.ndarray, frees: tuple[int, ...], family: str):
     out = []
-    tol = INTERSECT_TOL_REL * robot.length_scale
     for f in frees:
-        others = [i for i in range(4) if i != f]
-        types = tuple(bool(chain.revolute[i]) for i in others)
-        robot_f = 5 - f if rev_chain else f
-        xs = _samples(robot, robot_f, not chain.revolute[f])
-        samples = [_reduced(chain, W, f, x) for x in xs]
-        pts = np.cumsum(chain.P[:4], axis=0)
+        free = _Free(robot, chain, rev_chain, W, f)
         for case in CASES:
-            if case == "rrr" and family != "wrist" and not (f == 3 and _fixed_target(samples, tol)):
-                # the quartic's roots are no branches a sweep can follow, unless theta* leaves W's problem as it is
-                # (joint 4 turning about the wrist centre: the sweep answering a singular wrist, ``generic._continua``)
-                continue
-            ok, cond, rel = _check(case, types, samples, tol)  # type: ignore[arg-type]
-            if not ok:
-                continue
-            nb = BRANCHES[case][0]
-            if case in ("ab_par",):
-                nb = BRANCHES[case][0 if types[2] else 1]
-            elif case in ("bc_par",):
-                nb = BRANCHES[case][0 if types[0] else 1]
-            meet = np.zeros(3)
-            if rel is not None:
-                if case == "bc_int" and not _meets_as_kernel(chain, f, xs, rel, tol):
-                    continue
-                meet = pts[others[0] if case == "ab_int" else others[1]] + rel[0]
-            out.append(
-                Plan(
-                    family=family,
-                    reversed=rev_chain,
-                    free=f,
-                    case=case,
-                    branches=2 * nb if family == "wrist" else nb,
-                    W=_t(W),
-                    meet=_t(meet),
-                    conditional=cond,
-                )
-            )
+            plan = free.plan(case, family)
+            if plan is not None:
+                out.append(plan)
     return out
+
+
+class _Free:
+    """One theta* (joint ``f`` of the solved chain, the wrist centre ``W``): its reduced chains at the sample values
+    (worked out when first needed), and the plan of each position case (``plan``)."""
+
+    def __init__(self, robot: Robot, chain: Chain, rev_chain: bool, W: np.ndarray, f: int) -> None:
+        self.chain, self.rev_chain, self.W, self.f = chain, rev_chain, W, f
+        self.tol = INTERSECT_TOL_REL * robot.length_scale
+        self.others = [i for i in range(4) if i != f]
+        self.types = tuple(bool(chain.revolute[i]) for i in self.others)
+        robot_f = 5 - f if rev_chain else f
+        self.xs = _samples(robot, robot_f, not chain.revolute[f])
+        self._samples: list[tuple[np.ndarray, ...]] | None = None
+
+    @property
+    def samples(self) -> list[tuple[np.ndarray, ...]]:
+        if self._samples is None:
+            self._samples = [_reduced(self.chain, self.W, self.f, x) for x in self.xs]
+        return self._samples
+
+    def branches(self, case: str, family: str) -> int:
+        """The plan's branches for ``case`` (known before its check)."""
+        types = self.types
+        nb = BRANCHES[case][0]
+        if case in ("ab_par",):
+            nb = BRANCHES[case][0 if types[2] else 1]
+        elif case in ("bc_par",):
+            nb = BRANCHES[case][0 if types[0] else 1]
+        return 2 * nb if family == "wrist" else nb
+
+    def plan(self, case: str, family: str) -> Plan | None:
+        """The plan of ``family`` placing the wrist centre by ``case``, or None where it does not apply."""
+        f, tol, samples = self.f, self.tol, self.samples
+        if case == "rrr" and family != "wrist" and not (f == 3 and _fixed_target(samples, tol)):
+            # the quartic's roots are no branches a sweep can follow, unless theta* leaves W's problem as it is
+            # (joint 4 turning about the wrist centre: the sweep answering a singular wrist, ``generic._continua``)
+            return None
+        ok, cond, rel = _check(case, self.types, samples, tol)  # type: ignore[arg-type]
+        if not ok:
+            return None
+        meet = np.zeros(3)
+        if rel is not None:
+            if case == "bc_int" and not _meets_as_kernel(self.chain, f, self.xs, rel, tol):
+                return None
+            pts = np.cumsum(self.chain.P[:4], axis=0)
+            meet = pts[self.others[0] if case == "ab_int" else self.others[1]] + rel[0]
+        return Plan(
+            family=family,
+            reversed=self.rev_chain,
+            free=f,
+            case=case,
+            branches=self.branches(case, family),
+            W=_t(self.W),
+            meet=_t(meet),
+            conditional=cond,
+        )
 
 
 def parallel_plans(robot: Robot, chain: Chain, rev_chain: bool, st: Structure) -> list[Plan]:
@@ -443,17 +470,61 @@ def plans(robot: Robot) -> tuple[Plan, ...]:
         return ()
     found: list[Plan] = []
     for rev_chain, chain, st in chain_structures(robot):
-        rev = chain.revolute
-        if rev[3] and rev[4] and rev[5] and st.common_point((3, 4, 5)):
-            W = np.array(st.points[(3, 4)])
-            found += _position_plans(robot, chain, rev_chain, W, (3,), "wrist")
-        if rev[4] and rev[5] and st.intersecting(4, 5):
-            W = np.array(st.points[(4, 5)])
-            found += _position_plans(robot, chain, rev_chain, W, (0, 1, 2, 3), "pair")
+        for family, W, frees in _position_families(chain, st):
+            found += _position_plans(robot, chain, rev_chain, W, frees, family)
         found += parallel_plans(robot, chain, rev_chain, st)
         if not rev_chain:
             found += decoupled_plans(robot, chain)
     return tuple(sorted((p for p in found if continuum_covered(p, found, robot)), key=rank))
+
+
+def first_plan(robot: Robot) -> Plan | None:
+    """The first plan of :func:`plans` that has no blind spot (``conditional``): the automatic choice on an arm without
+    a near-structure (``decompose.choice``), found by checking the candidates in the order ``plans`` ranks them and
+    stopping at the first that applies, where ``plans`` checks every one (a held arm at a new lock value: ~0.3 ms of
+    ~2.6). None where none applies so, or where the first is a parallel plan (whether its continuum is covered depends
+    on the other plans, ``continuum_covered``): ``plans`` decides."""
+    if robot.n_joints != 6:
+        return None
+    # (rank with no blind spot: a plan's own is only larger; ties in the order plans() finds them, as its stable sort)
+    found: list[tuple[tuple[int, ...], int, Plan | tuple[_Free, str, str]]] = []
+    for rev_chain, chain, st in chain_structures(robot):
+        for family, W, frees in _position_families(chain, st):
+            for f in frees:
+                free = _Free(robot, chain, rev_chain, W, f)
+                for case in CASES:
+                    least = Plan(family, rev_chain, f, case, free.branches(case, family), (0.0,) * 3, (0.0,) * 3)
+                    found.append((rank(least), len(found), (free, case, family)))
+        others = parallel_plans(robot, chain, rev_chain, st) + ([] if rev_chain else decoupled_plans(robot, chain))
+        found.extend((rank(p), len(found), p) for p in others)
+    for _, _, c in sorted(found, key=lambda c: (c[0], c[1])):
+        plan = c if isinstance(c, Plan) else c[0].plan(c[1], c[2])
+        if plan is None or plan.conditional:
+            continue
+        return None if plan.family == "parallel" else plan
+    return None
+
+
+def position_plan(robot: Robot, family: str, reversed_chain: bool, free: int, case: str) -> Plan | None:
+    """The plan of :func:`plans` with this family (``wrist`` or ``pair``), chain, theta* and case, checked alone;
+    None where it does not apply."""
+    chain = robot.chain.reversed() if reversed_chain else robot.chain
+    for fam, W, frees in _position_families(chain, structure_of(chain, robot.length_scale)):
+        if fam == family and free in frees:
+            return _Free(robot, chain, reversed_chain, W, free).plan(case, family)
+    return None
+
+
+def _position_families(chain: Chain, st: Structure) -> list[tuple[str, np.ndarray, tuple[int, ...]]]:
+    """The families placing a wrist centre on ``chain`` (structure ``st``), in the order :func:`plans` tries them:
+    ``(family, W, the joints theta* may be)``."""
+    rev = chain.revolute
+    out: list[tuple[str, np.ndarray, tuple[int, ...]]] = []
+    if rev[3] and rev[4] and rev[5] and st.common_point((3, 4, 5)):
+        out.append(("wrist", np.array(st.points[(3, 4)]), (3,)))
+    if rev[4] and rev[5] and st.intersecting(4, 5):
+        out.append(("pair", np.array(st.points[(4, 5)]), (0, 1, 2, 3)))
+    return out
 
 
 def continuum_covered(plan: Plan, found: list[Plan], robot: Robot) -> bool:
