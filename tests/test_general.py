@@ -230,3 +230,19 @@ def test_free_joint_is_refused_for_the_general_method() -> None:
     robot = random_arm("6r", 0)
     with pytest.raises(NoReductionError, match="no decomposition sweeps"):
         sweepik.solve(robot, robot.fk(np.zeros(6)), free_joint=2)
+
+
+def test_vendor_arm_rewritten_keeps_a_double_root_the_polish_reaches_slowly() -> None:
+    """The big YAM as ``scripts/ssik_catalogue.py --rewrite --singular 10`` writes it (``tests/data``), at a
+    configuration next to its singular set (smallest singular value 9e-8 of the largest): the elimination gives the
+    generating configuration 1.7e-4 rad off, at 1.6e-11 of the arm; Newton's steps next to a double root creep along
+    its valley and certify it after 28 steps (``settings.ITERATIONS``: 16 left it at 1.4e-11, the pose one solution
+    short, 9 of 10). Every one of the ten comes back, alone and in a batch."""
+    robot = sweepik.load_robot(str(Path(__file__).parent / "data" / "big_yam_rewritten.toml"))
+    q = np.array([-0.1961366866990879, 2.1436679559991703, 2.3177342209721177, -0.1886700053514443, 1.57081109908104])
+    q = np.append(q, 2.1605644909863835)  # (the catalogue's singular configuration 39, rewritten)
+    T = robot.fk(q)
+    for sols in (sweepik.solve(robot, T, limits=False), sweepik.solve_many(robot, T[None], limits=False)[0]):
+        assert recovered(robot, sols, q) and len(sols) == 10
+        dp, ang = pose_errors(robot.fk(sols.q), T, robot.length_scale)
+        assert np.all(dp <= 1e-9) and np.all(ang <= 1e-9)
