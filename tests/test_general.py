@@ -137,11 +137,10 @@ def test_vendor_arm_rewritten_keeps_two_roots_whose_eigenvalues_turned_complex()
     assert recovered(rw.robot, s, q) and len(s) == 4
 
 
-@pytest.mark.xfail(strict=True, reason="known miss: a config exactly on the big YAM's singular set (issue 35)")
 def test_vendor_arm_nearly_without_structure_exactly_on_its_singular_set() -> None:
     """A configuration of the big YAM exactly on its singular set (smallest singular value 1.7e-11 of the largest):
-    the first arrangement finds no root and flags nothing, the others give a root 1e-5 from it or none (their
-    pencils nearly singular). Not recovered yet."""
+    the first arrangement finds no root (its double root a complex pair), and the pose was answered unreachable; a
+    pose without a solution now asks the other arrangements, which give the root 1.5e-5 from it, polished onto it."""
     pytest.importorskip("ssik")
     from catalogue import robot_from_ssik
     from singular import singular_configurations

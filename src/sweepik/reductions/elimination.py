@@ -1526,10 +1526,11 @@ class GeneralIK:
         infos = [info]
         # triggers for a second opinion from another arrangement: singular pencil, a real root that did not
         # polish, an odd number of solutions (the real roots of a real polynomial come in an even number:
-        # odd means a double root or a lost one)
+        # odd means a double root or a lost one), or none (a pose whose only roots are a double one, on the singular
+        # set, can lose it as a complex pair: the big YAM exactly on its singular set was answered unreachable)
         sing = info.get("singular_pencil", False)
         n_singular = info.get("n_singular", 0)
-        suspicious = sing or info["n_real_fail"] > 0 or len(sols) % 2 == 1 or n_singular > 0
+        suspicious = sing or info["n_real_fail"] > 0 or len(sols) % 2 == 1 or n_singular > 0 or len(sols) == 0
         continuum = False
         if suspicious:
             allsing = sing
