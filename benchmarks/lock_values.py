@@ -51,7 +51,7 @@ def main() -> None:
     batch = (time.perf_counter() - t0) / n
     print(
         f"{args.arm}, {args.joint} held: a new value every pose {new * 1e3:.2f} ms, the same value {same * 1e3:.3f} ms "
-        f"(x{new / same:.0f}); solve_many with a new value per pose {batch * 1e3:.2f} ms a pose"
+        f"(x{new / same:.2f}); solve_many with a new value per pose {batch * 1e3:.2f} ms a pose"
     )
 
 

@@ -189,9 +189,11 @@ def test_the_default_reduction_named_takes_the_one_call(
 def test_a_locked_arm_takes_the_one_call(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """A seven-joint arm with a joint locked (its held arm a closed form) takes the one call too, its solutions full
     length with the held value in place, the general path's bit for bit; poses with the held arm's wrist singular
-    go the general way."""
+    go the general way. (Built for the value held, not ``engine.held_pose``'s call with the value an argument:
+    tests/test_held_pose.py.)"""
     from sweepik.experiments.bench import _bench_lock
 
+    monkeypatch.setattr(solving, "_held_pose", lambda robot, k: None)
     robot = load_robot(name)
     locked = _bench_lock(robot)
     assert locked

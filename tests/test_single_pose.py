@@ -87,7 +87,10 @@ def test_the_one_call_is_the_general_path_on_arms_written_otherwise(
 
 @pytest.mark.parametrize(("name", "joint"), [("kuka_iiwa14", "A3"), ("franka_panda", "joint7")])
 def test_a_locked_arm_at_new_values(name: str, joint: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A seven-joint arm held at a new value each pose: the general path's solutions, the held value in place."""
+    """A seven-joint arm held at a new value each pose, its held arm built for the value (not ``engine.held_pose``'s
+    call with the value an argument: tests/test_held_pose.py): the general path's solutions, the held value in
+    place."""
+    monkeypatch.setattr(solving, "_held_pose", lambda robot, k: None)
     robot = load_robot(name)
     k = robot.joint_names.index(joint)
     rng = np.random.default_rng(4)

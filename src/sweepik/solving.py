@@ -14,14 +14,16 @@ from typing import Any, Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from sweepik._jit import writable
 from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
+from sweepik.engine.held_pose import HeldPose
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.settings import N_SAMPLES
 from sweepik.engine.single_pose import NOT_RIGID, SinglePose
 from sweepik.engine.windings import wound_block, wound_solutions
 from sweepik.errors import LockedJointError, NoReductionError, ShapeError, SweepikError, UnknownOptionError
-from sweepik.model.origin_axis import HeldJoints, hold_joints, lock_runs, per_pose
+from sweepik.model.origin_axis import HeldJoints, held_values, hold_joints, lock_runs, per_pose
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit
 from sweepik.model.validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
@@ -110,13 +112,55 @@ def solve_many(
     _check_strategy(strategy)
     check_bool(windings, "windings")
     P, runs = _pose_runs(robot, poses, locked)
+    options: dict[str, Any] = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples)
+    options.update(chunk_size=chunk_size, free_joint=free_joint)
+    fast = _held_values(robot, P, runs, options, windings)
+    if fast is not None:
+        held, values = fast
+
+        def general(i: int) -> Iterator[Block]:
+            return _held_run(robot, P[i : i + 1], {held.joint: float(values[i])}, options)
+
+        return SolutionBatch(robot, held.blocks(writable(P), values, limits, general))
     blocks: list[Block] = []
     for s, e, lock in runs:
-        held = held_joints(robot, lock)
-        arm = robot if held is None else held.arm
-        prepared = prepare(arm, P[s:e], reduction, strategy, limits, n_samples, chunk_size, free_joint, held)
-        blocks.extend(_finished(b, held, windings) for b in _solved_chunks(arm, P[s:e], prepared))
+        blocks.extend(_held_run(robot, P[s:e], lock, options, windings))
     return SolutionBatch(robot, blocks)
+
+
+def _held_run(
+    robot: Robot, P: Array, lock: object, options: dict[str, Any], windings: bool = False, first: Prepared | None = None
+) -> Iterator[Block]:
+    """The blocks of poses ``P`` solved with ``lock``'s joints held (``options``: ``prepare``'s; ``first``: already
+    prepared)."""
+    held = held_joints(robot, lock)
+    arm = robot if held is None else held.arm
+    prepared = first if first is not None else prepare(arm, P, **options, held=held)
+    return (_finished(b, held, windings) for b in _solved_chunks(arm, P, prepared))
+
+
+def _held_values(
+    robot: Robot, P: Array, runs: list[tuple[int, int, object]], options: dict[str, Any], windings: bool
+) -> tuple[HeldPose, Array] | None:
+    """With the default options and one joint of a seven-joint arm held, the ``HeldPose`` that takes its value as an
+    argument and each pose's value; else None."""
+    reduction = options["reduction"]
+    if not (
+        runs
+        and isinstance(runs[0][2], Mapping)
+        and len(runs[0][2]) == 1
+        and (reduction is None or type(reduction) is str)
+        and windings is False
+        and _defaults(robot, options["free_joint"], options["strategy"], options["limits"], options["n_samples"])
+    ):
+        return None
+    fast = _single_pose(robot, runs[0][2], reduction)
+    if not isinstance(fast, HeldAt):
+        return None
+    values = np.empty(len(P))
+    for s, e, lock in runs:
+        values[s:e] = held_values(robot, lock)[0][1]  # type: ignore[arg-type]
+    return fast.held, values
 
 
 def _solved_chunks(arm: Robot, P: Array, prepared: Prepared) -> Iterator[Block]:
@@ -192,6 +236,9 @@ def iter_solve(
     P, runs = _pose_runs(robot, poses, locked)
     options: dict[str, Any] = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples)
     options.update(chunk_size=chunk_size, free_joint=free_joint)
+    fast = _held_values(robot, P, runs, options, windings)
+    if fast is not None:
+        return _iter_held(robot, P, fast, options, progress)
     held = held_joints(robot, runs[0][2]) if runs else None
     first = prepare(robot if held is None else held.arm, P[: runs[0][1]], **options, held=held) if runs else None
     return _iter_checked(robot, P, runs, first, options, progress, windings)
@@ -366,14 +413,33 @@ def _iter_checked(
     if progress is not None:
         progress("solve", 0, total)
     for r, (s, e, lock) in enumerate(runs):
-        held = held_joints(robot, lock)
-        arm = robot if held is None else held.arm
-        prepared = first if r == 0 and first is not None else prepare(arm, P[s:e], **options, held=held)
-        for block in _solved_chunks(arm, P[s:e], prepared):
-            yield from _finished(block, held, windings)
+        for block in _held_run(robot, P[s:e], lock, options, windings, first if r == 0 else None):
+            yield from block
             done += block.n
             if progress is not None:
                 progress("solve", done, total)
+
+
+def _iter_held(
+    robot: Robot, P: Array, fast: tuple[HeldPose, Array], options: dict[str, Any], progress: Progress | None
+) -> Iterator[Solutions]:
+    """``_iter_checked`` for ``_held_values``' one call with the lock value an argument, ``chunk_size`` poses at a
+    time."""
+    held, values = fast
+    total, step = P.shape[0], options["chunk_size"]
+    W = writable(P)
+    if progress is not None:
+        progress("solve", 0, total)
+    for s in range(0, total, step):
+        e = min(s + step, total)
+
+        def general(i: int, s: int = s) -> Iterator[Block]:
+            return _held_run(robot, P[s + i : s + i + 1], {held.joint: float(values[s + i])}, options)
+
+        for block in held.blocks(W[s:e], values[s:e], options["limits"], general):
+            yield from block
+        if progress is not None:
+            progress("solve", e, total)
 
 
 def _solve_one(
@@ -441,19 +507,42 @@ def _default_reduction(robot: Robot, held: HeldJoints | None = None) -> Reductio
     return prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1, None, held)[0]
 
 
-def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> SinglePose | None:
+def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> SinglePose | HeldAt | None:
     """``robot``'s default reduction (``reduction``: None, or a name of it) ready for single poses with the default
     options and ``locked`` joints (None: it does not qualify, ``SinglePose.of``, or the arm, ``locked`` or
-    ``reduction`` is refused: the general path then raises, after the pose's checks)."""
+    ``reduction`` is refused: the general path then raises, after the pose's checks). One joint of a seven-joint arm
+    held: its lock value an argument of the compiled call where the plan allows (``HeldPose``)."""
     held = None
     if locked is not None:
         try:
+            if isinstance(robot, Robot) and robot.n_joints == 7 and isinstance(locked, Mapping) and len(locked) == 1:
+                ((k, v),) = held_values(robot, locked)
+                fast = _held_pose(robot, k)
+                if fast is not None and (reduction is None or is_default(fast.arm, reduction)):
+                    return HeldAt(fast, v)
             held = held_joints(robot, locked)
         except (SweepikError, TypeError):  # (an unhashable value: the general path says what is wrong)
             return None
     if reduction is not None and not is_default(robot if held is None else held.arm, reduction):
         return None
     return _single_pose_of(robot, held)
+
+
+class HeldAt(NamedTuple):
+    """A ``HeldPose`` at one lock value, solved as a ``SinglePose`` is."""
+
+    held: HeldPose
+    value: float
+
+    def solve(self, pose: Array, limits: bool) -> tuple[int, Solutions | None]:
+        return self.held.solve(pose, self.value, limits)
+
+
+@lru_cache(maxsize=16)
+def _held_pose(robot: Robot, k: int) -> HeldPose | None:
+    """``robot`` with joint ``k`` held, its lock value an argument (None: its plan changes with the value, or is not
+    a closed form of ``SinglePose``)."""
+    return HeldPose.of(robot, k, lambda held: _default_reduction(held.arm, held))
 
 
 @lru_cache(maxsize=16)

@@ -50,7 +50,7 @@ from sweepik.reductions.geometric import N_PARAMS, pose_rows
 from sweepik.reductions.kernels import defining_class, lazy_njit
 from sweepik.results import Solutions, no_solution_reason
 
-__all__ = ["SinglePose", "NOT_RIGID"]
+__all__ = ["SinglePose", "NOT_RIGID", "rigid_pose", "answer"]
 
 Array = NDArray[np.float64]
 
@@ -62,7 +62,7 @@ _rigid_values = inlined(rigid_values)
 
 
 @inlined
-def _rigid(T):  # pragma: no cover
+def rigid_pose(T):  # pragma: no cover
     """``validate.rigid_values`` of ``T (4, 4)``."""
     return _rigid_values(
         T[0, 0], T[0, 1], T[0, 2], T[0, 3], T[1, 0], T[1, 1], T[1, 2], T[1, 3],
@@ -98,7 +98,7 @@ def _closed_pose(
     """A closed form's target ``world (4, 4)`` (its chain pose ``chain``) checked, its row built (``pose_rows``'
     arguments ``base`` .. ``row``) and every branch settled (``every_branch_settled``'s arguments after them):
     ``(status, certified, reachable, q, error, error_geodesic, within_limits, multiplicity)``."""
-    if not _rigid(world):
+    if not rigid_pose(world):
         return _not_rigid(rev.shape[0])
     params = _row(chain, base, tool, reverse, r_end, w_tool, row)
     st, c, reachable, q, ep, eg, ins, mu, _ = every_branch_settled(
@@ -122,7 +122,7 @@ def _swept_pose(
     """A sweep's target (as ``_closed_pose``) searched over the circle, certified and settled (``searched_settled``'s
     arguments); ``MEET`` where two of its solutions lie within ``meet`` (``dedupe.any_near``: the general path merges
     them)."""
-    if not _rigid(world):
+    if not rigid_pose(world):
         return _not_rigid(rev.shape[0])
     params = _row(chain, base, tool, reverse, r_end, w_tool, row)
     lo, hi = np.empty(1), np.empty(1)
@@ -211,12 +211,18 @@ class SinglePose:
             out = self._kernel(pose, chain, *head, *tail[:3], search.MAX_CAND, search.MAX_FAM, *tail[3:], limits)
         else:
             out = self._kernel(pose, chain, *self._head, *self._tail, limits)
-        status, c, reachable, q, ep, eg, ins, mu = out
-        if status != OK or c > MAX_ISOLATED_SOLUTIONS:
-            if status == NOT_RIGID:
-                check_poses(pose)
-            return status, None
-        reason = None if q.shape[0] else no_solution_reason(reachable)
-        if self.held is not None:
-            q = self.held.expand(q)
-        return status, Solutions.settled(q, ep, eg, ins, mu, reason, pose.copy(), self.robot)
+        return answer(out, pose, self.robot, None if self.held is None else self.held.expand)
+
+
+def answer(out: tuple[Any, ...], pose: Array, robot: Robot, expand: Any = None) -> tuple[int, Solutions | None]:
+    """A one-pose kernel's ``out`` as ``SinglePose.solve`` returns it (``expand``: the held arm's configurations
+    made full length)."""
+    status, c, reachable, q, ep, eg, ins, mu = out
+    if status != OK or c > MAX_ISOLATED_SOLUTIONS:
+        if status == NOT_RIGID:
+            check_poses(pose)
+        return status, None
+    reason = None if q.shape[0] else no_solution_reason(reachable)
+    if expand is not None:
+        q = expand(q)
+    return status, Solutions.settled(q, ep, eg, ins, mu, reason, pose.copy(), robot)

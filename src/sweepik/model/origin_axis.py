@@ -303,4 +303,8 @@ def _hold(robot: Robot, held: tuple[tuple[int, float], ...]) -> HeldJoints:
         )
     except RobotDefinitionError as exc:  # pragma: no cover - the parts are valid transforms by construction
         raise LockedJointError(str(exc)) from None
+    # The held arm's tolerances are the full arm's, whatever the values held: its own sum of link offsets would
+    # change with them (a held joint turns two offsets into one), and with it every threshold of a solve
+    # (``engine.held_pose`` takes the value as an argument of one compiled call, its thresholds fixed).
+    arm.__dict__["length_scale"] = robot.length_scale  # (``Robot.length_scale`` is a cached property)
     return HeldJoints(robot, arm, free, held)

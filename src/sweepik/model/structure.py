@@ -69,10 +69,11 @@ def line_relation(h1: Array, o1: Array, h2: Array, o2: Array, dist_tol: float) -
         return ("coincident" if off < dist_tol else "parallel"), None
     if abs(float(np.dot(d, n))) / s >= dist_tol:
         return "skew", None
-    # closest points o1 + t1 h1 and o2 + t2 h2 (they meet within tolerance): midpoint
+    # closest points o1 + t1 h1 and o2 + t2 h2 (they meet within tolerance): midpoint. 1 - b^2 of unit axes is s^2,
+    # which keeps its digits where the axes are all but parallel (1 - b^2 rounds to 0 for s below 1e-8)
     b = float(np.dot(h1, h2))
-    t1 = (np.dot(d, h1) - b * np.dot(d, h2)) / (1.0 - b * b)
-    t2 = (b * np.dot(d, h1) - np.dot(d, h2)) / (1.0 - b * b)
+    t1 = (np.dot(d, h1) - b * np.dot(d, h2)) / (s * s)
+    t2 = (b * np.dot(d, h1) - np.dot(d, h2)) / (s * s)
     return "intersecting", 0.5 * ((o1 + t1 * h1) + (o2 + t2 * h2))
 
 
