@@ -19,7 +19,9 @@ import sweepik
 from sweepik import LockedJointError, load_robot, solving
 from sweepik.engine import held_pose
 from sweepik.engine.held_pose import HeldPose
+from sweepik.engine.lock_windows import in_windows
 from sweepik.engine.one_pose import OK
+from sweepik.reductions import first_held_reduction
 from sweepik.results import Solutions
 
 #: (arm, joint) of the bundled seven-joint arms whose held arm is one closed form at every value.
@@ -33,6 +35,8 @@ TAKEN = [
     ("franka_panda", "joint5"),
     ("franka_panda", "joint7"),
 ]
+#: ... and whose held arm is one sweep at every value.
+SWEPT = [("franka_panda", "joint1"), ("franka_panda", "joint3"), ("kinova_gen3", "joint_5"), ("kinova_gen3", "joint_7")]
 
 
 def _general(robot: sweepik.Robot, T: np.ndarray, k: int, value: float) -> Solutions:
@@ -54,7 +58,7 @@ def _fk_ok(robot: sweepik.Robot, sol: Solutions, T: np.ndarray) -> None:
     assert np.abs(F[..., :3, :3] - T[:3, :3]).max(initial=0.0) < 1e-9
 
 
-@pytest.mark.parametrize(("name", "joint"), TAKEN)
+@pytest.mark.parametrize(("name", "joint"), TAKEN + SWEPT)
 def test_the_one_call_is_the_held_arm_at_each_value(name: str, joint: str) -> None:
     """Random values and poses: the one call answers (most poses) with the held arm's own solutions."""
     robot = load_robot(name)
@@ -159,12 +163,11 @@ def test_the_one_call_hands_on_what_it_does_not_settle() -> None:
 
 
 def test_arms_whose_plan_is_not_one_closed_form_at_every_value_are_not_taken() -> None:
-    """A held arm that is a sweep (Panda joint 1), needs a companion (Gen3 joint 1) or is refused (iiwa A4: every pose
-    a continuum) is not taken; nor Panda joint 6, whose axes 5 and 7 meet at a point that slides along axis 5 with
-    the value and are parallel at 0 (another plan there); nor references of two different arms (their rows are not
-    one chain moved), nor a six-joint arm."""
+    """A held arm that needs a companion (Gen3 joint 1) or is refused (iiwa A4: every pose a continuum) is not
+    taken; nor Panda joint 6, whose axes 5 and 7 meet at a point that slides along axis 5 with the value and are
+    parallel at 0 (another plan there); nor references of two different arms (their rows are not one chain moved),
+    nor a six-joint arm."""
     panda, gen3, iiwa = load_robot("franka_panda"), load_robot("kinova_gen3"), load_robot("kuka_iiwa14")
-    assert solving._held_pose(panda, 0) is None
     assert solving._held_pose(panda, 5) is None
     held = sweepik.model.origin_axis.hold_joints(panda, {5: 0.0})
     assert solving._default_reduction(held.arm, held).plan.case != "ab_int"  # (the plan at 0 is another)
@@ -172,7 +175,7 @@ def test_arms_whose_plan_is_not_one_closed_form_at_every_value_are_not_taken() -
     assert solving._held_pose(iiwa, 3) is None
     with pytest.raises(sweepik.NoReductionError):
         sweepik.solve(iiwa, iiwa.fk(np.full(7, 0.3)), locked={"A4": 0.3})
-    assert HeldPose.of(load_robot("ur5"), 0, lambda held: solving._default_reduction(held.arm, held)) is None
+    assert HeldPose.of(load_robot("ur5"), 0, first_held_reduction) is None
     # a reference from another arm (the iiwa's A3 held, but one reference's plan of A5 held): refused
     found = []
     for f in held_pose.REFERENCES:
@@ -180,11 +183,11 @@ def test_arms_whose_plan_is_not_one_closed_form_at_every_value_are_not_taken() -
         held = sweepik.model.origin_axis.hold_joints(iiwa, {2: v})
         red = solving._default_reduction(held.arm, held)
         found.append((v, red, sweepik.engine.single_pose.SinglePose.of(held.arm, red, held)))
-    assert HeldPose._checked(iiwa, 2, False, found) is not None
+    assert HeldPose._checked(iiwa, 2, found) is not None
     other = sweepik.model.origin_axis.hold_joints(iiwa, {4: 0.5})
     red = solving._default_reduction(other.arm, other)
     found[2] = (found[2][0], red, sweepik.engine.single_pose.SinglePose.of(other.arm, red, other))
-    assert HeldPose._checked(iiwa, 2, False, found) is None
+    assert HeldPose._checked(iiwa, 2, found) is None
 
 
 def test_values_are_checked_as_before() -> None:
@@ -202,16 +205,16 @@ def test_values_are_checked_as_before() -> None:
 
 @pytest.mark.parametrize("seed", [0, 3])
 def test_values_where_the_neighbouring_axes_coincide_are_refused_as_before(seed: int) -> None:
-    """iiwa A2 held at 0 puts A1 and A3 on one line (every pose a continuum): refused with NoReductionError, as the
-    held arm built at that value is, also a hair off it and on the arm rewritten (where that value is another
-    number); a thousandth of a radian off it, solved."""
+    """iiwa A2 held at 0 puts A1 and A3 on one line (every pose a continuum): a special value (``lock_windows``),
+    refused with NoReductionError, as the held arm built at that value is, also a hair off it and on the arm
+    rewritten (where that value is another number); a hundredth of a radian off it, solved by the one call."""
     original = load_robot("kuka_iiwa14")
     rw = rewrite(original, np.random.default_rng(seed)) if seed else None
     robot = original if rw is None else rw.robot
     fast = solving._held_pose(robot, 1)
     assert fast is not None
     zero = float(rw.forward(np.zeros(7))[1]) if rw is not None else 0.0
-    assert any(abs(np.angle(np.exp(1j * (c - zero)))) < 1e-12 for c in fast.coaxial)
+    assert in_windows(zero, fast.windows) and not in_windows(zero + 0.01, fast.windows)
     q = in_limit_configurations(original, 3, np.random.default_rng(seed))
     for off in (0.0, 1e-9):
         q[:, 1] = off
@@ -220,7 +223,7 @@ def test_values_where_the_neighbouring_axes_coincide_are_refused_as_before(seed:
             T = robot.fk(q2)
             with pytest.raises(sweepik.NoReductionError):
                 sweepik.solve(robot, T, locked={1: float(q2[1])})
-    q[:, 1] = 1e-3
+    q[:, 1] = 1e-2
     for qq in q:
         q2 = qq if rw is None else rw.forward(qq)
         sol = sweepik.solve(robot, robot.fk(q2), locked={1: float(q2[1])})

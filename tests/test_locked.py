@@ -398,3 +398,21 @@ def test_writers_escape_names(tmp_path: Path) -> None:
     robot = Robot("weird\nname", joints, dh_convention="none", T_flange_tool=base.T_flange_tool, description="a\nb")
     back = _parse(robot_to_toml(robot), "weird.toml")
     assert back.joint_names == robot.joint_names and back.name == robot.name and back.description == "a\nb"
+
+
+def test_a_plan_remembered_from_another_value_gets_a_second_opinion() -> None:
+    """Kinova Gen3, joint 6 held (axes 5 and 7 of the held arm nearly meet at every value): held at 0 first, its plan
+    is remembered; at -0.4934 the short check passes that plan, which alone lost two of a pose's eight solutions (a
+    rounding of its meeting point): this value's own choice joins it as a companion, and the configuration the pose
+    was made from is found."""
+    from sweepik.reductions import _HELD_PLANS
+
+    robot = sweepik.load_robot("kinova_gen3")
+    _HELD_PLANS.clear()
+    q = np.array([1.5874311837898043, -0.019612219433625455, 2.160060773265002, -2.5503606983923333, 1.0427411412059486,
+                  -0.4933821199999999, -1.0891509835647515])  # fmt: skip
+    q0 = q.copy()
+    q0[5] = 0.0
+    sweepik.solve(robot, robot.fk(q0), locked={"joint_6": 0.0}, limits=False)
+    sols = sweepik.solve(robot, robot.fk(q), locked={"joint_6": float(q[5])}, limits=False)
+    assert len(sols) == 8 and recovers(robot, sols, q)

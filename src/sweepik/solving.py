@@ -27,7 +27,7 @@ from sweepik.model.origin_axis import HeldJoints, held_values, hold_joints, lock
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit
 from sweepik.model.validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
-from sweepik.reductions import Reduction, automatic_for_held, get_reduction, is_default
+from sweepik.reductions import Reduction, automatic_for_held, first_held_reduction, get_reduction, is_default
 from sweepik.reductions.decompose import not_sweepable
 from sweepik.results import Block, SolutionBatch, Solutions, no_solution_reason
 
@@ -542,7 +542,7 @@ class HeldAt(NamedTuple):
 def _held_pose(robot: Robot, k: int) -> HeldPose | None:
     """``robot`` with joint ``k`` held, its lock value an argument (None: its plan changes with the value, or is not
     a closed form of ``SinglePose``)."""
-    return HeldPose.of(robot, k, lambda held: _default_reduction(held.arm, held))
+    return HeldPose.of(robot, k, first_held_reduction)
 
 
 @lru_cache(maxsize=16)

@@ -1,7 +1,8 @@
 """A seven-joint arm with one joint held, its lock value an argument of the compiled call (issue 39).
 
 Holding joint ``k`` of a chain at ``v`` makes a six-joint chain whose geometry is the full chain's with the joints
-after ``k`` (and the tool) moved by joint ``k``'s motion at ``v``: a rotation about its axis, or a slide along it.
+after ``k`` (and the tool) turned by ``v`` about joint ``k``'s axis (a revolute joint: a held slide is left to the
+general way).
 The held arm, its plan and its kernel arguments were built for each new value (~2 ms on the iiwa); but when the plan
 is the same at every value, everything else in them is the full arm's geometry moved by that motion. Here the
 compiled call takes ``v`` and builds the held chain, the plan's parameter row (its axes, segments, wrist centre and
@@ -33,20 +34,21 @@ from numba import boolean, float64, int64
 from numpy.typing import NDArray
 
 from sweepik._jit import inlined, writable
-from sweepik.engine.one_pose import OK, SETTLE_CLOSED_SIG, every_branch_settled
+from sweepik.engine import search
+from sweepik.engine.lock_windows import in_windows, special_windows
+from sweepik.engine.one_pose import OK, SETTLE_CLOSED_SIG, SETTLE_ONE_SIG, every_branch_settled
 from sweepik.engine.settings import MAX_ISOLATED_SOLUTIONS
-from sweepik.engine.single_pose import NOT_RIGID, SinglePose, answer, rigid_pose
-from sweepik.model.chain import rotation_about
-from sweepik.model.origin_axis import HeldJoints, hold_joints
+from sweepik.engine.single_pose import NOT_RIGID, SinglePose, answer, rigid_pose, swept_settled
+from sweepik.model.chain import Chain, rotation_about
+from sweepik.model.origin_axis import hold_joints
 from sweepik.model.robot import Robot
-from sweepik.model.structure import INTERSECT_TOL_REL, PARALLEL_TOL
 from sweepik.reductions import GeometricReduction, Reduction
 from sweepik.reductions.geometric import LAYOUT, N_PARAMS, pose_rows
 from sweepik.reductions.kernels import lazy_njit
 from sweepik.results import Block, Solutions
-from sweepik.subproblems.vec import add, dot, rot, scale, sub
+from sweepik.subproblems.vec import add, dot, rot, sub
 
-__all__ = ["HeldPose", "REFERENCES", "COAXIAL", "coaxial_values"]
+__all__ = ["HeldPose", "REFERENCES", "SPECIAL"]
 
 Array = NDArray[np.float64]
 
@@ -55,32 +57,21 @@ Array = NDArray[np.float64]
 REFERENCES = (0.0731, 0.2689, 0.4623, 0.6571, 0.8817)
 #: The parameter row, chain and tool vectors built here equal the held arm's to this, times the length scale.
 MATCH_REL = 1e-12
-#: A lock value this near (radians, or the length unit) one where two axes of the held arm coincide is solved the
-#: general way (its own plan, or a refusal): the one call's plan has no meaning there.
-COAXIAL_NEAR = 1e-6
-#: ``HeldPose.solve``'s status for such a value.
-COAXIAL = -2
+#: ``HeldPose.solve``'s status for a value in its ``windows`` (the general way answers).
+SPECIAL = -2
 
 _H, _P, _W, _O = LAYOUT["H"], LAYOUT["P"], LAYOUT["W"], LAYOUT["O"]
 _M = LAYOUT["M"]
 
 
 @inlined
-def _moved(x, value, h, o, slide):  # pragma: no cover
-    """The point ``x`` moved by the joint of axis ``h`` through ``o`` at ``value`` (a tuple)."""
-    if slide:
-        return add(x, scale(value, h))
+def _moved(x, value, h, o):  # pragma: no cover
+    """The point ``x`` turned by ``value`` about the axis ``h`` through ``o`` (a tuple)."""
     return add(o, rot(h, value, sub(x, o)))
 
 
 @inlined
-def _turned(d, value, h, slide):  # pragma: no cover
-    """The direction ``d`` turned by that joint (a slide turns nothing)."""
-    return (d[0], d[1], d[2]) if slide else rot(h, value, d)
-
-
-@inlined
-def _held_chain(value, GH, pts, GR, k, slide):  # pragma: no cover
+def _held_chain(value, GH, pts, GR, k):  # pragma: no cover
     """The world chain of the full chain (axes ``GH (n, 3)``, joint points then the tool's ``pts (n + 1, 3)``, tool
     orientation ``GR``) with joint ``k`` held at ``value``: ``(H (n-1, 3), P (n, 3), R_end)``."""
     n = GH.shape[0]
@@ -91,16 +82,16 @@ def _held_chain(value, GH, pts, GR, k, slide):  # pragma: no cover
     for i in range(n + 1):
         if i == k:
             continue
-        x = (pts[i, 0], pts[i, 1], pts[i, 2]) if i < k else _moved(pts[i], value, h, o, slide)
+        x = (pts[i, 0], pts[i, 1], pts[i, 2]) if i < k else _moved(pts[i], value, h, o)
         d = sub(x, prev)
         P[j, 0], P[j, 1], P[j, 2] = d
         prev = x
         if i < n:
-            a = (GH[i, 0], GH[i, 1], GH[i, 2]) if i < k else _turned(GH[i], value, h, slide)
+            a = (GH[i, 0], GH[i, 1], GH[i, 2]) if i < k else rot(h, value, GH[i])
             H[j, 0], H[j, 1], H[j, 2] = a
         j += 1
     for c in range(3):
-        R_end[0, c], R_end[1, c], R_end[2, c] = _turned(GR[:, c], value, h, slide)
+        R_end[0, c], R_end[1, c], R_end[2, c] = rot(h, value, GR[:, c])
     return H, P, R_end
 
 
@@ -124,12 +115,12 @@ def _solved(H, P, R_end, reverse):  # pragma: no cover
 
 
 @inlined
-def _held_args(value, GH, pts, GR, k, slide, reverse, marks, moves, template):  # pragma: no cover
+def _held_args(value, GH, pts, GR, k, reverse, marks, moves, template):  # pragma: no cover
     """The held chain ``(H, P, R_end)`` at ``value`` and ``pose_rows``' arguments for its plan: the row (``template``
     with the solved chain's axes, segments, wrist centre and meeting point: ``marks`` at value 0 in the world,
     ``moves``: carried by the held joint), the solved chain's tool orientation and the wrist centre in the tool
     frame."""
-    H, P, R_end = _held_chain(value, GH, pts, GR, k, slide)
+    H, P, R_end = _held_chain(value, GH, pts, GR, k)
     end = _sum_rows(P)
     Hs, Ps, Rs = _solved(H, P, R_end, reverse)
     row = template.copy()
@@ -144,7 +135,7 @@ def _held_args(value, GH, pts, GR, k, slide, reverse, marks, moves, template):  
     for m in range(2):
         x = (marks[m, 0], marks[m, 1], marks[m, 2])
         if moves[m]:
-            x = _moved(x, value, GH[k], pts[k], slide)
+            x = _moved(x, value, GH[k], pts[k])
         if reverse:  # (the reversed chain's world is the tool frame at zero)
             x = _inverse_turned(R_end, sub(x, end))
         at = _W if m == 0 else _O
@@ -171,16 +162,20 @@ def _inverse_turned(R, v):  # pragma: no cover
     return (dot(R[:, 0], v), dot(R[:, 1], v), dot(R[:, 2], v))
 
 
-_GEOMETRY_SIG = (
-    float64, float64[:, ::1], float64[:, ::1], float64[:, ::1], int64, boolean, boolean, float64[:, ::1],
-    boolean[::1], float64[::1],
-)  # fmt: skip
+_CHAIN_SIG = (float64, float64[:, ::1], float64[:, ::1], float64[:, ::1], int64)
+_GEOMETRY_SIG = _CHAIN_SIG + (boolean, float64[:, ::1], boolean[::1], float64[::1])
+
+
+@lazy_njit(_CHAIN_SIG, cache=True, nogil=True)
+def held_chain(value, GH, pts, GR, k):  # pragma: no cover
+    """``_held_chain`` called from Python (``HeldPose.chain_at``)."""
+    return _held_chain(value, GH, pts, GR, k)
 
 
 @lazy_njit(_GEOMETRY_SIG, cache=True, nogil=True)
-def held_args(value, GH, pts, GR, k, slide, reverse, marks, moves, template):  # pragma: no cover
+def held_args(value, GH, pts, GR, k, reverse, marks, moves, template):  # pragma: no cover
     """``_held_args`` called from Python (``HeldPose.of`` checks it against the held arm's)."""
-    return _held_args(value, GH, pts, GR, k, slide, reverse, marks, moves, template)
+    return _held_args(value, GH, pts, GR, k, reverse, marks, moves, template)
 
 
 @lazy_njit(
@@ -190,132 +185,190 @@ def held_args(value, GH, pts, GR, k, slide, reverse, marks, moves, template):  #
     nogil=True,
 )  # fmt: skip
 def _held_closed_pose(
-    world, value, GH, pts, GR, k, slide, reverse, marks, moves, template, addr, nb, rev, weight, thr, lrev, lower,
+    world, value, GH, pts, GR, k, reverse, marks, moves, template, addr, nb, rev, weight, thr, lrev, lower,
     upper, ltol, beyond, reach, tol, scale, s_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
     """``single_pose._closed_pose`` for the held chain at ``value`` (``_held_args``' arguments after ``world``):
     ``(status, certified, reachable, q, error, error_geodesic, within_limits, multiplicity)`` with ``q`` full length,
     ``value`` in column ``k``."""
     if not rigid_pose(world):
-        none = np.empty(0)
-        return NOT_RIGID, 0, 0, np.empty((0, GH.shape[0])), none, none, np.empty(0, np.bool_), np.empty(0, np.int64)
-    H, P, R_end, row, r_end, w_tool = _held_args(value, GH, pts, GR, k, slide, reverse, marks, moves, template)
-    eye = np.eye(4)
-    params = np.empty((1, N_PARAMS))
-    pose_rows(world.reshape((1, 4, 4)), eye, eye, reverse, r_end, w_tool, row, params)
+        return _not_rigid_full(GH.shape[0])
+    H, P, R_end, row, r_end, w_tool = _held_args(value, GH, pts, GR, k, reverse, marks, moves, template)
+    params = _params(world, reverse, r_end, w_tool, row)
     st, c, reachable, q, ep, eg, ins, mu, _ = every_branch_settled(
         addr, params, world.reshape((1, 4, 4)), nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond,
         reach, tol, scale, s_thr, meet, only_inside,
     )  # fmt: skip
+    return st, c, reachable, _full(q, k, value), ep, eg, ins, mu
+
+
+@inlined
+def _not_rigid_full(n):  # pragma: no cover
+    """The kernels' answer for a target that is not a rigid transform (``n`` joints)."""
+    none = np.empty(0)
+    return NOT_RIGID, 0, 0, np.empty((0, n)), none, none, np.empty(0, np.bool_), np.empty(0, np.int64)
+
+
+@inlined
+def _params(world, reverse, r_end, w_tool, row):  # pragma: no cover
+    """The target's parameter row ``(1, N_PARAMS)`` (``pose_rows`` of the world pose: no base or tool)."""
+    eye = np.eye(4)
+    params = np.empty((1, N_PARAMS))
+    pose_rows(world.reshape((1, 4, 4)), eye, eye, reverse, r_end, w_tool, row, params)
+    return params
+
+
+@inlined
+def _full(q, k, value):  # pragma: no cover
+    """The held arm's configurations ``q (m, n - 1)`` full length, ``value`` in column ``k``."""
     full = np.empty((q.shape[0], q.shape[1] + 1))
     for r in range(q.shape[0]):
-        j = 0
-        for i in range(full.shape[1]):
-            if i == k:
-                full[r, i] = value
-            else:
-                full[r, i] = q[r, j]
-                j += 1
-    return st, c, reachable, full, ep, eg, ins, mu
+        for i in range(k):
+            full[r, i] = q[r, i]
+        full[r, k] = value
+        for i in range(k, q.shape[1]):
+            full[r, i + 1] = q[r, i]
+    return full
+
+
+@lazy_njit(
+    (float64[:, ::1],) + _GEOMETRY_SIG + SETTLE_ONE_SIG[:6] + SETTLE_ONE_SIG[11:18] + SETTLE_ONE_SIG[21:22]
+    + SETTLE_ONE_SIG[23:35] + (float64[::1],) + SETTLE_ONE_SIG[35:],
+    cache=True,
+    nogil=True,
+)  # fmt: skip
+def _held_swept_pose(
+    world, value, GH, pts, GR, k, reverse, marks, moves, template, addr, plan, branches, m_branches, steps,
+    noise, s, ends, twins, max_cand, max_fam, limits, clip, rev, weight, thr, lrev, lower, upper, ltol, beyond, reach,
+    tol, scale, c_joints, c_thr, meet, only_inside,
+):  # pragma: no cover  # fmt: skip
+    """``single_pose._swept_pose`` for the held chain at ``value``, as ``_held_closed_pose``."""
+    if not rigid_pose(world):
+        return _not_rigid_full(GH.shape[0])
+    H, P, R_end, row, r_end, w_tool = _held_args(value, GH, pts, GR, k, reverse, marks, moves, template)
+    params = _params(world, reverse, r_end, w_tool, row)
+    st, c, reachable, q, ep, eg, ins, mu = swept_settled(
+        world, params, addr, plan, branches, m_branches, steps, noise, s, ends, twins, max_cand, max_fam, limits, clip,
+        H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, c_joints, c_thr, meet,
+        only_inside,
+    )  # fmt: skip
+    return st, c, reachable, _full(q, k, value), ep, eg, ins, mu
+
+
+#: Where the chain's ``H``, ``P``, ``R_end`` and the probed thresholds (the largest of the references' taken) sit in
+#: a ``SinglePose``'s fixed arguments after the row's (``_head[6:] + _tail``), for a closed form and a sweep.
+_CHAIN_AT = {False: (2, 3, 5), True: (11, 12, 14)}
+_LARGEST_AT = {False: (16,), True: (5, 26)}
 
 
 class HeldPose:
-    """A seven-joint arm with joint ``k`` held, its closed form's arguments built in the compiled call from the lock
-    value (module docstring): ``of(robot, k, reduction_of)``, then ``solve(pose, value, limits)`` per pose."""
+    """A seven-joint arm with revolute joint ``k`` held, its closed form's or sweep's arguments built in the compiled
+    call from the lock value (module docstring): ``of(robot, k, reduction_of)``, then ``solve(pose, value, limits)``
+    per pose."""
 
-    __slots__ = ("robot", "joint", "arm", "coaxial", "_geometry", "_tail", "_period")
+    __slots__ = ("robot", "joint", "arm", "windows", "_geometry", "_fixed", "_sweeps")
 
     def __init__(
-        self, robot: Robot, joint: int, arm: Robot, geometry: tuple[Any, ...], tail: tuple[Any, ...]
+        self, robot: Robot, joint: int, arm: Robot, geometry: tuple[Any, ...], fixed: tuple[Any, ...], sweeps: bool
     ) -> None:  # fmt: skip
         self.robot = robot
         self.joint = joint
         self.arm = arm  # (the held arm at a reference value: what its reduction is named)
-        GH, pts, _, _, slide = geometry[:5]
-        #: values at which two axes of the held arm coincide (``coaxial_values``)
-        self.coaxial = coaxial_values(robot, joint, GH, pts)
-        self._period = math.inf if slide else 2.0 * math.pi
+        #: the values the general way answers (``lock_windows.special_windows``; set by ``of``)
+        self.windows = np.zeros((0, 2))
         self._geometry = geometry  # (the full chain, the joint, the plan's direction, marks and row)
-        self._tail = tail  # (the settling's arguments, as ``SinglePose``'s without the chain)
+        self._fixed = fixed  # (the settling's arguments, as ``SinglePose``'s without the chain)
+        self._sweeps = sweeps
 
     @classmethod
-    def of(cls, robot: Robot, k: int, reduction_of: Callable[[HeldJoints], Reduction]) -> HeldPose | None:
-        """``robot`` with joint ``k`` held, its plan checked at ``REFERENCES`` (``reduction_of(held)``: the held
-        arm's default reduction); None where it does not qualify (not seven joints, a plan that is not the same
-        closed form of ``SinglePose`` at every reference, a row that is not the full chain moved)."""
-        if robot.n_joints != 7:
+    def of(cls, robot: Robot, k: int, reduction_of: Callable[[Robot], Reduction | None]) -> HeldPose | None:
+        """``robot`` with joint ``k`` held, its plan checked at ``REFERENCES`` (``reduction_of(arm)``: the held arm's
+        automatic reduction at a value seen for the first time, None where it checks every plan); None where it does
+        not qualify (not seven joints, a slide held, a plan that is not the same closed form or sweep of
+        ``SinglePose`` at every reference, a row that is not the full chain moved, a reference at a special value)."""
+        if robot.n_joints != 7 or not robot.is_revolute[k]:
             return None
-        lo, hi = float(robot.lower[k]), float(robot.upper[k])
-        slide = not bool(robot.is_revolute[k])
-        if not slide:
-            lo, hi = max(lo, -math.pi), min(hi, math.pi)
+        lo, hi = max(float(robot.lower[k]), -math.pi), min(float(robot.upper[k]), math.pi)
         if not hi > lo:
             return None
-        refs = [lo + f * (hi - lo) for f in REFERENCES]
         found = []
-        for v in refs:
+        for v in (lo + f * (hi - lo) for f in REFERENCES):
             held = hold_joints(robot, {k: v})
-            try:
-                red = reduction_of(held)
-            except Exception:  # noqa: BLE001 (a value the arm refuses: the general path says why)
-                return None
+            red = reduction_of(held.arm)
             sp = SinglePose.of(held.arm, red, held) if isinstance(red, GeometricReduction) else None
-            if sp is None or sp._sweeps or not red.closed_form:
+            if sp is None:
                 return None
             found.append((v, red, sp))
-        return cls._checked(robot, k, slide, found)
+        made = cls._checked(robot, k, found)
+        if made is None:
+            return None
+        windows = special_windows(robot, k, made.chain_at, lambda v: _plan_at(robot, k, v, reduction_of), found[0][0])
+        if any(in_windows(v, windows) for v, _, _ in found):
+            return None
+        made.windows = windows
+        return made
+
+    def chain_at(self, value: float) -> Chain:
+        """The held arm's chain at ``value`` (world frame, as its ``Robot.chain``)."""
+        GH, pts, GR, k = self._geometry[:4]
+        H, P, R_end = held_chain(value, GH, pts, GR, k)
+        return Chain(H, P, np.delete(self.robot.is_revolute, k), R_end)
 
     @classmethod
-    def _checked(cls, robot: Robot, k: int, slide: bool, found: list[tuple[float, Any, SinglePose]]) -> HeldPose | None:
+    def _checked(cls, robot: Robot, k: int, found: list[tuple[float, Any, SinglePose]]) -> HeldPose | None:
         """``of`` once the references' reductions are found: the same plan at each, and this module's arguments
         equal to theirs."""
-        plan0 = found[0][1].plan
+        plan0, sweeps = found[0][1].plan, found[0][2]._sweeps
         same = ("family", "reversed", "free", "case", "branches", "conditional")
-        if any(tuple(getattr(r.plan, a) for a in same) != tuple(getattr(plan0, a) for a in same) for _, r, _ in found):
+        if any(
+            tuple(getattr(r.plan, a) for a in same) != tuple(getattr(plan0, a) for a in same) or sp._sweeps != sweeps
+            for _, r, sp in found
+        ):
             return None
         ch = robot.chain
         GH = writable(ch.H)
         pts = writable(np.concatenate([ch.points, ch.P.sum(axis=0)[None]]))
-        GR = writable(ch.R_end)
-        reverse = bool(plan0.reversed)
-        marks, moves = cls._marks(robot, k, slide, found, pts, GH)
+        marks, moves = cls._marks(robot, k, found, pts, GH)
         if marks is None:
             return None
-        tails = [sp._tail for _, _, sp in found]
-        template = writable(found[0][2]._head[5])
-        geometry = (GH, pts, GR, int(k), slide, reverse, marks, moves, template)
+        reverse, template = bool(plan0.reversed), found[0][2]._head[5]
+        geometry = (GH, pts, writable(ch.R_end), int(k), reverse, marks, moves, template)
         tol = MATCH_REL * robot.length_scale
-        for (v, _, sp), tail in zip(found, tails, strict=True):
+        chain_at, largest_at = _CHAIN_AT[sweeps], _LARGEST_AT[sweeps]
+        rest = [(*sp._head[6:], *sp._tail) for _, _, sp in found]
+        for (v, _, sp), args in zip(found, rest, strict=True):
             H, P, R_end, row, r_end, w_tool = held_args(v, *geometry)
-            head = sp._head
+            head, (at_H, at_P, at_R) = sp._head, chain_at
             fixed = np.r_[row[:_M], row[_W:]] - np.r_[head[5][:_M], head[5][_W:]]
             if not (
                 np.abs(fixed).max() <= tol
                 and np.abs(w_tool - head[4]).max() <= tol
                 and np.abs(r_end - head[3]).max() <= MATCH_REL
-                and np.abs(H - tail[2]).max() <= MATCH_REL
-                and np.abs(P - tail[3]).max() <= tol
-                and np.abs(R_end - tail[5]).max() <= MATCH_REL
+                and np.abs(H - args[at_H]).max() <= MATCH_REL
+                and np.abs(P - args[at_P]).max() <= tol
+                and np.abs(R_end - args[at_R]).max() <= MATCH_REL
             ):
                 return None
-        # the arguments that are not the chain's: the same at every reference (the singular thresholds: the largest)
-        keep = (0, 1, 4, *range(6, 16), 17)
-        for tail in tails[1:]:
-            for i in keep:
-                a, b = tails[0][i], tail[i]
-                if not (a is b or np.array_equal(np.asarray(a), np.asarray(b))):
-                    return None
-        s_thr = writable(np.max([t[16] for t in tails], axis=0))
-        t0 = tails[0]
-        return cls(robot, int(k), found[0][1].robot, geometry, (t0[0], t0[1], t0[4], *t0[6:16], s_thr, t0[17]))
+        # the arguments that are not the chain's: the same at every reference (the probed thresholds: the largest)
+        out = []
+        for i, a in enumerate(rest[0]):
+            if i in chain_at:
+                continue
+            if i in largest_at:
+                a = np.max([r[i] for r in rest], axis=0)
+                out.append(writable(a) if np.ndim(a) else float(a))
+            elif all(r[i] is a or np.array_equal(np.asarray(r[i]), np.asarray(a)) for r in rest[1:]):
+                out.append(a)
+            else:
+                return None
+        return cls(robot, int(k), found[0][1].robot, geometry, tuple(out), sweeps)
 
     @staticmethod
     def _marks(
-        robot: Robot, k: int, slide: bool, found: list[tuple[float, Any, SinglePose]], pts: Array,
-        GH: Array,
+        robot: Robot, k: int, found: list[tuple[float, Any, SinglePose]], pts: Array, GH: Array
     ) -> tuple[Array | None, NDArray[np.bool_]]:  # fmt: skip
-        """The plan's wrist centre and meeting point at value 0 in the world ``(2, 3)`` and whether each moves with
-        the held joint; None where one is neither fixed nor carried."""
+        """The plan's wrist centre and meeting point at value 0 in the world ``(2, 3)`` and whether each turns with
+        the held joint; None where one neither stays nor turns with it."""
         tol = MATCH_REL * 10.0 * robot.length_scale
         marks, moves = np.empty((2, 3)), np.zeros(2, dtype=np.bool_)
         for m in range(2):
@@ -326,11 +379,7 @@ class HeldPose:
                     ch = red.robot.chain
                     x = ch.R_end @ x + ch.P.sum(axis=0)
                 fixed.append(x)
-                if slide:
-                    carried.append(x - v * GH[k])
-                else:
-                    R = rotation_about(GH[k], -v)
-                    carried.append(R @ (x - pts[k]) + pts[k])
+                carried.append(rotation_about(GH[k], -v) @ (x - pts[k]) + pts[k])
             for i, cand in enumerate((fixed, carried)):
                 if np.abs(np.array(cand) - cand[0]).max() <= tol:
                     marks[m], moves[m] = cand[0], bool(i)
@@ -378,48 +427,33 @@ class HeldPose:
         )
 
     def _call(self, pose: Array, value: float, limits: bool) -> tuple[Any, ...]:
-        """The compiled call's answer for ``pose`` at ``value``; ``(COAXIAL, 0)`` within ``COAXIAL_NEAR`` of a value
-        where two of the held arm's axes coincide."""
-        for c in self.coaxial:
-            d = abs(value - c) % self._period  # (a turn away is the same angle)
-            if min(d, self._period - d) < COAXIAL_NEAR:
-                return COAXIAL, 0
-        return _held_closed_pose(pose, value, *self._geometry, *self._tail, limits)
+        """The compiled call's answer for ``pose`` at ``value``; ``(SPECIAL, 0)`` at a value in ``windows``."""
+        if in_windows(value, self.windows):
+            return SPECIAL, 0
+        if self._sweeps:  # (the buffers read here: a test may cut them)
+            fixed = self._fixed
+            buffers = (search.MAX_CAND, search.MAX_FAM)
+            return _held_swept_pose(pose, value, *self._geometry, *fixed[:9], *buffers, *fixed[9:], limits)
+        return _held_closed_pose(pose, value, *self._geometry, *self._fixed, limits)
 
     def solve(self, pose: Array, value: float, limits: bool) -> tuple[int, Solutions | None]:
         """``SinglePose.solve`` with the held joint at ``value`` (checked by the caller: ``held_values``)."""
         out = self._call(pose, value, limits)
-        if out[0] == COAXIAL:
-            return COAXIAL, None
+        if out[0] == SPECIAL:
+            return SPECIAL, None
         return answer(out, pose, self.robot)
 
 
-def coaxial_values(robot: Robot, k: int, GH: Array, pts: Array) -> tuple[float, ...]:
-    """The values of joint ``k`` at which its neighbours' axes coincide, both revolute (a continuum at every pose),
-    or run along one direction, both slides: the held arm is degenerate there, and its plan is not the plan of the
-    other values. (Only the neighbours: no joint between them moves one against the other.) ``GH``, ``pts``: the
-    full chain's axes and joint points at zero."""
-    a, b, rev = k - 1, k + 1, robot.is_revolute
-    if a < 0 or b >= GH.shape[0] or rev[a] != rev[b]:
-        return ()
-    hk, ok = GH[k], pts[k]
-    out: list[float] = []
-    for target in (GH[a], -GH[a]):
-        if rev[k]:  # the angle turning b's direction onto a's about hk (sp1), where there is one
-            u, w = GH[b] - (GH[b] @ hk) * hk, target - (target @ hk) * hk
-            v = math.atan2(float(hk @ np.cross(u, w)), float(u @ w))
-            R = rotation_about(hk, v)
-            if np.abs(R @ GH[b] - target).max() > PARALLEL_TOL:
-                continue
-            point = R @ (pts[b] - ok) + ok
-        else:  # a slide turns nothing: parallel directions, the slide that puts b's point on a's line
-            s = hk - (hk @ target) * target
-            if np.abs(GH[b] - target).max() > PARALLEL_TOL or not rev[b] or s @ s < PARALLEL_TOL:
-                continue  # (two slides: parallel at every value or none; the plan says which)
-            e = pts[b] - pts[a]
-            v = -float((e - (e @ target) * target) @ s) / float(s @ s)
-            point = pts[b] + v * hk
-        d = point - pts[a]
-        if not rev[b] or np.linalg.norm(d - (d @ target) * target) <= INTERSECT_TOL_REL * robot.length_scale:
-            out.append(float(v))
-    return tuple(out)
+def _plan_at(robot: Robot, k: int, v: float, reduction_of: Callable[[Robot], Reduction | None]) -> object:
+    """The plan (family, chain, theta*, case, branches, blind spot) that ``reduction_of`` chooses for ``robot`` held
+    at ``v`` or a turn of it within the limits, None for none or one with a companion; ``"unreachable"`` where no
+    turn of ``v`` is."""
+    for w in (v, v + 2.0 * math.pi, v - 2.0 * math.pi):
+        tol = float(robot.limit_tol[k])
+        if robot.lower[k] - tol <= w <= robot.upper[k] + tol:
+            red = reduction_of(hold_joints(robot, {k: w}).arm)
+            if not isinstance(red, GeometricReduction) or red.companion is not None:
+                return None
+            p = red.plan
+            return p.family, p.reversed, p.free, p.case, p.branches, p.conditional
+    return "unreachable"

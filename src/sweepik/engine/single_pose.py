@@ -50,7 +50,7 @@ from sweepik.reductions.geometric import N_PARAMS, pose_rows
 from sweepik.reductions.kernels import defining_class, lazy_njit
 from sweepik.results import Solutions, no_solution_reason
 
-__all__ = ["SinglePose", "NOT_RIGID", "rigid_pose", "answer"]
+__all__ = ["SinglePose", "NOT_RIGID", "rigid_pose", "answer", "swept_settled"]
 
 Array = NDArray[np.float64]
 
@@ -125,6 +125,20 @@ def _swept_pose(
     if not rigid_pose(world):
         return _not_rigid(rev.shape[0])
     params = _row(chain, base, tool, reverse, r_end, w_tool, row)
+    return swept_settled(
+        world, params, addr, plan, branches, m_branches, steps, noise, s, ends, twins, max_cand, max_fam, limits, clip,
+        H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, c_joints, c_thr, meet,
+        only_inside,
+    )  # fmt: skip
+
+
+@inlined
+def swept_settled(
+    world, params, addr, plan, branches, m_branches, steps, noise, s, ends, twins, max_cand, max_fam, limits, clip, H,
+    P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, c_joints, c_thr, meet,
+    only_inside,
+):  # pragma: no cover  # fmt: skip
+    """``_swept_pose`` once the target is checked and its row ``params (1, N_PARAMS)`` built."""
     lo, hi = np.empty(1), np.empty(1)
     lo[0], hi[0] = -math.pi, math.pi
     st, c, reachable, q, ep, eg, ins, mu = searched_settled(

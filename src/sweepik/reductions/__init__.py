@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from functools import lru_cache
 
-from sweepik.errors import UnknownOptionError
+from sweepik.errors import NoReductionError, UnknownOptionError
 from sweepik.model.robot import Robot
 from sweepik.reductions import decompose
 from sweepik.reductions.base import Reduction
@@ -26,6 +26,7 @@ __all__ = [
     "REDUCTIONS",
     "get_reduction",
     "is_default",
+    "first_held_reduction",
     "AUTO",
     "set_plan_check",
     "automatic_for_held",
@@ -130,6 +131,8 @@ def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduct
         plan, _ = decompose.choice(arm, None, hints)
         if plan in hints:  # (the other plan chosen with it, unchecked: a companion only adds solutions)
             comp = next((p for p in hints if p != plan), None)
+            if comp is None:  # (none remembered: this value's own choice, or its companion, as a second opinion)
+                comp = _own_second(arm, plan)
         else:
             comp = decompose.companion_plan(arm)
     red = _held_reduction(arm, plan, comp)
@@ -137,6 +140,27 @@ def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduct
         _HELD_PLANS.clear()
     _HELD_PLANS[key] = (_signature(plan), None if comp is None else _signature(comp))
     return red
+
+
+def _own_second(arm: Robot, plan: Plan) -> Plan | None:
+    """A companion for ``plan``, the plan remembered from other values that the short check at these values found
+    sound: the plan this value alone chooses, or its companion where that is ``plan``. A check that samples
+    configurations can pass a plan that loses a pose's roots near the near-structure (the Kinova Gen3 with joint 6
+    held at -0.49 after 0: two of eight, by a rounding of the meeting point)."""
+    try:
+        own, _ = decompose.choice(arm, None)
+    except NoReductionError:
+        return None
+    return own if own != plan else decompose.companion_plan(arm)
+
+
+def first_held_reduction(arm: Robot) -> Reduction | None:
+    """``automatic_for_held``'s reduction of ``arm`` (an arm with joints held) at values never held before: its first
+    plan without a blind spot, no companion; None where that choice checks every plan (a near-structure, a
+    continuum everywhere, no plan). Whatever other values chose (``engine.held_pose`` checks the plan of a joint's
+    values with it)."""
+    lazy = _without_near_structure(arm, ())
+    return None if lazy is None else _held_reduction(arm, lazy[0], None)
 
 
 def _without_near_structure(arm: Robot, sigs: tuple[_Sig | None, ...]) -> tuple[Plan, Plan | None] | None:

@@ -1,0 +1,153 @@
+"""The lock values at which a held arm is not the arm it is at other values (``held_pose``'s exceptions).
+
+Holding joint ``k`` of a seven-joint arm turns the axes after it about its axis; the relations between an axis before
+``k`` and one after it change with the value. At most values they are those of every other value, but near a few
+they come close to holding (two axes nearly parallel, the neighbours of ``k`` nearly meeting: a near-structure, where
+the automatic choice checks every plan and may join a companion) or hold exactly (another structure, another plan, or
+none: two axes on one line). ``special_windows`` finds those values once per arm and joint:
+
+1. a grid of one turn, ``NEAR_TOL / 4`` apart, flags each value where an axis before ``k`` and one after it are within
+   twice ``NEAR_TOL`` of parallel (the sine of their angle changes at most as fast as the value), or the neighbours
+   of ``k`` within twice ``NEAR_TOL`` (times the length scale) of meeting, unless the relation holds at every value;
+2. at each flagged value the held arm's own checks (``structure.near_structure``, ``structure.structure_of``) decide:
+   a near-structure, or a structure other than at the other values, marks it;
+3. where an axis before ``k`` turns perpendicular to one after it (a blind spot of some plans), the plan the held
+   arm chooses there (``plan_at``) must be the one of other values, else that value is marked;
+
+and returns the marked values, widened by two grid steps, as windows ``(m, 2)`` (radians, within one turn).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sweepik.model.chain import Chain
+from sweepik.model.robot import Robot
+from sweepik.model.structure import (
+    INTERSECT_TOL_REL,
+    NEAR_TOL,
+    PARALLEL_TOL,
+    Structure,
+    near_structure,
+    structure_of,
+)
+
+__all__ = ["special_windows", "in_windows", "GRID_STEP"]
+
+Array = NDArray[np.float64]
+
+#: The grid's step (radians): a quarter of the near-structure tolerance.
+GRID_STEP = NEAR_TOL / 4.0
+#: A value marked for its plan alone (step 3) is taken within this of it.
+EXACT_WINDOW = 1e-6
+
+
+def _turned(u: Array, h: Array, c: Array, s: Array) -> Array:
+    """``u (..., 3)`` turned about the unit axis ``h`` by the angles of cosines ``c (N,)`` and sines ``s``:
+    ``(N, ..., 3)`` (Rodrigues)."""
+    shape = (-1,) + (1,) * (u.ndim - 1) + (1,)
+    c, s = c.reshape(shape), s.reshape(shape)
+    return u * c + np.cross(h, u) * s + (u @ h)[..., None] * h * (1.0 - c)
+
+
+def _relations(structure: Structure) -> tuple[Any, ...]:
+    return structure.pairs, structure.parallel, structure.spherical
+
+
+def special_windows(
+    robot: Robot, k: int, chain_at: Callable[[float], Chain], plan_at: Callable[[float], object], reference: float
+) -> Array:
+    """The windows ``(m, 2)`` of values of revolute joint ``k`` (one turn, ``[-pi, pi]``; an end at -inf or inf: the
+    window goes round) where ``robot`` held at ``k`` is not the arm it is at ``reference`` (module docstring).
+    ``chain_at(v)``: the held arm's chain at ``v``; ``plan_at(v)``: its plan there (anything comparable)."""
+    ch = robot.chain
+    H, pts = ch.H, ch.points
+    n, hk, ok = ch.n_joints, ch.H[k], ch.points[k]
+    scale = robot.length_scale
+    grid = np.arange(-math.pi, math.pi, GRID_STEP)
+    c, s = np.cos(grid), np.sin(grid)
+    after = list(range(k + 1, n))
+    Ha = _turned(H[after], hk, c, s)  # (N, len(after), 3)
+    flag = np.zeros(grid.size, dtype=bool)
+    for i in range(k):
+        sines = np.linalg.norm(np.cross(H[i], Ha), axis=-1)  # (N, len(after))
+        for col in range(len(after)):
+            if sines[:, col].max() >= PARALLEL_TOL:  # (parallel at every value: the same structure at all)
+                flag |= sines[:, col] < 2.0 * NEAR_TOL
+    a, b = k - 1, k + 1
+    rev = robot.is_revolute
+    if a >= 0 and b < n and rev[a] and rev[b]:
+        pb = _turned(pts[b] - ok, hk, c, s) + ok  # (N, 3)
+        nrm = np.cross(H[a], Ha[:, 0])
+        sn = np.linalg.norm(nrm, axis=-1)
+        with np.errstate(all="ignore"):
+            d = np.abs(np.einsum("ij,ij->i", pb - pts[a], nrm)) / sn / scale
+        d = np.where(sn < NEAR_TOL, 0.0, d)  # (nearly parallel: flagged above)
+        if np.nanmax(d) >= INTERSECT_TOL_REL:
+            flag |= d < 2.0 * NEAR_TOL
+    near = np.convolve(flag, np.ones(5), mode="same") > 0  # (and the two values either side)
+    generic = _relations(structure_of(chain_at(reference), scale))
+    plan = plan_at(reference)
+    marked = np.zeros(grid.size, dtype=bool)
+    for g in np.nonzero(near)[0]:
+        held = chain_at(float(grid[g]))
+        if near_structure(held, scale) or _relations(structure_of(held, scale)) != generic:
+            marked[g] = True
+    windows = _runs(grid, np.convolve(marked, np.ones(5), mode="same") > 0)
+    for v in _perpendicular(H, hk, k, n):
+        if plan_at(v) != plan:
+            windows.append((v - EXACT_WINDOW, v + EXACT_WINDOW))
+    merged: list[list[float]] = []
+    for lo, hi in sorted(windows):
+        if merged and lo <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], hi)
+        else:
+            merged.append([lo, hi])
+    return np.array(merged, dtype=np.float64).reshape(-1, 2)
+
+
+def _runs(grid: Array, mask: NDArray[np.bool_]) -> list[tuple[float, float]]:
+    """The runs of ``mask`` as intervals of ``grid`` (a run at either end reaches past it: the turn closes)."""
+    out: list[tuple[float, float]] = []
+    idx = np.nonzero(mask)[0]
+    if idx.size == 0:
+        return out
+    breaks = np.nonzero(np.diff(idx) > 1)[0]
+    for s, e in zip(np.r_[0, breaks + 1], np.r_[breaks, idx.size - 1], strict=True):
+        lo, hi = float(grid[idx[s]]), float(grid[idx[e]])
+        lo = -math.inf if idx[s] == 0 else lo
+        hi = math.inf if idx[e] == grid.size - 1 else hi
+        out.append((lo, hi))
+    return out
+
+
+def _perpendicular(H: Array, hk: Array, k: int, n: int) -> list[float]:
+    """The values at which an axis before ``k`` is perpendicular to one after it (``H[i] . R(v) H[j] = 0``:
+    ``A cos v + B sin v + C``), where that is not so at every value."""
+    out = []
+    for i in range(k):
+        for j in range(k + 1, n):
+            u = H[j]
+            A = float(H[i] @ (u - (u @ hk) * hk))
+            B = float(H[i] @ np.cross(hk, u))
+            C = float((H[i] @ hk) * (u @ hk))
+            r = math.hypot(A, B)
+            if r < PARALLEL_TOL or abs(C) > r:
+                continue
+            phi, delta = math.atan2(B, A), math.acos(max(-1.0, min(1.0, -C / r)))
+            out += [math.remainder(phi + delta, 2.0 * math.pi), math.remainder(phi - delta, 2.0 * math.pi)]
+    return sorted(set(out))
+
+
+def in_windows(value: float, windows: Array) -> bool:
+    """Whether ``value`` (radians, any turn) lies in one of ``windows`` (``special_windows``)."""
+    if windows.shape[0] == 0:
+        return False
+    v = math.remainder(value, 2.0 * math.pi)
+    i = int(np.searchsorted(windows[:, 0], v, side="right")) - 1
+    return bool(i >= 0 and v <= windows[i, 1])
