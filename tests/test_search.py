@@ -282,3 +282,29 @@ def test_domain_edge_samples_lie_inside_their_domains(name: str) -> None:
     assert (touching[outside]).all(), cand.theta[outside & ~touching]
     assert outside.sum() <= edge.sum() / 10
     assert (np.abs(after[edge] - before[edge]) <= 1e-8).all()
+
+
+def test_a_domain_edge_hidden_between_two_samples_is_searched() -> None:
+    """Flexiv Rizon 4 of ssik's catalogue, rewritten (tests/data/rizon4_rewritten.toml), joint 7 held: branch 3 of
+    the held arm's sweep lives on [-0.0039, 0.0900], and two roots 7e-5 apart sit 1.5e-3 inside its right edge. The
+    margins' sweep missed that edge (a pair of close zeros of a margin), so no sample marked it: the samples around it
+    were one inside (0.0499) and one outside (0.0917), and the stretch between went unsearched (the pose answered
+    "unreachable"). The compiled search and its NumPy reference now locate the edge and search up to it."""
+    from pathlib import Path
+
+    from sweepik.engine.chunk import chain_poses
+
+    robot = load_robot(str(Path(__file__).parent / "data" / "rizon4_rewritten.toml"))
+    q = np.array([0.08851973794656232, 0.2905707832504163, -2.5798371727465472, 1.9845555624869284,
+                  -1.6838111600274586, -0.9725832260768259, -2.820486620872427])  # fmt: skip
+    T = robot.fk(q)
+    sols = sweepik.solve(robot, T, locked={6: float(q[6])}, limits=False)
+    assert len(sols) and np.abs(robot.fk(sols.q) - T).max() < 1e-9 * robot.length_scale
+    d = np.abs(np.angle(np.exp(1j * (sols.q - q))))
+    assert np.min(np.max(d, axis=1)) < 1e-6
+    held = sweepik.solving.held_joints(robot, {6: float(q[6])})
+    red = sweepik.solving._default_reduction(held.arm, held)
+    chain = chain_poses(held.arm, T[None])
+    lo, hi = np.array([-np.pi]), np.array([np.pi])
+    for cand in (search.search(red, chain, lo, hi, 64)[0], sweep.find_candidates(red, chain, lo, hi, 64)[0]):
+        assert np.any((cand.branch == 3) & (np.abs(cand.theta - q[0]) < 1e-9))

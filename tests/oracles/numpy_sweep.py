@@ -10,6 +10,8 @@ giving one residual sequence per (pose, branch). On each sequence:
   (as the root of a central difference of the residual); if it crosses zero there are two close roots
   (bracketed on either side), if it touches zero it is a double root (certified later by forward kinematics);
 * samples at the edge of a branch's domain (next to NaN) and at the ends of the range -> candidates;
+* an edge between a sample inside the domain and one outside it, not at the inside sample (no margin zero marked
+  it) -> located by bisection, a candidate, and the stretch up to it resampled as an interval next to an edge;
 * intervals where the curve bends enough to hide two roots between its samples (judged from second
   differences), or that touch a domain edge (square-root behaviour), are resampled more finely, recursively,
   and searched the same way;
@@ -194,6 +196,67 @@ class _Search:
         r_i, r_j = np.nonzero(refine)
         if r_i.size:
             self._resample(p, b, th, f, fin, r_i, r_j, level, near_edge, open_l, open_r, ctx, edge_x)
+        if level < MAX_LEVELS and self.signed:
+            self._hidden_edges(p, b, th, fin, valid, level, edge_left, edge_right, ctx)
+
+    def _hidden_edges(
+        self,
+        p: IntArray,
+        b: IntArray,
+        th: Array,
+        fin: Array,
+        valid: NDArray[np.bool_],
+        level: int,
+        edge_left: NDArray[np.bool_],
+        edge_right: NDArray[np.bool_],
+        ctx: tuple[Array, Array, Array, Array] | None,
+    ) -> None:
+        """``scan``'s step 6 (``search._hidden_edge``): an interval with one sample in the branch's domain whose
+        edge is not at that sample: the edge located by bisection (a candidate where the residual is near zero
+        there), the stretch from the inside sample to it resampled as an interval next to an edge."""
+        S, M = th.shape
+        h_i, h_j = np.nonzero((valid[:, :-1] != valid[:, 1:]) & (th[:, 1:] > th[:, :-1]))
+        right = valid[h_i, h_j]
+        inside = np.where(right, th[h_i, h_j], th[h_i, h_j + 1])
+        outside = np.where(right, th[h_i, h_j + 1], th[h_i, h_j])
+        span = self.span[p[h_i]]
+        out = self.residual(p[h_i], b[h_i], outside[:, None])[:, 0]  # (a family's sample is masked, not outside)
+        probe = self.residual(p[h_i], b[h_i], (inside + np.where(right, 1.0, -1.0) * EDGE_PROBE_REL * span)[:, None])
+        hidden = ~np.isfinite(out) & np.isfinite(probe[:, 0])
+        h_i, h_j, right, inside, outside, span = (a[hidden] for a in (h_i, h_j, right, inside, outside, span))
+        if not h_i.size:
+            return
+        pp, bb = p[h_i], b[h_i]
+        active = np.abs(outside - inside) > EDGE_PROBE_REL * span
+        while active.any():
+            k = np.nonzero(active)[0]
+            mid = 0.5 * (inside[k] + outside[k])
+            ok = np.isfinite(self.residual(pp[k], bb[k], mid[:, None])[:, 0])
+            inside[k[ok]], outside[k[~ok]] = mid[ok], mid[~ok]
+            active = np.abs(outside - inside) > EDGE_PROBE_REL * span
+        fe = self.residual(pp, bb, inside[:, None])[:, 0]
+        near = np.abs(fe) <= self.far
+        self._root(pp[near], bb[near], inside[near])
+        a = np.where(right, th[h_i, h_j], th[h_i, h_j + 1])
+        fa = np.where(right, fin[h_i, h_j], fin[h_i, h_j + 1])
+        lo, hi = np.where(right, a, inside), np.where(right, inside, a)
+        sub = lo[:, None] + (hi - lo)[:, None] * U_EDGE[None, :]
+        fs = self.residual(pp, bb, sub)
+        fs[:, 0], fs[:, -1] = np.where(right, fa, fe), np.where(right, fe, fa)
+        nan = np.full(h_i.size, np.nan)
+        has_l, has_r = h_j >= 1, h_j + 2 <= M - 1
+        jl, jr = np.maximum(h_j - 1, 0), np.minimum(h_j + 2, M - 1)
+        prev_open = np.where(h_j == 0, edge_left[h_i], ~valid[h_i, jl])
+        next_open = np.where(h_j + 1 == M - 1, edge_right[h_i], ~valid[h_i, jr])
+        el = np.where(right, prev_open, True)
+        er = np.where(right, True, next_open)
+        c0 = (nan, nan, nan, nan) if ctx is None else (ctx[0][h_i], ctx[1][h_i], ctx[2][h_i], ctx[3][h_i])
+        cl_t = np.where(right, np.where(has_l, th[h_i, jl], c0[0]), th[h_i, h_j])
+        cl_f = np.where(right, np.where(has_l, fin[h_i, jl], c0[1]), fin[h_i, h_j])
+        cr_t = np.where(right, th[h_i, h_j + 1], np.where(has_r, th[h_i, jr], c0[2]))
+        cr_f = np.where(right, fin[h_i, h_j + 1], np.where(has_r, fin[h_i, jr], c0[3]))
+        ex = np.where(el & er, np.nan, inside)
+        self.scan(pp, bb, sub, fs, np.isfinite(fs), level + 1, el, er, (cl_t, cl_f, cr_t, cr_f), ex)
 
     def _extrema_of(
         self, p: IntArray, b: IntArray, th: Array, fin: Array, ctx: tuple[Array, Array, Array, Array] | None

@@ -1,7 +1,8 @@
 """The precise sweep's candidate search, compiled (Numba): per pose and branch, sample theta*, bracket sign changes
-(Chandrupatla), locate extrema, keep domain-edge samples, resample bending or edge-adjacent intervals recursively,
-detect families and merge noise-level clusters. Poses run in parallel threads (:mod:`sweepik.engine.parallel`).
-The tests hold it against a NumPy reference of the same steps (``tests/oracles/numpy_sweep.py``).
+(Chandrupatla), locate extrema, keep domain-edge samples, locate a domain edge hidden between two samples, resample
+bending or edge-adjacent intervals recursively, detect families and merge noise-level clusters. Poses run in parallel
+threads (:mod:`sweepik.engine.parallel`). The tests hold it against a NumPy reference of the same steps
+(``tests/oracles/numpy_sweep.py``).
 
 A kernel is ``residual(params, theta, branch) -> float`` compiled with ``numba.njit`` to the signature
 ``reductions.kernels.RESIDUAL_SIG``, where ``params`` is one row of ``Reduction.kernel_params(poses)``; the
@@ -429,18 +430,69 @@ def _edge_samples(b, th, f, valid, level, fmask, noise, out_t, out_b, cnt):
             _push(out_t, out_b, cnt, th[j], b)
 
 
+@inlined
+def _hidden_edge(
+    res, p, b, th, f, valid, j, level, el, er, ctx, span, noise, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
+    signed,
+):  # pragma: no cover  # fmt: skip
+    """``_scan``, a signed residual, below the last level: interval j has one sample in the branch's domain and one
+    outside it (else nothing: a sample masked as a family's is not outside). A domain edge at the inside sample
+    (the residual just past it not finite: a margin's zero, sampled) is already the scan's. Elsewhere the edge is
+    hidden between the samples (a margin's pair of close zeros that the margins' sweep missed): it is located by
+    bisection, is a candidate where the residual there is near zero (as ``_edge_samples``), and the stretch from the
+    inside sample to it is resampled as an interval next to an edge (a root beside the edge, or a pair of close ones,
+    would otherwise go unsearched)."""
+    if not (level < MAX_LEVELS and signed and valid[j] != valid[j + 1] and th[j + 1] > th[j]):
+        return
+    M = th.shape[0]
+    right = valid[j]  # (the edge on the interval's right)
+    inside, outside = (th[j], th[j + 1]) if right else (th[j + 1], th[j])
+    side = 1.0 if right else -1.0
+    if not math.isfinite(res(p, inside + side * EDGE_PROBE_REL * span, b)) or math.isfinite(res(p, outside, b)):
+        return  # (the edge at the inside sample, as mostly; or a sample masked as a family's, not outside)
+    while abs(outside - inside) > EDGE_PROBE_REL * span:
+        mid = 0.5 * (inside + outside)
+        if math.isfinite(res(p, mid, b)):
+            inside = mid
+        else:
+            outside = mid
+    fe = res(p, inside, b)
+    if abs(fe) <= FAR_NOISE * noise:
+        _push(out_t, out_b, cnt, inside, b)
+    if top[0] >= stk_t.shape[0]:
+        cnt[0] += out_t.shape[0] + 1  # overflow: the caller redoes this pose with larger buffers
+        return
+    k0 = top[0]
+    a, fa = (th[j], f[j]) if right else (th[j + 1], f[j + 1])
+    lo, hi = (a, inside) if right else (inside, a)
+    for k in range(SUB_SAMPLES + 2):
+        stk_t[k0, k] = lo + (hi - lo) * _U_EDGE_ARR[k]
+    stk_f[k0, 0], stk_f[k0, SUB_SAMPLES + 1] = (fa, fe) if right else (fe, fa)
+    for k in range(1, SUB_SAMPLES + 1):
+        stk_f[k0, k] = res(p, stk_t[k0, k], b)
+    open_l = True if not right else (el if j == 0 else not valid[j - 1])
+    open_r = True if right else (er if j + 1 == M - 1 else not valid[j + 2])
+    stk_i[k0, 0], stk_i[k0, 1], stk_i[k0, 2] = level + 1, 1 if open_l else 0, 1 if open_r else 0
+    if right:
+        stk_c[k0, 0], stk_c[k0, 1] = (th[j - 1], f[j - 1]) if j >= 1 else (ctx[0], ctx[1])
+        stk_c[k0, 2], stk_c[k0, 3] = th[j + 1], f[j + 1]
+    else:
+        stk_c[k0, 0], stk_c[k0, 1] = th[j], f[j]
+        stk_c[k0, 2], stk_c[k0, 3] = (th[j + 2], f[j + 2]) if j + 2 <= M - 1 else (ctx[2], ctx[3])
+    stk_c[k0, 4] = np.nan if open_l and open_r else inside
+    top[0] += 1
+
+
 @internal
 def _scan(
     res, p, b, th, f, level, el, er, ctx, xe, span, noise, xtol, out_t, out_b, cnt, stk_t, stk_f, stk_i, stk_c, top,
     wv, wx, res_all, n_all, edge_f, edge_ok, fmask, f_all, later, signed,
 ):  # fmt: skip
-    """One sequence; intervals to resample are pushed on the stack (no recursion: Numba's cache cannot
-    hold recursive functions). ``ctx``: (theta, f) left and right of the sequence, ``xe``: the edge whose
-    coordinate judges curvature (NaN: theta), ``fmask``: the samples masked as a family's (read at level 0
-    only); ``signed``: the residual changes sign at a simple root (not the pose error's norm,
-    ``PoseErrorResidual``: an edge at a sample is then judged as any other). Level 0: ``f_all`` the sequence's
-    residuals on every branch, ``later`` the branches searched after this one; ``edge_f``, ``edge_ok`` the
-    all-branch sub-samples of its intervals (next to an edge, then not), and which are known."""
+    """One sequence; intervals to resample go on the stack (Numba's cache holds no recursive function). ``ctx``: (theta,
+    f) left and right of it, ``xe``: the edge whose coordinate judges curvature (NaN: theta), ``fmask``: samples masked
+    as a family's (level 0); ``signed``: not the pose error's norm (``PoseErrorResidual``: an edge at a sample judged as
+    any other). Level 0: ``f_all`` its residuals on every branch, ``later`` the branches searched after this one;
+    ``edge_f``, ``edge_ok`` the all-branch sub-samples of its intervals (next to an edge, then not), which are known."""
     M = th.shape[0]
     valid = wv[:M]  # work arrays of the pose (no allocation per sequence)
     for j in range(M):  # (and the samples on a root: the ends of a resampled interval are its parent's)
@@ -466,6 +518,8 @@ def _scan(
             if hl != 0.0 and hr != 0.0:  # (decreasing where the edge is on the right: same dd)
                 c2 = _dd(f[j], f[j + 1], f[j + 2], hl, hr)
         if not (valid[j] and valid[j + 1] and th[j + 1] > th[j]):
+            _hidden_edge(res, p, b, th, f, valid, j, level, el, er, ctx, span, noise, out_t, out_b, cnt, stk_t, stk_f,
+                         stk_i, stk_c, top, signed)  # fmt: skip
             continue
         prod = f[j] * f[j + 1]
         refine = False
