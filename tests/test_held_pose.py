@@ -144,7 +144,7 @@ def test_solve_many_with_a_value_per_pose_is_solve(name: str, joint: str) -> Non
     )
     for got, one in zip(streamed, batch, strict=True):
         np.testing.assert_array_equal(got.q, one.q)
-    assert seen == [0, 5, 10, 15, 16]
+    assert seen[0] == 0 and seen[-1] == 16 and seen == sorted(seen) and max(np.diff(seen)) <= 5
     grid = np.linspace(robot.lower[k], robot.upper[k], 9)[1:-1]
     for v, sols in zip(grid, sweepik.solve_many(robot, T[0], locked={joint: grid}), strict=True):
         np.testing.assert_array_equal(sols.q, sweepik.solve(robot, T[0], locked={joint: float(v)}).q)
@@ -228,3 +228,24 @@ def test_values_where_the_neighbouring_axes_coincide_are_refused_as_before(seed:
         q2 = qq if rw is None else rw.forward(qq)
         sol = sweepik.solve(robot, robot.fk(q2), locked={1: float(q2[1])})
         assert recovers(robot, sol, q2)
+
+
+def test_long_runs_of_one_value_are_solved_batched(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A batch held at one value (a run of ``HELD_RUN_MIN`` poses or more) goes the batched way, by the held arm; the
+    short runs around it pose by pose; the solutions are each pose's, the held value in place."""
+    robot = load_robot("kuka_iiwa14")
+    q = in_limit_configurations(robot, solving.HELD_RUN_MIN + 6, np.random.default_rng(3))
+    q[3 : 3 + solving.HELD_RUN_MIN, 2] = 0.7
+    T = robot.fk(q)
+    taken: list[int] = []
+    blocks = HeldPose.blocks
+    monkeypatch.setattr(HeldPose, "blocks", lambda self, P, *a: taken.append(len(P)) or blocks(self, P, *a))
+    batch = sweepik.solve_many(robot, T, locked={"A3": q[:, 2]})
+    assert taken == [3, 3]
+    for i in range(len(q)):
+        assert np.all(batch[i].q[:, 2] == q[i, 2]) and recovers(robot, batch[i], q[i])
+    taken.clear()
+    sweepik.solve_many(robot, T[:10], locked={"A3": 0.7})
+    assert taken == [10]
+    sweepik.solve_many(robot, T, locked={"A3": 0.7})
+    assert taken == [10]

@@ -115,17 +115,49 @@ def solve_many(
     options: dict[str, Any] = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples)
     options.update(chunk_size=chunk_size, free_joint=free_joint)
     fast = _held_values(robot, P, runs, options, windings)
-    if fast is not None:
-        held, values = fast
-
-        def general(i: int) -> Iterator[Block]:
-            return _held_run(robot, P[i : i + 1], {held.joint: float(values[i])}, options)
-
-        return SolutionBatch(robot, held.blocks(writable(P), values, limits, general))
     blocks: list[Block] = []
-    for s, e, lock in runs:
-        blocks.extend(_held_run(robot, P[s:e], lock, options, windings))
+    for s, e, lock in _segments(runs, fast is not None):
+        if lock is _BY_VALUE:  # (short runs: the lock value an argument of one compiled call per pose)
+            assert fast is not None
+            blocks.extend(_held_blocks(robot, P, fast, options, s, e))
+        else:
+            blocks.extend(_held_run(robot, P[s:e], lock, options, windings))
     return SolutionBatch(robot, blocks)
+
+
+#: Runs of at least this many consecutive poses with the same lock value are solved batched by their held arm; shorter
+#: ones (a value per pose) pose by pose with the value an argument (``engine.held_pose``, ~15 us a pose either way
+#: where the held arm is cached, ~2 ms more per run where it is built for a new value).
+HELD_RUN_MIN = 64
+#: ``_segments``' mark of the poses ``HeldPose`` takes.
+_BY_VALUE = object()
+
+
+def _segments(runs: list[tuple[int, int, object]], fast: bool) -> list[tuple[int, int, object]]:
+    """``runs`` with consecutive ones shorter than ``HELD_RUN_MIN`` joined as ``(start, stop, _BY_VALUE)`` (with
+    ``fast``: a ``HeldPose`` takes them)."""
+    out: list[tuple[int, int, object]] = []
+    for s, e, lock in runs:
+        if not (fast and e - s < HELD_RUN_MIN):
+            out.append((s, e, lock))
+        elif out and out[-1][2] is _BY_VALUE:
+            out[-1] = (out[-1][0], e, _BY_VALUE)
+        else:
+            out.append((s, e, _BY_VALUE))
+    return out
+
+
+def _held_blocks(
+    robot: Robot, P: Array, fast: tuple[HeldPose, Array], options: dict[str, Any], s: int, e: int
+) -> list[Block]:
+    """The blocks of poses ``s .. e - 1`` of ``P`` from ``fast``'s compiled call, each pose at its own lock value; a
+    pose it does not settle by its held arm (``_held_run``)."""
+    held, values = fast
+
+    def general(i: int) -> Iterator[Block]:
+        return _held_run(robot, P[s + i : s + i + 1], {held.joint: float(values[s + i])}, options)
+
+    return held.blocks(writable(P[s:e]), values[s:e], options["limits"], general)
 
 
 def _held_run(
@@ -237,11 +269,11 @@ def iter_solve(
     options: dict[str, Any] = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples)
     options.update(chunk_size=chunk_size, free_joint=free_joint)
     fast = _held_values(robot, P, runs, options, windings)
-    if fast is not None:
-        return _iter_held(robot, P, fast, options, progress)
-    held = held_joints(robot, runs[0][2]) if runs else None
-    first = prepare(robot if held is None else held.arm, P[: runs[0][1]], **options, held=held) if runs else None
-    return _iter_checked(robot, P, runs, first, options, progress, windings)
+    first = None
+    if runs and not (fast is not None and runs[0][1] - runs[0][0] < HELD_RUN_MIN):
+        held = held_joints(robot, runs[0][2])
+        first = prepare(robot if held is None else held.arm, P[: runs[0][1]], **options, held=held)
+    return _iter_held(robot, P, runs, fast, first, options, progress, windings)
 
 
 class Prepared(NamedTuple):
@@ -398,48 +430,34 @@ def _free_joint_index(robot: Robot, free_joint: object, reduction: object) -> in
     return check_int(free_joint, "free_joint", 0, robot.n_joints - 1)
 
 
-def _iter_checked(
+def _iter_held(
     robot: Robot,
     P: Array,
     runs: list[tuple[int, int, object]],
+    fast: tuple[HeldPose, Array] | None,
     first: Prepared | None,
     options: dict[str, Any],
-    progress: Progress | None = None,
-    windings: bool = False,
+    progress: Progress | None,
+    windings: bool,
 ) -> Iterator[Solutions]:
-    """``iter_solve``'s generator: the runs of ``_pose_runs`` chunk by chunk, the first run's options ``first``
-    prepared by the caller (the arguments' checks), the others' when their turn comes."""
-    total, done = P.shape[0], 0
+    """``iter_solve``'s generator: ``_segments`` of ``runs``, long runs chunk by chunk by their held arms (the first
+    run's options ``first`` prepared by the caller: the arguments' checks; the others' when their turn comes), short
+    ones ``chunk_size`` poses at a time through ``fast``."""
+    total, done, step = P.shape[0], 0, options["chunk_size"]
     if progress is not None:
         progress("solve", 0, total)
-    for r, (s, e, lock) in enumerate(runs):
-        for block in _held_run(robot, P[s:e], lock, options, windings, first if r == 0 else None):
+    for s, e, lock in _segments(runs, fast is not None):
+        if lock is _BY_VALUE:
+            assert fast is not None
+            parts = (_held_blocks(robot, P, fast, options, a, min(a + step, e)) for a in range(s, e, step))
+            blocks: Iterator[Block] = (b for part in parts for b in part)
+        else:
+            blocks = _held_run(robot, P[s:e], lock, options, windings, first if s == 0 else None)
+        for block in blocks:
             yield from block
             done += block.n
             if progress is not None:
                 progress("solve", done, total)
-
-
-def _iter_held(
-    robot: Robot, P: Array, fast: tuple[HeldPose, Array], options: dict[str, Any], progress: Progress | None
-) -> Iterator[Solutions]:
-    """``_iter_checked`` for ``_held_values``' one call with the lock value an argument, ``chunk_size`` poses at a
-    time."""
-    held, values = fast
-    total, step = P.shape[0], options["chunk_size"]
-    W = writable(P)
-    if progress is not None:
-        progress("solve", 0, total)
-    for s in range(0, total, step):
-        e = min(s + step, total)
-
-        def general(i: int, s: int = s) -> Iterator[Block]:
-            return _held_run(robot, P[s + i : s + i + 1], {held.joint: float(values[s + i])}, options)
-
-        for block in held.blocks(W[s:e], values[s:e], options["limits"], general):
-            yield from block
-        if progress is not None:
-            progress("solve", e, total)
 
 
 def _solve_one(
