@@ -37,6 +37,7 @@ def main() -> None:
     panda = sweepik.load_robot("franka_panda")
     batch(sweepik.load_robot("kuka_iiwa14"), locked={"A3": 0.3})
     batch(panda, locked={"joint7": 0.3})
+    batch(panda, locked={"joint1": 0.3})  # (a held sweep, its value an argument: engine.held_pose)
     from general_arms import random_arm
 
     for kind, k in (("6r", 0), ("5r1p", 0), ("4r2p", 1)):
