@@ -1,26 +1,27 @@
 """A seven-joint arm with one joint held, its lock value an argument of the compiled call (issue 39).
 
-Holding joint ``k`` of a chain at ``v`` makes a six-joint chain whose geometry is the full chain's with the joints
-after ``k`` (and the tool) turned by ``v`` about joint ``k``'s axis (a revolute joint: a held slide is left to the
-general way).
-The held arm, its plan and its kernel arguments were built for each new value (~2 ms on the iiwa); but when the plan
-is the same at every value, everything else in them is the full arm's geometry moved by that motion. Here the
+Holding joint ``k`` of a chain at ``v`` makes a six-joint chain whose geometry is the full chain's with the joints after
+``k`` (and the tool) turned by ``v`` about joint ``k``'s axis (a revolute joint: a held slide is left to the general
+way). The held arm, its plan and its kernel arguments were built for each new value (~2 ms on the iiwa); but when the
+plan is the same at every value, everything else in them is the full arm's geometry moved by that motion. Here the
 compiled call takes ``v`` and builds the held chain, the plan's parameter row (its axes, segments, wrist centre and
-meeting point) and the certification's chain itself, then settles every branch as ``single_pose`` does: a new value
-costs what the same value costs.
+meeting point) and the certification's chain itself, then settles the pose as ``single_pose`` does (every branch of a
+closed form, or a sweep's search): a new value costs what the same value costs.
 
-When the plan holds at every value (``HeldPose.of``): the plan chosen for the held arm at five values spread over
-the joint's range (``REFERENCES``) must be the same family, case, theta* and chain direction at each; its wrist
-centre and meeting point each either fixed in the world or carried by the held joint's motion (a point on the held
+When the plan holds at every value (``HeldPose.of``): the plan chosen for the held arm at five values spread over the
+joint's range (``REFERENCES``; the choice at a value seen first, ``reductions.first_held_reduction``, so that what is
+taken does not depend on what was solved before) must be the same family, case, theta* and chain direction at each; its
+wrist centre and meeting point each either fixed in the world or carried by the held joint's motion (a point on the held
 axis is both); and this module's parameter row, chain and tool vectors must equal the held arm's at those values to
-rounding. That makes the plan's structure hold at every value: axes that meet at a point fixed in the world, or
-carried with them, meet whatever the value; a direction turned by the held joint is a trigonometric polynomial of
-degree one in the value, so one parallel to another at five values is parallel at all. (Axes that meet at a point
-sliding along one of them are not taken: they are parallel at some value, where the plan changes - Panda joint 6.)
-The arguments that do not depend on the geometry are the held arm's at every value (its length scale is the full
-arm's: ``origin_axis.hold_joints``); the singular set's thresholds (typical step amplitudes, probed) are the largest
-of the five: a pose nearer its singular set than that goes the general way, where the held arm at its own value
-answers. So does every pose the one call does not settle (``single_pose``).
+rounding. That makes the plan's structure hold at every value: axes that meet at a point fixed in the world, or carried
+with them, meet whatever the value; a direction turned by the held joint is a trigonometric polynomial of degree one in
+the value, so one parallel to another at five values is parallel at all. (Axes that meet at a point sliding along one of
+them are not taken: they are parallel at some value, where the plan changes - Panda joint 6.) The arguments that do not
+depend on the geometry are the held arm's at every value (its length scale is the full arm's:
+``origin_axis.hold_joints``); the singular set's thresholds (typical step amplitudes, probed) are the largest of the
+five: a pose nearer its singular set than that goes the general way, where the held arm at its own value answers. So
+does every pose the one call does not settle (``single_pose``), and every value near which the held arm is another arm
+(a near-structure, another structure, another plan: ``lock_windows``).
 """
 
 from __future__ import annotations
