@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from sweepik._jit import writable
 from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
-from sweepik.engine.held_pose import HeldPose
+from sweepik.engine.held_pose import SPECIAL, HeldPose
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.settings import N_SAMPLES
 from sweepik.engine.single_pose import NOT_RIGID, SinglePose
@@ -559,7 +559,7 @@ class HeldAt(NamedTuple):
 @lru_cache(maxsize=16)
 def _held_pose(robot: Robot, k: int) -> HeldPose | None:
     """``robot`` with joint ``k`` held, its lock value an argument (None: its plan changes with the value, or is not
-    a closed form of ``SinglePose``)."""
+    a closed form or sweep of ``SinglePose``: ``HeldPose.of``)."""
     return HeldPose.of(robot, k, first_held_reduction)
 
 
@@ -641,7 +641,7 @@ def solve(
             status, sol = fast.solve(pose, limits)
             if sol is not None:
                 return sol
-            one_call = status == NOT_RIGID  # (else the one call was made: the general path answers)
+            one_call = status in (NOT_RIGID, SPECIAL)  # (else the one call was made: the general path answers)
     P = check_poses(pose, "pose")
     if P.shape != (4, 4):
         raise ShapeError(f"pose must have shape (4, 4), got {P.shape}; use solve_many for batches")
