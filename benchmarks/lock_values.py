@@ -31,7 +31,10 @@ def main() -> None:
     # fresh configurations (and lock values) for each measurement: held arms and their reductions are cached
     q = np.random.default_rng(2).uniform(arm.lower, arm.upper, (3 * n + 1, arm.n_joints))
     T = arm.fk(q)
-    sweepik.solve(arm, T[0], locked={args.joint: float(q[0, k])})  # (kernels loaded)
+    # (kernels loaded: the one call's, and the general path's that the poses it hands on take, ~30 ms once a process)
+    sweepik.solve(arm, T[0], locked={args.joint: float(q[0, k])})
+    warm = np.clip(q[1:, k] + 0.01, arm.lower[k], arm.upper[k])
+    sweepik.solve_many(arm, T[1:], limits=False, locked={args.joint: warm})
     if args.parts:
         parts(arm, args.joint, q[1 : n + 1], T[1 : n + 1])
         return
