@@ -39,12 +39,12 @@ from sweepik.engine import search
 from sweepik.engine.lock_windows import in_windows, special_windows
 from sweepik.engine.one_pose import OK, SETTLE_CLOSED_SIG, SETTLE_ONE_SIG, every_branch_settled
 from sweepik.engine.settings import MAX_ISOLATED_SOLUTIONS
-from sweepik.engine.single_pose import NOT_RIGID, SinglePose, answer, rigid_pose, swept_settled
+from sweepik.engine.single_pose import SinglePose, answer, not_rigid, pose_row, rigid_pose, swept_settled
 from sweepik.model.chain import Chain, rotation_about
 from sweepik.model.origin_axis import hold_joints
 from sweepik.model.robot import Robot
 from sweepik.reductions import GeometricReduction, Reduction
-from sweepik.reductions.geometric import LAYOUT, N_PARAMS, pose_rows
+from sweepik.reductions.geometric import LAYOUT
 from sweepik.reductions.kernels import lazy_njit
 from sweepik.results import Block, Solutions
 from sweepik.subproblems.vec import add, dot, rot, sub
@@ -62,6 +62,8 @@ MATCH_REL = 1e-12
 SPECIAL = -2
 
 _H, _P, _W, _O = LAYOUT["H"], LAYOUT["P"], LAYOUT["W"], LAYOUT["O"]
+#: The base and tool transforms ``pose_rows`` takes: the held chain is the world chain (none to take off).
+_EYE = np.eye(4)
 _M = LAYOUT["M"]
 
 
@@ -193,30 +195,14 @@ def _held_closed_pose(
     ``(status, certified, reachable, q, error, error_geodesic, within_limits, multiplicity)`` with ``q`` full length,
     ``value`` in column ``k``."""
     if not rigid_pose(world):
-        return _not_rigid_full(GH.shape[0])
+        return not_rigid(GH.shape[0])
     H, P, R_end, row, r_end, w_tool = _held_args(value, GH, pts, GR, k, reverse, marks, moves, template)
-    params = _params(world, reverse, r_end, w_tool, row)
+    params = pose_row(world, _EYE, _EYE, reverse, r_end, w_tool, row)
     st, c, reachable, q, ep, eg, ins, mu, _ = every_branch_settled(
         addr, params, world.reshape((1, 4, 4)), nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond,
         reach, tol, scale, s_thr, meet, only_inside,
     )  # fmt: skip
     return st, c, reachable, _full(q, k, value), ep, eg, ins, mu
-
-
-@inlined
-def _not_rigid_full(n):  # pragma: no cover
-    """The kernels' answer for a target that is not a rigid transform (``n`` joints)."""
-    none = np.empty(0)
-    return NOT_RIGID, 0, 0, np.empty((0, n)), none, none, np.empty(0, np.bool_), np.empty(0, np.int64)
-
-
-@inlined
-def _params(world, reverse, r_end, w_tool, row):  # pragma: no cover
-    """The target's parameter row ``(1, N_PARAMS)`` (``pose_rows`` of the world pose: no base or tool)."""
-    eye = np.eye(4)
-    params = np.empty((1, N_PARAMS))
-    pose_rows(world.reshape((1, 4, 4)), eye, eye, reverse, r_end, w_tool, row, params)
-    return params
 
 
 @inlined
@@ -245,9 +231,9 @@ def _held_swept_pose(
 ):  # pragma: no cover  # fmt: skip
     """``single_pose._swept_pose`` for the held chain at ``value``, as ``_held_closed_pose``."""
     if not rigid_pose(world):
-        return _not_rigid_full(GH.shape[0])
+        return not_rigid(GH.shape[0])
     H, P, R_end, row, r_end, w_tool = _held_args(value, GH, pts, GR, k, reverse, marks, moves, template)
-    params = _params(world, reverse, r_end, w_tool, row)
+    params = pose_row(world, _EYE, _EYE, reverse, r_end, w_tool, row)
     st, c, reachable, q, ep, eg, ins, mu = swept_settled(
         world, params, addr, plan, branches, m_branches, steps, noise, s, ends, twins, max_cand, max_fam, limits, clip,
         H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, c_joints, c_thr, meet,
@@ -320,11 +306,7 @@ class HeldPose:
         """``of`` once the references' reductions are found: the same plan at each, and this module's arguments
         equal to theirs."""
         plan0, sweeps = found[0][1].plan, found[0][2]._sweeps
-        same = ("family", "reversed", "free", "case", "branches", "conditional")
-        if any(
-            tuple(getattr(r.plan, a) for a in same) != tuple(getattr(plan0, a) for a in same) or sp._sweeps != sweeps
-            for _, r, sp in found
-        ):
+        if any(_signature(r.plan) != _signature(plan0) or sp._sweeps != sweeps for _, r, sp in found):
             return None
         ch = robot.chain
         GH = writable(ch.H)
@@ -455,6 +437,10 @@ def _plan_at(robot: Robot, k: int, v: float, reduction_of: Callable[[Robot], Red
             red = reduction_of(hold_joints(robot, {k: w}).arm)
             if not isinstance(red, GeometricReduction) or red.companion is not None:
                 return None
-            p = red.plan
-            return p.family, p.reversed, p.free, p.case, p.branches, p.conditional
+            return _signature(red.plan)
     return "unreachable"
+
+
+def _signature(p: Any) -> tuple[Any, ...]:
+    """What a plan is, its wrist centre and meeting point aside: family, chain, theta*, case, branches, blind spot."""
+    return p.family, p.reversed, p.free, p.case, p.branches, p.conditional

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.model.chain import Chain
+from sweepik.model.chain import Chain, rotation_about
 from sweepik.model.robot import Robot
 from sweepik.model.structure import (
     INTERSECT_TOL_REL,
@@ -47,14 +47,6 @@ GRID_STEP = NEAR_TOL / 4.0
 EXACT_WINDOW = 1e-6
 
 
-def _turned(u: Array, h: Array, c: Array, s: Array) -> Array:
-    """``u (..., 3)`` turned about the unit axis ``h`` by the angles of cosines ``c (N,)`` and sines ``s``:
-    ``(N, ..., 3)`` (Rodrigues)."""
-    shape = (-1,) + (1,) * (u.ndim - 1) + (1,)
-    c, s = c.reshape(shape), s.reshape(shape)
-    return u * c + np.cross(h, u) * s + (u @ h)[..., None] * h * (1.0 - c)
-
-
 def _relations(structure: Structure) -> tuple[Any, ...]:
     return structure.pairs, structure.parallel, structure.spherical
 
@@ -70,9 +62,9 @@ def special_windows(
     n, hk, ok = ch.n_joints, ch.H[k], ch.points[k]
     scale = robot.length_scale
     grid = np.arange(-math.pi, math.pi, GRID_STEP)
-    c, s = np.cos(grid), np.sin(grid)
+    R = rotation_about(hk, grid)  # (N, 3, 3)
     after = list(range(k + 1, n))
-    Ha = _turned(H[after], hk, c, s)  # (N, len(after), 3)
+    Ha = np.einsum("nij,mj->nmi", R, H[after])  # (N, len(after), 3)
     flag = np.zeros(grid.size, dtype=bool)
     for i in range(k):
         sines = np.linalg.norm(np.cross(H[i], Ha), axis=-1)  # (N, len(after))
@@ -82,7 +74,7 @@ def special_windows(
     a, b = k - 1, k + 1
     rev = robot.is_revolute
     if a >= 0 and b < n and rev[a] and rev[b]:
-        pb = _turned(pts[b] - ok, hk, c, s) + ok  # (N, 3)
+        pb = R @ (pts[b] - ok) + ok  # (N, 3)
         nrm = np.cross(H[a], Ha[:, 0])
         sn = np.linalg.norm(nrm, axis=-1)
         with np.errstate(all="ignore"):

@@ -50,7 +50,7 @@ from sweepik.reductions.geometric import N_PARAMS, pose_rows
 from sweepik.reductions.kernels import defining_class, lazy_njit
 from sweepik.results import Solutions, no_solution_reason
 
-__all__ = ["SinglePose", "NOT_RIGID", "rigid_pose", "answer", "swept_settled"]
+__all__ = ["SinglePose", "NOT_RIGID", "rigid_pose", "not_rigid", "pose_row", "answer", "swept_settled"]
 
 Array = NDArray[np.float64]
 
@@ -71,14 +71,14 @@ def rigid_pose(T):  # pragma: no cover
 
 
 @inlined
-def _not_rigid(n):  # pragma: no cover
+def not_rigid(n):  # pragma: no cover
     """The kernels' answer for a target that is not a rigid transform: nothing settled."""
     none = np.empty(0)
     return NOT_RIGID, 0, 0, np.empty((0, n)), none, none, np.empty(0, np.bool_), np.empty(0, np.int64)
 
 
 @inlined
-def _row(chain, base, tool, reverse, r_end, w_tool, row):  # pragma: no cover
+def pose_row(chain, base, tool, reverse, r_end, w_tool, row):  # pragma: no cover
     """The parameter row ``(1, N_PARAMS)`` of the chain pose ``chain (4, 4)`` (``pose_rows``)."""
     params = np.empty((1, N_PARAMS))
     pose_rows(chain.reshape((1, 4, 4)), base, tool, reverse, r_end, w_tool, row, params)
@@ -99,8 +99,8 @@ def _closed_pose(
     arguments ``base`` .. ``row``) and every branch settled (``every_branch_settled``'s arguments after them):
     ``(status, certified, reachable, q, error, error_geodesic, within_limits, multiplicity)``."""
     if not rigid_pose(world):
-        return _not_rigid(rev.shape[0])
-    params = _row(chain, base, tool, reverse, r_end, w_tool, row)
+        return not_rigid(rev.shape[0])
+    params = pose_row(chain, base, tool, reverse, r_end, w_tool, row)
     st, c, reachable, q, ep, eg, ins, mu, _ = every_branch_settled(
         addr, params, world.reshape((1, 4, 4)), nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond,
         reach, tol, scale, s_thr, meet, only_inside,
@@ -123,8 +123,8 @@ def _swept_pose(
     arguments); ``MEET`` where two of its solutions lie within ``meet`` (``dedupe.any_near``: the general path merges
     them)."""
     if not rigid_pose(world):
-        return _not_rigid(rev.shape[0])
-    params = _row(chain, base, tool, reverse, r_end, w_tool, row)
+        return not_rigid(rev.shape[0])
+    params = pose_row(chain, base, tool, reverse, r_end, w_tool, row)
     return swept_settled(
         world, params, addr, plan, branches, m_branches, steps, noise, s, ends, twins, max_cand, max_fam, limits, clip,
         H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, c_joints, c_thr, meet,
