@@ -226,3 +226,27 @@ def test_residual_rows_is_the_residual_of_those_rows() -> None:
     shifted = Shifted(robot, red.plan)
     got = shifted.residual_rows(poses, rows, theta, np.broadcast_to(branch, theta.shape))
     np.testing.assert_array_equal(got, red.residual(poses[rows], theta, np.broadcast_to(branch, theta.shape)) + 1.0)
+
+
+def test_a_lazy_kernels_unchecked_entry_answers_as_its_dispatcher() -> None:
+    """``LazyKernel.unchecked`` (the compiled entry point the single-pose paths call, without type resolution) gives
+    what the kernel called through its dispatcher gives, on the signature's types; a kernel whose dispatcher has no
+    entry point for its signature falls back to the dispatcher."""
+    from numba import float64
+
+    from sweepik.reductions.kernels import LazyKernel, lazy_njit
+
+    @lazy_njit((float64[:, ::1], float64), cache=False)
+    def scaled_sum(a, s):  # pragma: no cover
+        return a.sum() * s, a * s
+
+    a = np.random.default_rng(0).standard_normal((3, 4))
+    want = scaled_sum(a, 2.5)
+    got = scaled_sum.unchecked(a, 2.5)
+    assert got[0] == want[0]
+    np.testing.assert_array_equal(got[1], want[1])
+    assert scaled_sum.unchecked is not scaled_sum.dispatcher
+
+    kernel = LazyKernel(scaled_sum.py_func, (float64[:, ::1], float64))
+    kernel.dispatcher.overloads.clear()  # (no overload: what Numba would give without an entry point)
+    assert kernel.unchecked is kernel.dispatcher

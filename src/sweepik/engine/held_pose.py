@@ -253,7 +253,7 @@ class HeldPose:
     call from the lock value (module docstring): ``of(robot, k, reduction_of)``, then ``solve(pose, value, limits)``
     per pose."""
 
-    __slots__ = ("robot", "joint", "arm", "windows", "_geometry", "_fixed", "_sweeps")
+    __slots__ = ("robot", "joint", "arm", "windows", "_geometry", "_fixed", "_sweeps", "_kernel")
 
     def __init__(
         self, robot: Robot, joint: int, arm: Robot, geometry: tuple[Any, ...], fixed: tuple[Any, ...], sweeps: bool
@@ -266,6 +266,8 @@ class HeldPose:
         self._geometry = geometry  # (the full chain, the joint, the plan's direction, marks and row)
         self._fixed = fixed  # (the settling's arguments, as ``SinglePose``'s without the chain)
         self._sweeps = sweeps
+        # (the compiled entry point itself: ``_call`` passes the signature's types, its pose checked by the caller)
+        self._kernel = (_held_swept_pose if sweeps else _held_closed_pose).unchecked
 
     @classmethod
     def of(cls, robot: Robot, k: int, reduction_of: Callable[[Robot], Reduction | None]) -> HeldPose | None:
@@ -416,8 +418,8 @@ class HeldPose:
         if self._sweeps:  # (the buffers read here: a test may cut them)
             fixed = self._fixed
             buffers = (search.MAX_CAND, search.MAX_FAM)
-            return _held_swept_pose(pose, value, *self._geometry, *fixed[:9], *buffers, *fixed[9:], limits)
-        return _held_closed_pose(pose, value, *self._geometry, *self._fixed, limits)
+            return self._kernel(pose, value, *self._geometry, *fixed[:9], *buffers, *fixed[9:], limits)
+        return self._kernel(pose, value, *self._geometry, *self._fixed, limits)
 
     def solve(self, pose: Array, value: float, limits: bool) -> tuple[int, Solutions | None]:
         """``SinglePose.solve`` with the held joint at ``value`` (checked by the caller: ``held_values``)."""

@@ -162,7 +162,8 @@ class SinglePose:
     ) -> None:
         self.robot = arm if held is None else held.robot  # (the solutions' arm)
         self.held = held
-        self._kernel = kernel
+        # (the compiled entry point itself: ``solve`` passes the signature's types, its pose checked by the caller)
+        self._kernel = kernel.unchecked
         self._head = head  # (pose_rows' arguments)
         self._tail = tail  # (the settling's, but the rows, targets and buffers; then the meeting reach)
         self._sweeps = kernel is _swept_pose
