@@ -261,12 +261,29 @@ def test_lock_values_per_pose_errors() -> None:
         ([0.1, 0.2, 3.1], "pose 2: .*outside its limits"),
         (["a", "b", "c"], "numbers"),
         (np.zeros((3, 1)), "shape"),
+        ([True, False, True], "not booleans"),  # (as a single True is refused: not a joint value)
+        (np.ones(3, dtype=bool), "not booleans"),
     ]:
         with pytest.raises(LockedJointError, match=needle):
             sweepik.solve_many(panda, T, locked={"joint7": values})
     with pytest.raises(LockedJointError, match="outside its limits"):
         sweepik.iter_solve(panda, T, locked={"joint7": [0.1, 0.2, 0.3], "joint4": 0.0})  # (checked when called)
     assert len(sweepik.solve_many(panda, np.zeros((0, 4, 4)), locked={"joint7": []})) == 0
+
+
+def test_a_lock_value_in_a_0d_array_is_a_number() -> None:
+    """``np.array(v)`` (0-d, as NumPy reductions give) holds a joint as ``v`` does; a 0-d array of booleans or text
+    is refused as the scalar is."""
+    panda = sweepik.load_robot("franka_panda")
+    q = in_limit_configurations(panda, 1, np.random.default_rng(4))[0]
+    T = panda.fk(q)
+    want = sweepik.solve(panda, T, locked={"joint7": float(q[6])})
+    got = sweepik.solve(panda, T, locked={"joint7": np.array(q[6])})
+    np.testing.assert_array_equal(got.q, want.q)
+    assert recovers(panda, got, q)
+    for bad in (np.array(True), np.array("0.1")):
+        with pytest.raises(LockedJointError, match="needs a number"):
+            sweepik.solve(panda, T, locked={"joint7": bad})
 
 
 # ------------------------------------------------------------------------------------------ TOML joint form

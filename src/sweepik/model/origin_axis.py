@@ -171,6 +171,8 @@ def held_values(robot: Robot, locked: Mapping[Any, Any]) -> tuple[tuple[int, flo
         k = _joint_index(robot, key)
         if k in out:
             raise LockedJointError(f"locked: joint {robot.joint_names[k]!r} is given twice")
+        if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+            value = value.item()  # (a number held in a 0-d array, as NumPy gives one)
         if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
             raise LockedJointError(f"locked: joint {robot.joint_names[k]!r} needs a number, got {value!r}")
         v = float(value)
@@ -212,6 +214,8 @@ def lock_runs(robot: Robot, locked: Mapping[Any, Any], n: int) -> list[tuple[int
     for k, value in zip(keys, locked.values(), strict=True):
         name = robot.joint_names[k]
         if isinstance(value, list | tuple | np.ndarray) and np.ndim(value) > 0:
+            if _booleans(value):
+                raise LockedJointError(f"locked: joint {name!r} needs numbers, one per pose, not booleans")
             try:
                 col = np.asarray(value, dtype=np.float64)
             except (TypeError, ValueError):
@@ -237,6 +241,13 @@ def lock_runs(robot: Robot, locked: Mapping[Any, Any], n: int) -> list[tuple[int
             raise LockedJointError(f"pose {s}: {err}") from None
         runs.append((s, e, values))
     return runs
+
+
+def _booleans(values: list[Any] | tuple[Any, ...] | np.ndarray) -> bool:
+    """Per-pose lock values given as booleans (refused as a single ``True`` is: not a joint value)."""
+    if isinstance(values, np.ndarray):
+        return values.dtype.kind == "b"
+    return any(isinstance(x, bool | np.bool_) for x in values)
 
 
 def hold_joints(robot: Robot, locked: Mapping[Any, Any], n_free: int | None = 6) -> HeldJoints:
