@@ -33,6 +33,7 @@ TAKEN = [
     ("kuka_iiwa14", "A6"),
     ("kuka_iiwa14", "A7"),
     ("franka_panda", "joint5"),
+    ("franka_panda", "joint6"),  # (axes 5 and 7 meet at a point that slides along axis 5 with the value)
     ("franka_panda", "joint7"),
 ]
 #: ... and whose held arm is one sweep at every value.
@@ -78,7 +79,10 @@ def test_the_one_call_is_the_held_arm_at_each_value(name: str, joint: str) -> No
     assert answered >= 10
 
 
-@pytest.mark.parametrize(("name", "joint"), [("kuka_iiwa14", "A3"), ("franka_panda", "joint7"), ("kuka_iiwa14", "A6")])
+@pytest.mark.parametrize(
+    ("name", "joint"),
+    [("kuka_iiwa14", "A3"), ("franka_panda", "joint7"), ("kuka_iiwa14", "A6"), ("franka_panda", "joint6")],
+)
 @pytest.mark.parametrize("seed", [1, 2])
 def test_arms_written_otherwise(name: str, joint: str, seed: int) -> None:
     """Rewritten at random (axis signs, zeros, base and tool frames, units): the one call is taken and gives the held
@@ -100,7 +104,10 @@ def test_arms_written_otherwise(name: str, joint: str, seed: int) -> None:
         assert recovers(robot, sol, q2)
 
 
-@pytest.mark.parametrize(("name", "joint"), [("kuka_iiwa14", "A3"), ("franka_panda", "joint7"), ("kuka_iiwa14", "A1")])
+@pytest.mark.parametrize(
+    ("name", "joint"),
+    [("kuka_iiwa14", "A3"), ("franka_panda", "joint7"), ("kuka_iiwa14", "A1"), ("franka_panda", "joint6")],
+)
 def test_values_where_axes_line_up_and_singular_wrists(name: str, joint: str) -> None:
     """The held joint at 0, +-pi/2 and its limits (where the held arm has more structure than at other values), the
     wrist straight or the elbow at 0: every solution reaches the pose and the generating configuration is found."""
@@ -113,8 +120,9 @@ def test_values_where_axes_line_up_and_singular_wrists(name: str, joint: str) ->
             continue
         q = in_limit_configurations(robot, 6, rng)
         q[:, k] = v
-        q[:2, 5] = 0.0 if robot.lower[5] <= 0.0 <= robot.upper[5] else q[:2, 5]
-        q[2:4, 3] = 0.0 if robot.lower[3] <= 0.0 <= robot.upper[3] else q[2:4, 3]
+        for rows, j in ((slice(0, 2), 5), (slice(2, 4), 3)):  # (not the held joint itself)
+            if j != k and robot.lower[j] <= 0.0 <= robot.upper[j]:
+                q[rows, j] = 0.0
         for qq, T in zip(q, robot.fk(q), strict=True):
             sol = sweepik.solve(robot, T, locked={joint: float(v)})
             _fk_ok(robot, sol, T)
@@ -164,11 +172,12 @@ def test_the_one_call_hands_on_what_it_does_not_settle() -> None:
 
 def test_arms_whose_plan_is_not_one_closed_form_at_every_value_are_not_taken() -> None:
     """A held arm that needs a companion (Gen3 joint 1) or is refused (iiwa A4: every pose a continuum) is not
-    taken; nor Panda joint 6, whose axes 5 and 7 meet at a point that slides along axis 5 with the value and are
-    parallel at 0 (another plan there); nor references of two different arms (their rows are not one chain moved),
-    nor a six-joint arm."""
+    taken; nor references of two different arms (their rows are not one chain moved), nor a six-joint arm. Panda
+    joint 6 is taken, its axes 5 and 7 meeting at a point that slides along axis 5 with the value, but not at 0 and
+    pi, where they are parallel (another plan there): those values go the general way."""
     panda, gen3, iiwa = load_robot("franka_panda"), load_robot("kinova_gen3"), load_robot("kuka_iiwa14")
-    assert solving._held_pose(panda, 5) is None
+    six = solving._held_pose(panda, 5)
+    assert six is not None and in_windows(0.0, six.windows) and in_windows(np.pi, six.windows)
     held = sweepik.model.origin_axis.hold_joints(panda, {5: 0.0})
     assert solving._default_reduction(held.arm, held).plan.case != "ab_int"  # (the plan at 0 is another)
     assert solving._held_pose(gen3, 0) is None
@@ -188,6 +197,34 @@ def test_arms_whose_plan_is_not_one_closed_form_at_every_value_are_not_taken() -
     red = solving._default_reduction(other.arm, other)
     found[2] = (found[2][0], red, sweepik.engine.single_pose.SinglePose.of(other.arm, red, other))
     assert HeldPose._checked(iiwa, 2, found) is None
+
+
+@pytest.mark.parametrize(("name", "joint"), [("franka_panda", "joint6"), ("kuka_iiwa14", "A3")])
+def test_values_just_outside_the_windows_are_the_held_arm(name: str, joint: str) -> None:
+    """Next to a window (axes nearly parallel or nearly meeting: a sliding meeting point far away, the plan badly
+    conditioned) the one call's answers, where it gives them, are still the held arm's at that value, and the
+    generating configuration is recovered either way."""
+    robot = load_robot(name)
+    k = robot.joint_names.index(joint)
+    fast = solving._held_pose(robot, k)
+    assert fast is not None and fast.windows.size
+    edges = fast.windows[np.isfinite(fast.windows)]
+    values = [e + d for e in edges for d in (-3e-3, -5e-4, 5e-4, 3e-3)]
+    values = [v for v in values if robot.lower[k] <= v <= robot.upper[k] and not in_windows(v, fast.windows)]
+    assert values
+    rng = np.random.default_rng(11)
+    answered = 0
+    for v in values:
+        q = in_limit_configurations(robot, 3, rng)
+        q[:, k] = v
+        for qq, T in zip(q, robot.fk(q), strict=True):
+            status, sol = fast.solve(np.ascontiguousarray(T), float(v), True)
+            if sol is not None:
+                answered += 1
+                _same(sol, _general(robot, T, k, float(v)), robot)
+                _fk_ok(robot, sol, T)
+            assert recovers(robot, sweepik.solve(robot, T, locked={joint: float(v)}), qq)
+    assert answered >= 1  # (the others, badly conditioned there, went the general way)
 
 
 def test_values_are_checked_as_before() -> None:

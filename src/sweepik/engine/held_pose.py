@@ -15,8 +15,11 @@ wrist centre and meeting point each either fixed in the world or carried by the 
 axis is both); and this module's parameter row, chain and tool vectors must equal the held arm's at those values to
 rounding. That makes the plan's structure hold at every value: axes that meet at a point fixed in the world, or carried
 with them, meet whatever the value; a direction turned by the held joint is a trigonometric polynomial of degree one in
-the value, so one parallel to another at five values is parallel at all. (Axes that meet at a point sliding along one of
-them are not taken: they are parallel at some value, where the plan changes - Panda joint 6.) The arguments that do not
+the value, so one parallel to another at five values is parallel at all. Axes that meet at a point sliding along one of
+them (Panda joint 6: axes 5 and 7, one turned by the held joint, in a plane across it) meet at every value where
+they meet at five (their being coplanar is a trigonometric polynomial of degree two in the value): the meeting point
+is worked out in the compiled call; where they turn parallel the held arm is another arm (``lock_windows``). The
+arguments that do not
 depend on the geometry are the held arm's at every value (its length scale is the full arm's:
 ``origin_axis.hold_joints``); the singular set's thresholds (typical step amplitudes, probed) are the largest of the
 five: a pose nearer its singular set than that goes the general way, where the held arm at its own value answers. So
@@ -62,6 +65,9 @@ MATCH_REL = 1e-12
 SPECIAL = -2
 
 _H, _P, _W, _O = LAYOUT["H"], LAYOUT["P"], LAYOUT["W"], LAYOUT["O"]
+#: How the wrist centre and the meeting point follow the value (``HeldPose._marks``): fixed in the world, carried by
+#: the held joint, or (the meeting point) where two axes of the solved chain meet, worked out at each value.
+_FIXED, _CARRIED, _MET = 0, 1, 2
 #: The base and tool transforms ``pose_rows`` takes: the held chain is the world chain (none to take off).
 _EYE = np.eye(4)
 _M = LAYOUT["M"]
@@ -121,7 +127,8 @@ def _solved(H, P, R_end, reverse):  # pragma: no cover
 def _held_args(value, GH, pts, GR, k, reverse, marks, moves, template):  # pragma: no cover
     """The held chain ``(H, P, R_end)`` at ``value`` and ``pose_rows``' arguments for its plan: the row (``template``
     with the solved chain's axes, segments, wrist centre and meeting point: ``marks`` at value 0 in the world,
-    ``moves``: carried by the held joint), the solved chain's tool orientation and the wrist centre in the tool
+    ``moves[m]`` how each follows the value, ``_FIXED``, ``_CARRIED`` or ``_MET``: where the solved chain's axes
+    ``moves[2]`` and ``moves[3]`` meet), the solved chain's tool orientation and the wrist centre in the tool
     frame."""
     H, P, R_end = _held_chain(value, GH, pts, GR, k)
     end = _sum_rows(P)
@@ -136,11 +143,14 @@ def _held_args(value, GH, pts, GR, k, reverse, marks, moves, template):  # pragm
             row[_P + 3 * i + a] = Ps[i, a]
     w = (0.0, 0.0, 0.0)
     for m in range(2):
-        x = (marks[m, 0], marks[m, 1], marks[m, 2])
-        if moves[m]:
-            x = _moved(x, value, GH[k], pts[k])
-        if reverse:  # (the reversed chain's world is the tool frame at zero)
-            x = _inverse_turned(R_end, sub(x, end))
+        if moves[m] == _MET:  # (in the solved chain's frame already)
+            x = _meeting(Hs, Ps, moves[2], moves[3])
+        else:
+            x = (marks[m, 0], marks[m, 1], marks[m, 2])
+            if moves[m] == _CARRIED:
+                x = _moved(x, value, GH[k], pts[k])
+            if reverse:  # (the reversed chain's world is the tool frame at zero)
+                x = _inverse_turned(R_end, sub(x, end))
         at = _W if m == 0 else _O
         row[at], row[at + 1], row[at + 2] = x
         if m == 0:
@@ -148,6 +158,18 @@ def _held_args(value, GH, pts, GR, k, reverse, marks, moves, template):  # pragm
     w_tool = np.empty(3)
     w_tool[0], w_tool[1], w_tool[2] = _inverse_turned(Rs, sub(w, _sum_rows(Ps)))
     return H, P, R_end, row, Rs, w_tool
+
+
+@inlined
+def _meeting(H, P, a, b):  # pragma: no cover
+    """Where the axes ``a`` and ``b`` of the chain ``H, P`` (zero configuration) meet: the point of axis ``a``
+    nearest axis ``b`` (a tuple)."""
+    pa, pb = _sum_rows(P[: a + 1]), _sum_rows(P[: b + 1])
+    ha, hb = (H[a, 0], H[a, 1], H[a, 2]), (H[b, 0], H[b, 1], H[b, 2])
+    r = sub(pa, pb)
+    A, B, C, D, E = dot(ha, ha), dot(ha, hb), dot(hb, hb), dot(ha, r), dot(hb, r)
+    t = (B * E - C * D) / (A * C - B * B)
+    return (pa[0] + t * ha[0], pa[1] + t * ha[1], pa[2] + t * ha[2])
 
 
 @inlined
@@ -166,7 +188,7 @@ def _inverse_turned(R, v):  # pragma: no cover
 
 
 _CHAIN_SIG = (float64, float64[:, ::1], float64[:, ::1], float64[:, ::1], int64)
-_GEOMETRY_SIG = _CHAIN_SIG + (boolean, float64[:, ::1], boolean[::1], float64[::1])
+_GEOMETRY_SIG = _CHAIN_SIG + (boolean, float64[:, ::1], int64[::1], float64[::1])
 
 
 @lazy_njit(_CHAIN_SIG, cache=True, nogil=True)
@@ -351,11 +373,13 @@ class HeldPose:
     @staticmethod
     def _marks(
         robot: Robot, k: int, found: list[tuple[float, Any, SinglePose]], pts: Array, GH: Array
-    ) -> tuple[Array | None, NDArray[np.bool_]]:  # fmt: skip
-        """The plan's wrist centre and meeting point at value 0 in the world ``(2, 3)`` and whether each turns with
-        the held joint; None where one neither stays nor turns with it."""
+    ) -> tuple[Array | None, NDArray[np.int64]]:  # fmt: skip
+        """The plan's wrist centre and meeting point at value 0 in the world ``(2, 3)`` and how each follows the value
+        (``_held_args``' ``moves``): fixed, turned with the held joint, or (the meeting point of a plan whose first
+        two position axes meet, ``ab_int``) where those axes meet at each value (Panda joint 6: axes 5 and 7 meet
+        at a point that slides along axis 5; the row check of ``_checked`` confirms it); None where one does neither."""
         tol = MATCH_REL * 10.0 * robot.length_scale
-        marks, moves = np.empty((2, 3)), np.zeros(2, dtype=np.bool_)
+        marks, moves = np.zeros((2, 3)), np.zeros(4, dtype=np.int64)
         for m in range(2):
             fixed, carried = [], []
             for v, red, _ in found:
@@ -367,10 +391,14 @@ class HeldPose:
                 carried.append(rotation_about(GH[k], -v) @ (x - pts[k]) + pts[k])
             for i, cand in enumerate((fixed, carried)):
                 if np.abs(np.array(cand) - cand[0]).max() <= tol:
-                    marks[m], moves[m] = cand[0], bool(i)
+                    marks[m], moves[m] = cand[0], (_FIXED, _CARRIED)[i]
                     break
             else:
-                return None, moves
+                plan = found[0][1].plan
+                if m == 0 or plan.case != "ab_int":
+                    return None, moves
+                others = [i for i in range(4) if i != plan.free]
+                moves[1], moves[2], moves[3] = _MET, others[0], others[1]
         return marks, moves
 
     def blocks(

@@ -1,0 +1,101 @@
+"""Which locks of the seven-joint arms take their value as an argument of one compiled call (``engine.held_pose``),
+and whether that call gives the held arm's own solutions (issue 39).
+
+    python scripts/held_locks.py [--n 15] [--ssik] [--rewrite] [--only gen3 panda]
+
+For every seven-joint arm (the bundled ones; ``--ssik``: ssik 8.2's catalogue too, ``tests/catalogue.py``) and each
+revolute joint: whether ``HeldPose`` takes it (a closed form or a sweep at every value), then ``--n`` random poses at
+random values: the one call's solutions (where it settles the pose) against the held arm built at the value and
+solved the general way (same count, configurations to 1e-8 of the arm's size), and the generating configuration
+recovered by ``solve``. ``--rewrite``: each arm rewritten at random too (axis signs, zeros, frames, units:
+``tests/rewrites.py``). Prints a line per taken lock and the totals.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+
+from oracles import in_limit_configurations, recovers  # noqa: E402
+from rewrites import rewrite  # noqa: E402
+
+import sweepik  # noqa: E402
+from sweepik import solving  # noqa: E402
+
+
+def _general(robot: sweepik.Robot, T: np.ndarray, k: int, value: float) -> sweepik.Solutions:
+    return solving._solve_one(robot, T[None], None, "precise", True, solving.N_SAMPLES, None, {k: value}, False)
+
+
+def _differs(a: sweepik.Solutions, b: sweepik.Solutions, robot: sweepik.Robot) -> float:
+    """inf where the counts differ, else the largest difference of the sorted configurations."""
+    if len(a) != len(b):
+        return np.inf
+    return float(np.abs(np.sort(a.q, axis=0) - np.sort(b.q, axis=0)).max(initial=0.0))
+
+
+def check_arm(robot: sweepik.Robot, n: int, rng: np.random.Generator) -> tuple[int, int, int, int, int]:
+    """``(locks, taken, poses answered by the one call, differing, not recovered)`` of one arm."""
+    locks = taken = answered = differ = missed = 0
+    for k in range(7):
+        if not robot.is_revolute[k]:
+            continue
+        locks += 1
+        fast = solving._held_pose(robot, k)
+        if fast is None:
+            continue
+        taken += 1
+        q = in_limit_configurations(robot, n, rng)
+        mine = 0
+        for qq, T in zip(q, robot.fk(q), strict=True):
+            v = float(qq[k])
+            status, sol = fast.solve(np.ascontiguousarray(T), v, True)
+            if sol is not None:
+                mine += 1
+                d = _differs(sol, _general(robot, T, k, v), robot)
+                if not d <= 1e-8 * max(1.0, robot.length_scale):
+                    differ += 1
+                    print(f"    differs: joint {robot.joint_names[k]} at {v!r}, q = {qq.tolist()}: {d}")
+            if not recovers(robot, sweepik.solve(robot, T, locked={k: v}), qq):
+                missed += 1
+                print(f"    not recovered: joint {robot.joint_names[k]} at {v!r}, q = {qq.tolist()}")
+        answered += mine
+        print(f"  {robot.name} {robot.joint_names[k]}: taken, {mine}/{n} answered by the one call", flush=True)
+    return locks, taken, answered, differ, missed
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n", type=int, default=15)
+    ap.add_argument("--ssik", action="store_true")
+    ap.add_argument("--rewrite", action="store_true")
+    ap.add_argument("--only", nargs="*", default=None)
+    args = ap.parse_args()
+    robots = [r for r in map(sweepik.load_robot, sweepik.bundled_robots()) if r.n_joints == 7]
+    if args.ssik:
+        import ssik
+        from catalogue import robot_from_ssik
+
+        robots += [robot_from_ssik(a.name) for a in ssik.list_arms() if a.dof == 7]
+    if args.only:
+        robots = [r for r in robots if any(s in r.name for s in args.only)]
+    rng = np.random.default_rng(0)
+    total = np.zeros(5, dtype=int)
+    for robot in robots:
+        total += check_arm(robot, args.n, rng)
+        if args.rewrite:
+            total += check_arm(rewrite(robot, rng).robot, args.n, rng)
+    locks, taken, answered, differ, missed = total.tolist()
+    print(
+        f"locks {locks}, taken {taken}; poses answered by the one call {answered}, differing {differ}; "
+        f"not recovered {missed}"
+    )
+
+
+if __name__ == "__main__":
+    main()
