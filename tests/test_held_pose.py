@@ -286,3 +286,28 @@ def test_long_runs_of_one_value_are_solved_batched(monkeypatch: pytest.MonkeyPat
     assert taken == [10]
     sweepik.solve_many(robot, T, locked={"A3": 0.7})
     assert taken == [10]
+
+
+@pytest.mark.parametrize(("name", "joint"), TAKEN + SWEPT)
+def test_the_general_way_builds_the_vouched_plan_as_it_would_find_it(name: str, joint: str) -> None:
+    """A pose the one call does not settle goes the general way, whose held arm at a new value takes the plan
+    ``HeldPose`` vouched for (``reductions.vouch_held_plan``) without looking for it again: at random values outside
+    the windows it is the plan ``first_plan`` finds there, to the last bit of its wrist centre and meeting point; in
+    the windows nothing is vouched for."""
+    from sweepik.reductions import _vouched
+    from sweepik.reductions.plan import first_plan
+
+    robot = load_robot(name)
+    k = robot.joint_names.index(joint)
+    fast = solving._held_pose(robot, k)
+    assert fast is not None
+    rng = np.random.default_rng(k + 17)
+    lo, hi = max(robot.lower[k], -np.pi), min(robot.upper[k], np.pi)
+    values = [v for v in rng.uniform(lo, hi, 25) if not fast.special(v)]
+    for v in values:
+        arm = sweepik.model.origin_axis.hold_joints(robot, {k: float(v)}).arm
+        assert _vouched(robot, (k,), arm, (float(v),)) == first_plan(arm)
+    for v in fast.windows[np.isfinite(fast.windows)]:
+        if robot.lower[k] <= v <= robot.upper[k]:
+            arm = sweepik.model.origin_axis.hold_joints(robot, {k: float(v)}).arm
+            assert _vouched(robot, (k,), arm, (float(v),)) is None

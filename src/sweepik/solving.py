@@ -328,7 +328,8 @@ def prepare(
     fj = _free_joint_index(robot, free_joint, reduction)
     try:
         if held is not None and fj is None and is_default(robot, reduction) and robot.default_reduction is None:
-            red = automatic_for_held(held.robot, tuple(k for k, _ in held.held), robot)
+            values = tuple(v for _, v in held.held)
+            red = automatic_for_held(held.robot, tuple(k for k, _ in held.held), robot, values)
         else:
             red = get_reduction(robot, reduction, fj)
     except NoReductionError:

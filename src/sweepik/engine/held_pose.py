@@ -46,7 +46,7 @@ from sweepik.engine.single_pose import SinglePose, answer, not_rigid, pose_row, 
 from sweepik.model.chain import Chain, rotation_about
 from sweepik.model.origin_axis import hold_joints
 from sweepik.model.robot import Robot
-from sweepik.reductions import GeometricReduction, Reduction
+from sweepik.reductions import GeometricReduction, Reduction, vouch_held_plan
 from sweepik.reductions.geometric import LAYOUT
 from sweepik.reductions.kernels import lazy_njit
 from sweepik.results import Block, Solutions
@@ -317,7 +317,13 @@ class HeldPose:
         if any(in_windows(v, windows) for v, _, _ in found):
             return None
         made.windows = windows
+        plan = found[0][1].plan  # (the general way builds it at a new value as it is: ``vouch_held_plan``)
+        vouch_held_plan(robot, (k,), (plan.family, plan.reversed, plan.free, plan.case), made.special)
         return made
+
+    def special(self, value: float) -> bool:
+        """Whether ``value`` is in ``windows`` (the held arm there may be another arm)."""
+        return in_windows(value, self.windows)
 
     def chain_at(self, value: float) -> Chain:
         """The held arm's chain at ``value`` (world frame, as its ``Robot.chain``)."""

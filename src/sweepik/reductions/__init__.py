@@ -30,6 +30,7 @@ __all__ = [
     "AUTO",
     "set_plan_check",
     "automatic_for_held",
+    "vouch_held_plan",
 ]
 
 #: Name of the reduction derived from the arm's geometry (``reductions.decompose``).
@@ -111,18 +112,45 @@ def _signature(plan: Plan) -> _Sig:
     return plan.family, plan.reversed, plan.free, plan.case
 
 
-def automatic_for_held(full: Robot, held: tuple[int, ...], arm: Robot) -> Reduction:
+#: Plans that hold at every value of a held joint but a few (``engine.held_pose``), by (full arm, held joints): the
+#: plan's signature and the test of the values where it may not (``vouch_held_plan``).
+_VOUCHED: dict[tuple[Robot, tuple[int, ...]], tuple[_Sig, Callable[[float], bool]]] = {}
+
+
+def vouch_held_plan(full: Robot, held: tuple[int, ...], sig: _Sig, special: Callable[[float], bool]) -> None:
+    """``full`` with the joints ``held`` locked is the plan ``sig`` (a ``wrist`` or ``pair`` plan's family, chain,
+    theta* and case) at every value where ``special(value)`` is False, and that plan is the first without a blind
+    spot there (``engine.held_pose`` checked it): ``automatic_for_held`` then builds that plan at a new value
+    (``position_plan``) instead of finding it again (``first_plan``, the near-structure and continuum checks: 1-4 ms),
+    with the same outcome."""
+    if sig[0] in ("wrist", "pair"):
+        if len(_VOUCHED) > 256:  # (bounded, as the caches around it)
+            _VOUCHED.clear()
+        _VOUCHED[(full, held)] = (sig, special)
+
+
+def _vouched(full: Robot, held: tuple[int, ...], arm: Robot, values: tuple[float, ...] | None) -> Plan | None:
+    """The plan ``vouch_held_plan`` vouched for at these ``values`` (one held joint), None where none was or the value
+    is one of its special ones."""
+    entry = _VOUCHED.get((full, held))
+    if entry is None or values is None or len(values) != 1 or entry[1](values[0]):
+        return None
+    return position_plan(arm, *entry[0])
+
+
+def automatic_for_held(
+    full: Robot, held: tuple[int, ...], arm: Robot, values: tuple[float, ...] | None = None
+) -> Reduction:
     """The automatic reduction of ``arm``, ``full`` with the joints ``held`` locked at some values: as
     ``get_reduction(arm, "auto")`` (on an arm with a near-structure every plan is checked on the arm, ``plan_check``),
     but the plan chosen for other values of the same joints (the same family, theta*, case and chain) is taken
     when a shorter check at these values finds it (or else its companion, :mod:`sweepik.engine.companion`) sound, the
-    other
-    of the two as the companion:
-    a new lock value every pose (a redundant arm's self-motion swept, a path with a changing elbow angle) would
-    otherwise check every plan again."""
+    other of the two as the companion: a new lock value every pose (a redundant arm's self-motion swept, a path with a
+    changing elbow angle) would otherwise check every plan again. ``values``: the held joints' values (a plan
+    ``vouch_held_plan`` vouched for at them is taken as ``first_plan`` would find it)."""
     key = (full, held)
     sigs = _HELD_PLANS.get(key, ())
-    lazy = _without_near_structure(arm, sigs)
+    lazy = _without_near_structure(arm, sigs, _vouched(full, held, arm, values))
     if lazy is not None:
         plan, comp = lazy
     else:
@@ -163,18 +191,22 @@ def first_held_reduction(arm: Robot) -> Reduction | None:
     return None if lazy is None else _held_reduction(arm, lazy[0], None)
 
 
-def _without_near_structure(arm: Robot, sigs: tuple[_Sig | None, ...]) -> tuple[Plan, Plan | None] | None:
+def _without_near_structure(
+    arm: Robot, sigs: tuple[_Sig | None, ...], vouched: Plan | None = None
+) -> tuple[Plan, Plan | None] | None:
     """``automatic_for_held``'s plan and companion for an arm without a near-structure (nor a continuum everywhere),
     the same ones, without every plan checked: ``decompose.choice`` takes the first plan without a blind spot
     (``plan.first_plan``), and the companion is the other plan chosen with it before (``sigs``) where that plan
     applies (``plan.position_plan``), else None (``companion_plan``'s without a near-structure). None: the arm needs
     ``plans`` (a near-structure, a parallel plan first, no plan, or a companion of a family ``position_plan`` does not
-    build)."""
-    if decompose.near_structures(arm) or decompose.continuum_everywhere(arm) is not None:
-        return None
-    plan = first_plan(arm)
+    build). ``vouched``: the plan ``vouch_held_plan`` vouched for (no near-structure there, the first plan)."""
+    plan = vouched
     if plan is None:
-        return None
+        if decompose.near_structures(arm) or decompose.continuum_everywhere(arm) is not None:
+            return None
+        plan = first_plan(arm)
+        if plan is None:
+            return None
     mine = _signature(plan)
     if mine not in sigs:
         return plan, None
