@@ -302,11 +302,13 @@ class HeldPose:
         lo, hi = max(float(robot.lower[k]), -math.pi), min(float(robot.upper[k]), math.pi)
         if not hi > lo:
             return None
-        found = []
+        found: list[tuple[float, GeometricReduction, SinglePose]] = []
         for v in (lo + f * (hi - lo) for f in REFERENCES):
             held = hold_joints(robot, {k: v})
             red = reduction_of(held.arm)
-            sp = SinglePose.of(held.arm, red, held) if isinstance(red, GeometricReduction) else None
+            if not isinstance(red, GeometricReduction):
+                return None
+            sp = SinglePose.of(held.arm, red, held)
             if sp is None:
                 return None
             found.append((v, red, sp))
