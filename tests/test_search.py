@@ -284,6 +284,26 @@ def test_domain_edge_samples_lie_inside_their_domains(name: str) -> None:
     assert (np.abs(after[edge] - before[edge]) <= 1e-8).all()
 
 
+def test_a_hidden_edge_beside_a_root_is_no_candidate_of_its_own() -> None:
+    """The C-Arm with its elbow stretched and the rail at its end (0): a double root at the sample d1 = 0, and the
+    branch's domain ending 8e-4 mm on, between two samples, where the residual is still near zero. Taken as a second
+    candidate, that edge was merged with the root into one solution 5e-5 mm off it (multiplicity 2; IK(FK(q)) missed
+    q by 5e-5). The edge is a candidate only where the residual is no larger there than at the inside sample: the
+    root alone, exact, in the compiled search and its NumPy reference."""
+    arm = load_robot("carm")
+    q = np.array([0.0, -np.pi, -1.4660765716752369, -np.pi / 2, 2.0, -np.pi])
+    T = arm.fk(q)
+    sols = sweepik.solve(arm, T)
+    assert np.max(np.abs(np.angle(np.exp(1j * (sols.nearest(q)[1:] - q[1:]))))) < 1e-9
+    assert abs(sols.nearest(q)[0] - q[0]) < 1e-9 and np.all(sols.multiplicity == 1)
+    from sweepik.engine.chunk import chain_poses
+
+    red = sweepik.solving._default_reduction(arm, None)
+    chain, lo, hi = chain_poses(arm, T[None]), np.array([0.0]), np.array([2000.0])
+    for cand in (search.search(red, chain, lo, hi, 64)[0], sweep.find_candidates(red, chain, lo, hi, 64)[0]):
+        assert np.all(np.abs(cand.theta) < 1e-9)
+
+
 def test_a_domain_edge_hidden_between_two_samples_is_searched() -> None:
     """Flexiv Rizon 4 of ssik's catalogue, rewritten (tests/data/rizon4_rewritten.toml), joint 7 held: branch 3 of
     the held arm's sweep lives on [-0.0039, 0.0900], and two roots 7e-5 apart sit 1.5e-3 inside its right edge. The

@@ -213,7 +213,8 @@ class _Search:
     ) -> None:
         """``scan``'s step 6 (``search._hidden_edge``): an interval with one sample in the branch's domain whose
         edge is not at that sample: the edge located by bisection (a candidate where the residual is near zero
-        there), the stretch from the inside sample to it resampled as an interval next to an edge."""
+        there and no larger than at the inside sample), the stretch from the inside sample to it resampled as an
+        interval next to an edge."""
         S, M = th.shape
         h_i, h_j = np.nonzero((valid[:, :-1] != valid[:, 1:]) & (th[:, 1:] > th[:, :-1]))
         right = valid[h_i, h_j]
@@ -235,10 +236,10 @@ class _Search:
             inside[k[ok]], outside[k[~ok]] = mid[ok], mid[~ok]
             active = np.abs(outside - inside) > EDGE_PROBE_REL * span
         fe = self.residual(pp, bb, inside[:, None])[:, 0]
-        near = np.abs(fe) <= self.far
-        self._root(pp[near], bb[near], inside[near])
         a = np.where(right, th[h_i, h_j], th[h_i, h_j + 1])
         fa = np.where(right, fin[h_i, h_j], fin[h_i, h_j + 1])
+        near = (np.abs(fe) <= self.far) & (np.abs(fe) <= np.abs(fa))
+        self._root(pp[near], bb[near], inside[near])
         lo, hi = np.where(right, a, inside), np.where(right, inside, a)
         sub = lo[:, None] + (hi - lo)[:, None] * U_EDGE[None, :]
         fs = self.residual(pp, bb, sub)

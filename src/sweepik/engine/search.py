@@ -439,7 +439,10 @@ def _hidden_edge(
     outside it (else nothing: a sample masked as a family's is not outside). A domain edge at the inside sample
     (the residual just past it not finite: a margin's zero, sampled) is already the scan's. Elsewhere the edge is
     hidden between the samples (a margin's pair of close zeros that the margins' sweep missed): it is located by
-    bisection, is a candidate where the residual there is near zero (as ``_edge_samples``), and the stretch from the
+    bisection, is a candidate where the residual there is near zero and no larger than at the inside sample (as
+    ``_edge_samples``: a least value; the C-Arm's stretched elbow at the rail's end has its double root at the
+    inside sample and an edge 8e-4 mm on, where the residual is still near zero: a second candidate there was merged
+    with the root into one 5e-5 mm off it), and the stretch from the
     inside sample to it is resampled as an interval next to an edge (a root beside the edge, or a pair of close ones,
     would otherwise go unsearched)."""
     if not (level < MAX_LEVELS and signed and valid[j] != valid[j + 1] and th[j + 1] > th[j]):
@@ -457,13 +460,13 @@ def _hidden_edge(
         else:
             outside = mid
     fe = res(p, inside, b)
-    if abs(fe) <= FAR_NOISE * noise:
+    a, fa = (th[j], f[j]) if right else (th[j + 1], f[j + 1])
+    if abs(fe) <= FAR_NOISE * noise and abs(fe) <= abs(fa):  # (not where |f| grows towards it: beside a root)
         _push(out_t, out_b, cnt, inside, b)
     if top[0] >= stk_t.shape[0]:
         cnt[0] += out_t.shape[0] + 1  # overflow: the caller redoes this pose with larger buffers
         return
     k0 = top[0]
-    a, fa = (th[j], f[j]) if right else (th[j + 1], f[j + 1])
     lo, hi = (a, inside) if right else (inside, a)
     for k in range(SUB_SAMPLES + 2):
         stk_t[k0, k] = lo + (hi - lo) * _U_EDGE_ARR[k]
