@@ -37,7 +37,7 @@ def main() -> None:
     # (kernels loaded: the one call's, and the general path's that the poses it hands on take, ~30 ms once a process)
     sweepik.solve(arm, T[0], locked={args.joint: float(q[0, k])})
     warm = np.clip(q[1:, k] + 0.01, arm.lower[k], arm.upper[k])
-    sweepik.solve_many(arm, T[1:], limits=False, locked={args.joint: warm})
+    sweepik.solve_many(arm, T[1:], locked={args.joint: warm})
     if args.parts:
         parts(arm, args.joint, q[1 : n + 1], T[1 : n + 1])
         return

@@ -338,3 +338,25 @@ def test_bad_options_raise() -> None:
         solve_many(CARM, T)
     with pytest.raises(SweepikError, match="C-Arm"):
         solve(load_robot("puma560"), np.eye(4), reduction="carm-d1")
+
+
+def test_limits_that_lie_outside_one_turn_around_zero() -> None:
+    """A revolute joint limited to [200, 300] deg (outside (-180, 180] altogether): the reductions' probes sampled
+    the joint in its limits cut to one turn about 0, an empty range (a ValueError traceback); the arm is solved, its
+    configuration recovered, on a six-joint arm and a seven-joint one held."""
+    import dataclasses
+
+    from oracles import recovers
+
+    for name, j, q, locked in (
+        ("ur5", 3, [0.3, -1.0, 1.2, np.radians(250), 0.5, 0.2], None),
+        ("franka_panda", 2, [0.3, -0.5, np.radians(250), -1.5, 0.5, 1.2, 0.2], {"joint7": 0.2}),
+        ("kinova_gen3", 3, [0.3, -0.5, 0.2, np.radians(250), 0.5, 1.2, 0.2], {"joint_5": 0.5}),
+    ):
+        base = sweepik.load_robot(name)
+        joints = list(base.joints)
+        joints[j] = dataclasses.replace(joints[j], lower=np.radians(200), upper=np.radians(300))
+        arm = dataclasses.replace(base, joints=tuple(joints))
+        qq = np.array(q)
+        sols = solve(arm, arm.fk(qq), locked=locked)
+        assert recovers(arm, sols, qq)

@@ -18,9 +18,11 @@ from sweepik._jit import writable
 from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
 from sweepik.engine.held_pose import SPECIAL, HeldPose
+from sweepik.engine.one_pose import DUE
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.settings import N_SAMPLES
 from sweepik.engine.single_pose import NOT_RIGID, SinglePose
+from sweepik.engine.turned_lock import TurnedLock, turned_lock
 from sweepik.engine.windings import wound_block, wound_solutions
 from sweepik.errors import LockedJointError, NoReductionError, ShapeError, SweepikError, UnknownOptionError
 from sweepik.model.origin_axis import HeldJoints, held_values, hold_joints, lock_runs, per_pose
@@ -161,14 +163,52 @@ def _held_blocks(
 
 
 def _held_run(
-    robot: Robot, P: Array, lock: object, options: dict[str, Any], windings: bool = False, first: Prepared | None = None
+    robot: Robot,
+    P: Array,
+    lock: object,
+    options: dict[str, Any],
+    windings: bool = False,
+    first: Prepared | None = None,
+    turned: bool = True,
 ) -> Iterator[Block]:
     """The blocks of poses ``P`` solved with ``lock``'s joints held (``options``: ``prepare``'s; ``first``: already
-    prepared)."""
+    prepared, at the reference value where the lock is ``turned``: ``_turned``)."""
+    turn = _turned(robot, lock, options, windings) if turned else None
+    if turn is not None:
+        return _turned_run(robot, P, lock, turn, options, first)
     held = held_joints(robot, lock)
     arm = robot if held is None else held.arm
     prepared = first if first is not None else prepare(arm, P, **options, held=held)
     return (_finished(b, held, windings) for b in _solved_chunks(arm, P, prepared))
+
+
+def _turned(robot: Robot, lock: object, options: Mapping[str, Any], windings: bool = False) -> TurnedLock | None:
+    """``lock`` solved at its joint's reference value and turned (``engine.turned_lock``: the first or last joint of
+    a seven-joint arm held) with the default options, else None."""
+    reduction = options["reduction"]
+    if not (
+        (reduction is None or reduction == "auto")
+        and windings is False
+        and _defaults(robot, options["free_joint"], options["strategy"], options["limits"], options["n_samples"])
+    ):
+        return None
+    return turned_lock(robot, lock)
+
+
+def _turned_run(
+    robot: Robot, P: Array, lock: object, turn: TurnedLock, options: dict[str, Any], first: Prepared | None
+) -> Iterator[Block]:
+    """``_held_run`` of a turned lock: the blocks of ``turn.poses(P)`` at the reference value turned back, a block
+    ``turn.block`` cannot give back solved by the held arm at the value itself."""
+    at = 0
+    for b in _held_run(robot, turn.poses(P), turn.locked, options, False, first):
+        part = P[at : at + b.n]
+        back = turn.block(robot, b, part)
+        if back is None:
+            yield from _held_run(robot, part, lock, options, turned=False)
+        else:
+            yield back
+        at += b.n
 
 
 def _held_values(
@@ -271,7 +311,8 @@ def iter_solve(
     fast = _held_values(robot, P, runs, options, windings)
     first = None
     if runs and not (fast is not None and runs[0][1] - runs[0][0] < HELD_RUN_MIN):
-        held = held_joints(robot, runs[0][2])
+        turn = _turned(robot, runs[0][2], options, windings)  # (then solved at the reference value)
+        held = held_joints(robot, runs[0][2] if turn is None else turn.locked)
         first = prepare(robot if held is None else held.arm, P[: runs[0][1]], **options, held=held)
     return _iter_held(robot, P, runs, fast, first, options, progress, windings)
 
@@ -473,7 +514,15 @@ def _solve_one(
     one_call: bool = True,
 ) -> Solutions:
     """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly (with
-    ``one_call``: by the one compiled call where it settles the pose)."""
+    ``one_call``: by the one compiled call where it settles the pose); a turned lock (``_turned``) at its reference
+    value, turned back."""
+    options = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples, free_joint=free_joint)
+    turn = _turned(robot, locked, options)
+    if turn is not None:
+        ref = _solve_one(robot, turn.poses(P), reduction, strategy, limits, n_samples, None, turn.locked, one_call)
+        sol = turn.solutions(robot, ref, P[0])
+        if sol is not None:
+            return sol
     default = _defaults(robot, free_joint, strategy, limits, n_samples)
     held = held_joints(robot, locked)
     arm = robot if held is None else held.arm
@@ -526,7 +575,7 @@ def _default_reduction(robot: Robot, held: HeldJoints | None = None) -> Reductio
     return prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1, None, held)[0]
 
 
-def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> SinglePose | HeldAt | None:
+def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> SinglePose | HeldAt | TurnedAt | None:
     """``robot``'s default reduction (``reduction``: None, or a name of it) ready for single poses with the default
     options and ``locked`` joints (None: it does not qualify, ``SinglePose.of``, or the arm, ``locked`` or
     ``reduction`` is refused: the general path then raises, after the pose's checks). One joint of a seven-joint arm
@@ -539,12 +588,36 @@ def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> 
                 fast = _held_pose(robot, k)
                 if fast is not None and (reduction is None or is_default(fast.arm, reduction)):
                     return HeldAt(fast, v)
+                turn = turned_lock(robot, locked) if reduction in (None, "auto") else None
+                if turn is not None:  # (the held arm at the reference value, once for every value)
+                    ref = _single_pose(robot, turn.locked, reduction)
+                    return None if ref is None else TurnedAt(ref, turn, robot)
             held = held_joints(robot, locked)
         except (SweepikError, TypeError):  # (an unhashable value: the general path says what is wrong)
             return None
     if reduction is not None and not is_default(robot if held is None else held.arm, reduction):
         return None
     return _single_pose_of(robot, held)
+
+
+class TurnedAt(NamedTuple):
+    """A turned lock (``engine.turned_lock``) solved as a ``SinglePose`` is: the pose turned, solved by the held arm
+    at the reference value, its solutions turned back."""
+
+    fast: SinglePose | HeldAt | TurnedAt
+    turn: TurnedLock
+    robot: Robot
+
+    def solve(self, pose: Array, limits: bool) -> tuple[int, Solutions | None]:
+        try:
+            status, sol = self.fast.solve(self.turn.poses(pose), limits)
+        except SweepikError:
+            check_poses(pose)  # (the caller's pose named in the error)
+            raise
+        if sol is None:
+            return status, None
+        back = self.turn.solutions(self.robot, sol, pose)
+        return (status, back) if back is not None else (DUE, None)
 
 
 class HeldAt(NamedTuple):

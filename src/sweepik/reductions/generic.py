@@ -125,6 +125,8 @@ class GeometricReduction(Reduction):
         rng = np.random.default_rng(0)
         lo = np.where(robot.is_revolute, np.maximum(robot.lower, -np.pi), robot.lower)
         hi = np.where(robot.is_revolute, np.minimum(robot.upper, np.pi), robot.upper)
+        # (limits that lie outside (-pi, pi) altogether, e.g. [200, 300] deg: the range as given)
+        lo, hi = np.where(hi > lo, lo, robot.lower), np.where(hi > lo, hi, robot.upper)
         q = rng.uniform(lo, hi, size=(TWIN_POSES, robot.n_joints))
         params = self._params(robot.T_base_world @ robot.fk(q) @ robot.T_tool_flange, probing=True)
         j = self.free_joint
