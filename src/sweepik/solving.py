@@ -22,7 +22,7 @@ from sweepik.engine.one_pose import DUE
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.settings import N_SAMPLES
 from sweepik.engine.single_pose import NOT_RIGID, SinglePose
-from sweepik.engine.turned_lock import TurnedLock, turned_lock
+from sweepik.engine.turned_lock import TurnedLock, turned_at, turned_lock
 from sweepik.engine.windings import wound_block, wound_solutions
 from sweepik.errors import LockedJointError, NoReductionError, ShapeError, SweepikError, UnknownOptionError
 from sweepik.model.origin_axis import HeldJoints, held_values, hold_joints, lock_runs, per_pose
@@ -512,14 +512,16 @@ def _solve_one(
     free_joint: int | str | None = None,
     locked: object = None,
     one_call: bool = True,
+    turned: bool = True,
 ) -> Solutions:
     """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly (with
-    ``one_call``: by the one compiled call where it settles the pose); a turned lock (``_turned``) at its reference
-    value, turned back."""
+    ``one_call``: by the one compiled call where it settles the pose); a turned lock (``_turned``, unless not
+    ``turned``) at its reference value, turned back."""
     options = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples, free_joint=free_joint)
-    turn = _turned(robot, locked, options)
+    turn = _turned(robot, locked, options) if turned else None
     if turn is not None:
-        ref = _solve_one(robot, turn.poses(P), reduction, strategy, limits, n_samples, None, turn.locked, one_call)
+        P0, lock0 = turn.poses(P), turn.locked
+        ref = _solve_one(robot, P0, reduction, strategy, limits, n_samples, None, lock0, one_call, False)
         sol = turn.solutions(robot, ref, P[0])
         if sol is not None:
             return sol
@@ -588,9 +590,9 @@ def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> 
                 fast = _held_pose(robot, k)
                 if fast is not None and (reduction is None or is_default(fast.arm, reduction)):
                     return HeldAt(fast, v)
-                turn = turned_lock(robot, locked) if reduction in (None, "auto") else None
+                turn = turned_at(robot, k, v) if reduction in (None, "auto") else None
                 if turn is not None:  # (the held arm at the reference value, once for every value)
-                    ref = _single_pose(robot, turn.locked, reduction)
+                    ref = _reference_pose(robot, turn.joint, turn.reference, reduction)
                     return None if ref is None else TurnedAt(ref, turn, robot)
             held = held_joints(robot, locked)
         except (SweepikError, TypeError):  # (an unhashable value: the general path says what is wrong)
@@ -600,11 +602,18 @@ def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> 
     return _single_pose_of(robot, held)
 
 
+@lru_cache(maxsize=16)
+def _reference_pose(robot: Robot, k: int, value: float, reduction: str | None) -> SinglePose | HeldAt | None:
+    """``_single_pose`` of ``robot`` with joint ``k`` held at the reference ``value`` (kept: every value asks)."""
+    fast = _single_pose(robot, {k: value}, reduction)
+    return None if isinstance(fast, TurnedAt) else fast
+
+
 class TurnedAt(NamedTuple):
     """A turned lock (``engine.turned_lock``) solved as a ``SinglePose`` is: the pose turned, solved by the held arm
     at the reference value, its solutions turned back."""
 
-    fast: SinglePose | HeldAt | TurnedAt
+    fast: SinglePose | HeldAt
     turn: TurnedLock
     robot: Robot
 

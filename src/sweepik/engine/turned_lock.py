@@ -21,19 +21,19 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine.certify import pose_errors
 from sweepik.engine.settle import settle_bounds
-from sweepik.model.chain import rotation_about
 from sweepik.model.origin_axis import held_values
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
 from sweepik.results import Block, Solutions
 
-__all__ = ["TurnedLock", "turned_lock"]
+__all__ = ["TurnedLock", "turned_at", "turned_lock", "reference_value"]
 
 Array = NDArray[np.float64]
 
@@ -106,18 +106,38 @@ def turned_lock(robot: Robot, locked: object) -> TurnedLock | None:
     if not (isinstance(locked, Mapping) and len(locked) == 1 and robot.n_joints >= 7):
         return None
     ((k, v),) = held_values(robot, locked)
+    return turned_at(robot, k, v)
+
+
+@lru_cache(maxsize=256)
+def turned_at(robot: Robot, k: int, v: float) -> TurnedLock | None:
+    """``turned_lock`` of joint ``k`` at ``v`` (checked by ``held_values``), kept: a solve asks for it a few times."""
     n = robot.n_joints
     if k not in (0, n - 1) or not robot.is_revolute[k]:
         return None
     v0 = reference_value(robot, k)
     if v == v0:
         return None
-    ch = robot.chain
-    line = _turn_about(ch.H[k], ch.points[k], v0 - v)
+    h, p = _axis(robot, k)
+    line = _turn_about(h, p, v0 - v)
     if k == 0:
         return TurnedLock(k, v, v0, line, True)
-    F0 = robot.fk(np.zeros(n))
-    return TurnedLock(k, v, v0, np.linalg.inv(F0) @ line @ F0, False)
+    F0, F0_inv = _tool_at_zero(robot)
+    return TurnedLock(k, v, v0, F0_inv @ line @ F0, False)
+
+
+@lru_cache(maxsize=64)
+def _axis(robot: Robot, k: int) -> tuple[Array, Array]:
+    """Joint ``k``'s axis and a point of it, in the world at the zero configuration."""
+    ch = robot.chain
+    return ch.H[k].copy(), ch.points[k].copy()
+
+
+@lru_cache(maxsize=64)
+def _tool_at_zero(robot: Robot) -> tuple[Array, Array]:
+    """The tool pose at the zero configuration and its inverse."""
+    F0 = robot.fk(np.zeros(robot.n_joints))
+    return F0, np.asarray(np.linalg.inv(F0), dtype=np.float64)
 
 
 def reference_value(robot: Robot, k: int) -> float:
@@ -129,8 +149,18 @@ def reference_value(robot: Robot, k: int) -> float:
 
 
 def _turn_about(h: Array, p: Array, angle: float) -> Array:
-    """The rigid turn ``(4, 4)`` by ``angle`` about the line through ``p`` along the unit ``h``."""
+    """The rigid turn ``(4, 4)`` by ``angle`` about the line through ``p`` along the unit ``h`` (``rotation_about``'s
+    Rodrigues, in scalars: a solve at a new value builds one)."""
+    c, s = math.cos(angle), math.sin(angle)
+    x, y, z = float(h[0]), float(h[1]), float(h[2])
+    t = 1.0 - c
+    R = np.array(
+        [
+            [c + x * x * t, x * y * t - z * s, x * z * t + y * s],
+            [y * x * t + z * s, c + y * y * t, y * z * t - x * s],
+            [z * x * t - y * s, z * y * t + x * s, c + z * z * t],
+        ]
+    )
     M = np.eye(4)
-    R = rotation_about(h, angle)
     M[:3, :3], M[:3, 3] = R, p - R @ p
     return M
