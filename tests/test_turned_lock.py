@@ -175,3 +175,34 @@ def test_the_reference_value() -> None:
     q = np.array([0.3, 0.2, -0.1, -1.5, 0.4, 1.8, 2.1])
     sols = sweepik.solve(moved, moved.fk(q), locked={"joint7": 2.1})
     assert np.all(sols.q[:, 6] == 2.1) and recovers(moved, sols, q)
+
+
+def test_a_turned_lock_in_one_compiled_call(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Where ``HeldPose`` does not take the first or last joint but the held arm at the reference value is one
+    closed form (``SinglePose``), ``solve`` turns the pose into that call (``solving.TurnedAt``): the same solutions
+    as the held arm at the value, the caller's pose named in a refusal. (No bundled or ssik arm needs it today:
+    ``HeldPose`` is made to refuse the iiwa's A1 here.)"""
+    robot = load_robot("kuka_iiwa14")
+    monkeypatch.setattr(solving, "_held_pose", lambda robot, k: None)
+    solving._reference_pose.cache_clear()
+    fast = solving._single_pose(robot, {"A1": 0.4})
+    assert isinstance(fast, solving.TurnedAt)
+    q = in_limit_configurations(robot, 10, np.random.default_rng(9))
+    answered = 0
+    for qq, T in zip(q, robot.fk(q), strict=True):
+        v = float(qq[0])
+        status, sol = solving._single_pose(robot, {"A1": v}).solve(np.ascontiguousarray(T), True)
+        if sol is not None:
+            answered += 1
+            _same(sol, _at_value(robot, T, 0, v), robot)
+        _same(sweepik.solve(robot, T, locked={"A1": v}), _at_value(robot, T, 0, v), robot)
+        assert recovers(robot, sweepik.solve(robot, T, locked={"A1": v}), qq)
+    assert answered >= 8
+    bad = robot.fk(q[0])
+    bad[0, 0] = 2.0
+    with pytest.raises(InvalidPoseError) as want:
+        check_poses(bad, "pose")
+    with pytest.raises(InvalidPoseError) as err:
+        sweepik.solve(robot, bad, locked={"A1": 0.4})
+    assert str(err.value) == str(want.value)
+    solving._reference_pose.cache_clear()
