@@ -196,3 +196,30 @@ def test_a_held_arm_gets_the_plans_it_got_with_every_plan_checked() -> None:
                 assert lazy == full(arm, sigs)
                 checked += 1
     assert checked >= 100
+
+
+def test_a_sound_hint_is_taken_without_the_general_methods_setup(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A held arm with a near-structure (the Gen3 with joint 4 held: its wrist axes meet to 3e-4) at a new lock value:
+    the plan chosen at another value, found sound by the short check, is taken without setting up the general method
+    (``general_refusal``, ~20 ms of elimination), and it is the plan the choice takes with the general method among
+    the options."""
+    from sweepik.model.origin_axis import hold_joints
+    from sweepik.reductions import _signature
+
+    from sweepik.plan_check import checked_choice
+
+    gen3 = load_robot("kinova_gen3")
+    first = hold_joints(gen3, {3: 0.4}).arm
+    plan0, _ = decompose.choice(first, None)
+    arm = hold_joints(gen3, {3: -0.9}).arm
+    options = tuple(p for p in plans(arm) if not p.conditional)
+    hints = tuple(p for p in options if _signature(p) == _signature(plan0))
+    assert hints and decompose.near_structures(arm) and decompose.general_refusal(arm) is None
+    with_general = checked_choice(arm, (*options, decompose.GENERAL), hints)  # (as the choice was made before)
+    assert with_general is not None
+    calls = []
+    real = decompose.general_refusal
+    monkeypatch.setattr(decompose, "general_refusal", lambda robot: calls.append(robot) or real(robot))
+    decompose.choice.cache_clear()
+    got = decompose.choice(arm, None, hints)
+    assert got[0] == with_general[0] == hints[0] and not calls

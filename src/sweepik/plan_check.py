@@ -104,16 +104,19 @@ def check_plan(robot: Robot, plan: Plan, n: int = N_CHECK) -> PlanCheck:
 
 
 def checked_choice(
-    robot: Robot, options: tuple[Plan, ...], hints: tuple[Plan, ...] = ()
-) -> tuple[Plan, tuple[PlanCheck, ...]]:
+    robot: Robot, options: tuple[Plan, ...], hints: tuple[Plan, ...] = (), hints_only: bool = False
+) -> tuple[Plan, tuple[PlanCheck, ...]] | None:
     """The plan of ``options`` (best ranked first) with the best ``PlanCheck.score`` (ties: ``decompose.cheapest``),
     with every plan's check (in the order of ``options``). The first of ``hints`` (plans of ``options``) that gives back
-    all of ``N_QUICK`` configurations is taken instead, with the quick checks made."""
+    all of ``N_QUICK`` configurations is taken instead, with the quick checks made; ``hints_only``: None where none
+    does (the caller then adds options of its own and asks again)."""
     quick: list[PlanCheck] = []
     for hint in hints:
         quick.append(check_plan(robot, hint, N_QUICK))
         if quick[-1].passed:
             return hint, tuple(quick)
+    if hints_only:
+        return None
     checks = tuple(check_plan(robot, plan) for plan in options)
     top = max(c.score for c in checks)
     return cheapest([c for c in checks if c.score == top]).plan, checks

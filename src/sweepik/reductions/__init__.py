@@ -98,7 +98,7 @@ def _automatic(robot: Robot, free_joint: int | None) -> Reduction:
 def set_plan_check(check: Callable[..., object] | None) -> None:
     """Register the check that the automatic decomposition runs on the plans it chooses among
     (``decompose.set_plan_check``); cached choices are dropped."""
-    decompose.set_plan_check(check)  # type: ignore[arg-type]
+    decompose.set_plan_check(check)
     _automatic.cache_clear()
 
 
