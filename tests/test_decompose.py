@@ -204,9 +204,8 @@ def test_a_sound_hint_is_taken_without_the_general_methods_setup(monkeypatch: py
     (``general_refusal``, ~20 ms of elimination), and it is the plan the choice takes with the general method among
     the options."""
     from sweepik.model.origin_axis import hold_joints
-    from sweepik.reductions import _signature
-
     from sweepik.plan_check import checked_choice
+    from sweepik.reductions import _signature
 
     gen3 = load_robot("kinova_gen3")
     first = hold_joints(gen3, {3: 0.4}).arm
