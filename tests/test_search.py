@@ -284,6 +284,30 @@ def test_domain_edge_samples_lie_inside_their_domains(name: str) -> None:
     assert (np.abs(after[edge] - before[edge]) <= 1e-8).all()
 
 
+def test_a_close_pair_just_inside_an_edge_at_a_sample_is_searched() -> None:
+    """The JACO2 next to its singular set (``scripts/singular_audit.py --n 40 --seed 3``, configuration 39): branch 2
+    of its joint-1 sweep holds two roots 1.6e-5 apart, 2.3e-4 inside the branch's domain edge, which sits at a sample
+    (a margin's zero). The edge's residual is 7.7e-4 against its neighbour's 3.2e-2, and the three samples make a
+    straight line in the edge's coordinate, so the bend test left the interval unsearched and both roots were missed
+    (4 solutions of 6, the configuration not among them). An edge whose residual is below ``EDGE_LOW`` of its
+    neighbour's now has the interval resampled: the compiled search and its NumPy reference find both."""
+    from sweepik.engine.chunk import chain_poses
+
+    robot = load_robot("kinova_jaco2")
+    q = np.array([1.8657100929952852, 3.0150848528098333, 3.09552824518443, 0.15830510205445636,
+                  -2.120970656728688, -2.4609361811184405])  # fmt: skip
+    T = robot.fk(q)
+    for limits in (True, False):
+        sols = sweepik.solve(robot, T, limits=limits)
+        assert len(sols) == 6 and np.abs(robot.fk(sols.q) - T).max() < 1e-9
+        assert np.max(np.abs(np.angle(np.exp(1j * (sols.nearest(q) - q))))) < 1e-7
+    red = sweepik.solving._default_reduction(robot, None)
+    chain, lo, hi = chain_poses(robot, T[None]), np.array([-np.pi]), np.array([np.pi])
+    for cand in (search.search(red, chain, lo, hi, 64)[0], sweep.find_candidates(red, chain, lo, hi, 64)[0]):
+        near = np.abs(cand.theta - q[0]) < 1e-4
+        assert np.count_nonzero(near & (cand.branch == 2)) >= 2
+
+
 def test_a_hidden_edge_beside_a_root_is_no_candidate_of_its_own() -> None:
     """The C-Arm with its elbow stretched and the rail at its end (0): a double root at the sample d1 = 0, and the
     branch's domain ending 8e-4 mm on, between two samples, where the residual is still near zero. Taken as a second

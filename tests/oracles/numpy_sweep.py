@@ -40,6 +40,7 @@ from sweepik.engine.settings import (
     DIFF_LEVELS,
     DIFF_SHRINK,
     DIFF_STEP_REL,
+    EDGE_LOW,
     EDGE_PROBE_REL,
     EXTREMUM_REACH,
     FAMILY_BISECT,
@@ -458,6 +459,7 @@ class _Search:
         with np.errstate(invalid="ignore", divide="ignore"):
             dd = 2.0 * ((f2 - f1) / (x2 - x1) - (f1 - f0) / x1) / x2
             bent = np.minimum(np.abs(f0), np.abs(f1)) <= BEND * np.abs(dd) * x1 * x1
+            bent |= np.abs(f0) <= EDGE_LOW * np.abs(f1)
         step = EDGE_PROBE_REL * self.span[p[i]]
         past = self.residual(p[i], b[i], (te + side * step)[:, None])[:, 0]
         at = ok & np.isfinite(dd) & ~np.isfinite(past)

@@ -35,6 +35,7 @@ from sweepik.engine.settings import (
     DIFF_LEVELS,
     DIFF_SHRINK,
     DIFF_STEP_REL,
+    EDGE_LOW,
     EDGE_MARGIN,
     EDGE_NUDGES,
     EDGE_PROBE_REL,
@@ -343,7 +344,7 @@ def _edge_bent(res, p, b, th, f, valid, fmask, j, right, span, otherwise):
     dd = 2.0 * ((f[n2] - f[n1]) / (x2 - x1) - (f[n1] - f[e]) / x1) / x2
     if not math.isfinite(dd) or math.isfinite(res(p, te + side * EDGE_PROBE_REL * span, b)):
         return otherwise
-    return min(abs(f[e]), abs(f[n1])) <= BEND * abs(dd) * x1 * x1
+    return min(abs(f[e]), abs(f[n1])) <= BEND * abs(dd) * x1 * x1 or abs(f[e]) <= EDGE_LOW * abs(f[n1])
 
 
 @inlined

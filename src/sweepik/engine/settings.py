@@ -118,6 +118,11 @@ MAX_LEVELS = 4
 #: where that test says so; at the first level only where the edge sits at a sample (``EDGE_PROBE_REL``), else
 #: always.
 BEND = 1.0
+#: ... and, an edge at a sample, whatever that test says, where the residual at the edge is below this fraction of its
+#: neighbour's: it falls towards zero there, and a pair of close roots may sit between the two (the JACO2 next to its
+#: singular set: a pair 1.6e-5 apart, 2.3e-4 inside a branch's edge, the edge's residual 1/42 of its neighbour's and
+#: the three samples a straight line in the edge's coordinate).
+EDGE_LOW = 0.1
 #: An interior extremum of |residual| is examined only if its sample is within EXTREMUM_REACH |f''| h^2 of
 #: zero: 8 times the deepest dip a parabola through the three samples can have (|f''| h^2 / 2).
 EXTREMUM_REACH = 4.0
