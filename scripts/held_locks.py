@@ -23,7 +23,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-from oracles import in_limit_configurations, recovers  # noqa: E402
+from oracles import recovers  # noqa: E402
 from rewrites import rewrite  # noqa: E402
 
 import sweepik  # noqa: E402
@@ -52,7 +52,7 @@ def check_arm(robot: sweepik.Robot, n: int, rng: np.random.Generator) -> tuple[i
         if fast is None:
             continue
         taken += 1
-        q = in_limit_configurations(robot, n, rng)
+        q = _configurations(robot, n, rng)
         mine = 0
         for qq, T in zip(q, robot.fk(q), strict=True):
             v = float(qq[k])
