@@ -19,8 +19,7 @@ the value, so one parallel to another at five values is parallel at all. Axes th
 them (Panda joint 6: axes 5 and 7, one turned by the held joint, in a plane across it) meet at every value where
 they meet at five (their being coplanar is a trigonometric polynomial of degree two in the value): the meeting point
 is worked out in the compiled call; where they turn parallel the held arm is another arm (``lock_windows``). The
-arguments that do not
-depend on the geometry are the held arm's at every value (its length scale is the full arm's:
+arguments that do not depend on the geometry are the held arm's at every value (its length scale is the full arm's:
 ``origin_axis.hold_joints``); the singular set's thresholds (typical step amplitudes, probed) are the largest of the
 five: a pose nearer its singular set than that goes the general way, where the held arm at its own value answers. So
 does every pose the one call does not settle (``single_pose``), and every value near which the held arm is another arm
