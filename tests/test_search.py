@@ -308,6 +308,27 @@ def test_a_close_pair_just_inside_an_edge_at_a_sample_is_searched() -> None:
         assert np.count_nonzero(near & (cand.branch == 2)) >= 2
 
 
+def test_a_double_root_in_a_dip_beside_an_edge_at_a_sample_is_searched() -> None:
+    """The JACO2 on its singular set (``scripts/singular_audit.py --n 60 --seed 5``, configuration 12): a double root
+    of branch 2 2.4e-3 inside the branch's domain edge, which sits at a sample, in a dip ~1e-2 wide that the three
+    samples of the bend test (2.7e-3 at the edge, 3.1e-3 and 3.2e-3 before it) do not show; the configuration was
+    not among the 8 solutions. The residual halfway between the edge and its neighbour, in the edge's coordinate, now
+    decides too (below both: resampled): the compiled search and its NumPy reference find the root."""
+    from sweepik.engine.chunk import chain_poses
+
+    robot = load_robot("kinova_jaco2")
+    q = np.array([-1.932163912795935, 1.1179441845404252, -0.057268935354375786, 0.30807111710135393,
+                  -0.294277518194058, -1.4178137911894344])  # fmt: skip
+    T = robot.fk(q)
+    sols = sweepik.solve(robot, T, limits=False)
+    assert np.abs(robot.fk(sols.q) - T).max() < 1e-9
+    assert np.max(np.abs(np.angle(np.exp(1j * (sols.nearest(q) - q))))) < 1e-6
+    red = sweepik.solving._default_reduction(robot, None)
+    chain, lo, hi = chain_poses(robot, T[None]), np.array([-np.pi]), np.array([np.pi])
+    for cand in (search.search(red, chain, lo, hi, 64)[0], sweep.find_candidates(red, chain, lo, hi, 64)[0]):
+        assert np.any((cand.branch == 2) & (np.abs(cand.theta - q[0]) < 1e-6))
+
+
 def test_a_hidden_edge_beside_a_root_is_no_candidate_of_its_own() -> None:
     """The C-Arm with its elbow stretched and the rail at its end (0): a double root at the sample d1 = 0, and the
     branch's domain ending 8e-4 mm on, between two samples, where the residual is still near zero. Taken as a second

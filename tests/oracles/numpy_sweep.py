@@ -458,11 +458,15 @@ class _Search:
         f0, f1, f2 = fin[i, e], fin[i, n1], fin[i, n2]
         with np.errstate(invalid="ignore", divide="ignore"):
             dd = 2.0 * ((f2 - f1) / (x2 - x1) - (f1 - f0) / x1) / x2
-            bent = np.minimum(np.abs(f0), np.abs(f1)) <= BEND * np.abs(dd) * x1 * x1
-            bent |= np.abs(f0) <= EDGE_LOW * np.abs(f1)
+            low = np.minimum(np.abs(f0), np.abs(f1))
+            bent = (low <= BEND * np.abs(dd) * x1 * x1) | (np.abs(f0) <= EDGE_LOW * np.abs(f1))
         step = EDGE_PROBE_REL * self.span[p[i]]
         past = self.residual(p[i], b[i], (te + side * step)[:, None])[:, 0]
         at = ok & np.isfinite(dd) & ~np.isfinite(past)
+        # (a dip between the edge and its neighbour that the three samples do not show: halfway in its coordinate)
+        mid = self.residual(p[i], b[i], (te - side * 0.25 * x1 * x1)[:, None])[:, 0]
+        with np.errstate(invalid="ignore"):
+            bent |= np.abs(mid) < low
         judged[i_r, j_r], judged[i_l, j_l] = at[: j_r.size], at[j_r.size :]
         bent_out[i_r, j_r], bent_out[i_l, j_l] = bent[: j_r.size], bent[j_r.size :]
         return judged, bent_out

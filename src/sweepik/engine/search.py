@@ -344,7 +344,11 @@ def _edge_bent(res, p, b, th, f, valid, fmask, j, right, span, otherwise):
     dd = 2.0 * ((f[n2] - f[n1]) / (x2 - x1) - (f[n1] - f[e]) / x1) / x2
     if not math.isfinite(dd) or math.isfinite(res(p, te + side * EDGE_PROBE_REL * span, b)):
         return otherwise
-    return min(abs(f[e]), abs(f[n1])) <= BEND * abs(dd) * x1 * x1 or abs(f[e]) <= EDGE_LOW * abs(f[n1])
+    low = min(abs(f[e]), abs(f[n1]))
+    if low <= BEND * abs(dd) * x1 * x1 or abs(f[e]) <= EDGE_LOW * abs(f[n1]):
+        return True
+    # (a dip between them that the three samples do not show: the residual halfway in the edge's coordinate)
+    return abs(res(p, te - side * 0.25 * x1 * x1, b)) < low
 
 
 @inlined
