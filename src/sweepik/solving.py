@@ -517,8 +517,10 @@ def _solve_one(
     """The solutions of the one pose ``P (1, 4, 4)`` (arguments checked here): its chunk, solved directly (with
     ``one_call``: by the one compiled call where it settles the pose); a turned lock (``_turned``, unless not
     ``turned``) at its reference value, turned back."""
-    options = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples, free_joint=free_joint)
-    turn = _turned(robot, locked, options) if turned else None
+    turn = None
+    if turned and locked is not None:
+        options = dict(reduction=reduction, strategy=strategy, limits=limits, n_samples=n_samples)
+        turn = _turned(robot, locked, {**options, "free_joint": free_joint})
     if turn is not None:
         P0, lock0 = turn.poses(P), turn.locked
         ref = _solve_one(robot, P0, reduction, strategy, limits, n_samples, None, lock0, one_call, False)

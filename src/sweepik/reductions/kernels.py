@@ -172,13 +172,17 @@ class LazyKernel:
                 self._dispatcher = _njit(self._sig, **self._options)(self.py_func)
         return self._dispatcher
 
-    @property
-    def signature(self) -> Any:
-        """The compiled signature (a Numba ``Signature``)."""
+    def _overload(self) -> Any:
+        """The dispatcher's compiled overload for the signature (None where Numba keeps none)."""
         from numba.core import sigutils
 
         args, _ = sigutils.normalize_signature(self._sig)
-        return self.dispatcher.overloads[tuple(args)].signature
+        return self.dispatcher.overloads.get(tuple(args))
+
+    @property
+    def signature(self) -> Any:
+        """The compiled signature (a Numba ``Signature``)."""
+        return self._overload().signature
 
     @property
     def unchecked(self) -> Any:
@@ -187,11 +191,7 @@ class LazyKernel:
         the signature's types (arrays of its dtype, dimensions and layout); another type would be read as this one.
         The dispatcher where Numba gives no entry point."""
         if self._unchecked is None:
-            from numba.core import sigutils
-
-            args, _ = sigutils.normalize_signature(self._sig)
-            overload = self.dispatcher.overloads.get(tuple(args))
-            self._unchecked = getattr(overload, "entry_point", None) or self.dispatcher
+            self._unchecked = getattr(self._overload(), "entry_point", None) or self.dispatcher
         return self._unchecked
 
     def __call__(self, *args: Any) -> Any:
