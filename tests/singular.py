@@ -73,6 +73,57 @@ def singular_configurations(robot: Any, n: int, rng: np.random.Generator, grid: 
     return np.array(out)
 
 
+def _wrist_straight(robot: Any, q: np.ndarray, grid: int = 721) -> list[float]:
+    """Values of joint 5 where, with the rest of ``q``, the axes of joints 4 and 6 are parallel (their cross product,
+    along joint 5's axis, changes sign)."""
+
+    def cross(Q: np.ndarray) -> np.ndarray:
+        J = robot.jacobian(Q)
+        return np.einsum("...i,...i->...", np.cross(J[..., 3:, 3], J[..., 3:, 5]), J[..., 3:, 4])
+
+    xs = np.linspace(-np.pi, np.pi, grid)
+    Q = np.repeat(q[None], grid, axis=0)
+    Q[:, 4] = xs
+    vals = cross(Q)
+    out = []
+    for i in np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0):
+        out.append(brentq(lambda x: float(cross(np.r_[q[:4], x, q[5:]])), xs[i], xs[i + 1], xtol=1e-15))
+    return out
+
+
+def folds_with_a_straight_wrist(
+    robot: Any, n: int, joint: int, rng: np.random.Generator, grid: int = 721
+) -> np.ndarray:
+    """``(n, 6)`` configurations of a 6R arm with a wrist (joints 4-6) where det J = 0 along ``joint`` with joint 5
+    1e-7 ... 1e-4 rad from where the wrist is straight (axes 4 and 6 parallel): a double root whose neighbours the
+    nearly singular wrist spreads far apart (a later step divides by the wrist's sine)."""
+    out: list[np.ndarray] = []
+    for _ in range(20 * n):
+        if len(out) == n:
+            break
+        q = rng.uniform(-np.pi, np.pi, 6)
+        straight = _wrist_straight(robot, q, grid)
+        if not straight:
+            continue
+        q[4] = float(rng.choice(straight)) + float(rng.choice([-1.0, 1.0])) * 10.0 ** rng.uniform(-7.0, -4.0)
+        xs = np.linspace(-np.pi, np.pi, grid)
+        Q = np.repeat(q[None], grid, axis=0)
+        Q[:, joint] = xs
+        vals = np.linalg.det(robot.jacobian(Q))
+        idx = np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)
+        if idx.size == 0:
+            continue
+        i = int(rng.choice(idx))
+        q[joint] = brentq(
+            lambda x, q=q: float(np.linalg.det(robot.jacobian(np.r_[q[:joint], x, q[joint + 1 :]]))),
+            xs[i],
+            xs[i + 1],
+            xtol=1e-15,
+        )
+        out.append(q)
+    return np.array(out)
+
+
 def recovered(robot: Any, sols: Any, q: np.ndarray, tol: float = 1e-6) -> bool:
     """``q`` is among ``sols`` (a ``sweepik.Solutions``) as the module docstring says."""
     if not (len(sols) or sols.families):

@@ -54,6 +54,14 @@ __all__ = [
 #: from moves ``c`` by a few ulps, and a solution exactly at a branch-domain edge must not turn into "none".
 DOMAIN_TOL = 1e-12
 
+#: ``|c|`` within this many roundings of 1 (``eps`` times the magnitudes ``c`` is built from, over ``r``) is 1: the
+#: two angles meet. The digits below the rounding carry no information, yet ``sqrt(1 - c^2)`` turns them into two
+#: angles ``sqrt(2 tau)`` apart (3 ulps: 2.6e-8) -- which a later ill-conditioned step magnifies: a UR3 on its
+#: shoulder fold with the wrist 8.5e-6 from straight had its double root split into two points 3.7e-3 apart (joint 1
+#: over the wrist's sine), each solving the pose to rounding, neither the root.
+MEET_ROUNDINGS = 4.0
+_EPS = float(np.finfo(np.float64).eps)
+
 
 @njit(cache=True, error_model=ERROR_MODEL, forceinline=True)
 def in_domain(c):
@@ -85,16 +93,18 @@ def sp1(p1, p2, k):
 def sp4_cs(h, p, k, d):
     """``sp4`` without angles: ``(cos, sin)`` of both solutions, then ``c`` and ``r``:
     ``cos_a, sin_a, cos_b, sin_b, c, r``. The angles are ``phi +- w`` with ``(cos, sin)(phi) = (A, B) / r`` and
-    ``cos w = c``, ``sin w = sqrt(1 - c^2)`` (``w`` = 0 or pi outside ``|c| <= 1``: the least-squares angle)."""
+    ``cos w = c``, ``sin w = sqrt(1 - c^2)`` (``w`` = 0 or pi outside ``|c| <= 1``: the least-squares angle, and
+    within rounding of ``|c| = 1``: ``MEET_ROUNDINGS``)."""
     A = dot(h, perp(k, p))
     B = dot(h, cross(k, p))
     r = math.sqrt(A * A + B * B)
-    rhs = d - dot(h, k) * dot(k, p)
+    along = dot(h, k) * dot(k, p)
     if r == 0.0:
         return 1.0, 0.0, 1.0, 0.0, math.nan, 0.0
-    c = rhs / r
+    c = (d - along) / r
     cp, sp = A / r, B / r
-    if abs(c) >= 1.0:  # tangent or least squares: one angle
+    # tangent (to rounding: ``MEET_ROUNDINGS``) or least squares: one angle
+    if abs(c) >= 1.0 - MEET_ROUNDINGS * _EPS * (1.0 + (abs(d) + abs(along)) / r):
         cw = 1.0 if c > 0.0 else -1.0
         return cp * cw, sp * cw, cp * cw, sp * cw, c, r
     sw = math.sqrt(1.0 - c * c)
