@@ -65,3 +65,20 @@ def test_a_double_root_beyond_a_nearly_straight_wrist_is_one_root(name: str, joi
     for q in folds_with_a_straight_wrist(robot, 12, joint, np.random.default_rng(joint)):
         s = sweepik.solve(robot, robot.fk(q), limits=False)
         assert recovered(robot, s, q), (name, q.tolist())
+
+
+def test_a_root_just_inside_a_domain_edge_from_a_nearly_singular_edge_candidate() -> None:
+    """An xArm 6 configuration on its singular set whose root, for the sweep of joint 6, touches zero on a bump 2e-6
+    wide 7.8e-7 rad inside its branch domain's edge: no sampling sees the bump, and the edge's candidate, 1.3e-4 rad
+    from the root, misses the pose by 1.4e-6 of the arm's size, just above the polish's reach for a simple root
+    (``settings.POLISH_BELOW_REL``). Its configuration is nearly singular: polished up to ``POLISH_SINGULAR_REL``, it is
+    the root."""
+    robot = sweepik.load_robot("xarm6")
+    q = np.array([2.035763340732469, -1.6923828505008456, 0.408385759659455, 0.03207725126969141,
+                  1.4158783088420002, 0.21986759611671802])  # fmt: skip
+    assert sweepik.analyze(robot)["chosen"]["free_joint"] == 5
+    s = sweepik.solve(robot, robot.fk(q), limits=False)
+    assert recovered(robot, s, q)
+    assert np.all(s.error_geodesic <= 1e-13 * robot.length_scale)
+    batch = sweepik.solve_many(robot, robot.fk(np.stack([q, np.full(6, 0.3)])), limits=False)
+    assert recovered(robot, batch[0], q)

@@ -25,6 +25,7 @@ from sweepik.engine.families import (
 )
 from sweepik.engine.family_join import add_crossing_families, trace_cut_continua, with_families
 from sweepik.engine.paper_sweep import paper_candidates
+from sweepik.engine.partners import nearly_singular
 from sweepik.engine.polish import polish
 from sweepik.engine.rough_continua import RoughRedo
 from sweepik.engine.settings import (
@@ -34,6 +35,7 @@ from sweepik.engine.settings import (
     N_SAMPLES,
     PAPER_ACCEPT_MM,
     POLISH_BELOW_REL,
+    POLISH_SINGULAR_REL,
     SEED_TOL_REL,
 )
 from sweepik.engine.settle import (
@@ -572,7 +574,11 @@ def _settle_stepwise(
         err_geo, err_paper = errors_of(robot, q, poses[pose_idx], weight)
     below, above, paper_above, accept, multiple = settle_bounds(robot)
     if strategy == "precise":
-        reach = np.where(mult >= 2, multiple, below)  # (a multiple root's candidate: further, POLISH_MULTIPLE_REL)
+        # (a multiple root's candidate: further, POLISH_MULTIPLE_REL; a nearly singular one's: POLISH_SINGULAR_REL)
+        reach = np.where(mult >= 2, multiple, below)
+        band = np.flatnonzero((err_geo > below) & (err_geo <= POLISH_SINGULAR_REL * robot.length_scale) & (mult < 2))
+        if band.size:
+            reach[band[nearly_singular(robot, q[band])]] = multiple
         near = np.nonzero((err_geo <= reach) & ((err_geo > above) | (err_paper > paper_above)))[0]
         if near.size:
             target = poses[pose_idx[near]]

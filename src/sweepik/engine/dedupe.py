@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from sweepik._jit import inlined, internal
 from sweepik.engine import parallel
-from sweepik.engine.settings import DEDUPE_ANGLE, DEDUPE_LENGTH_REL
+from sweepik.engine.settings import DEDUPE_ANGLE, DEDUPE_LENGTH_REL, POLISH_BELOW_REL, POLISH_SINGULAR_REL
 from sweepik.reductions.kernels import lazy_njit
 from sweepik.results import joint_distance
 from sweepik.subproblems.trig import wrap_pi
@@ -33,6 +33,9 @@ if TYPE_CHECKING:
     from sweepik.model.robot import Robot
 
 Array = NDArray[np.float64]
+
+#: ``settings.POLISH_SINGULAR_REL`` over ``POLISH_BELOW_REL``: ``_settle`` takes the latter, absolute.
+_SINGULAR_OVER_BELOW = POLISH_SINGULAR_REL / POLISH_BELOW_REL
 
 __all__ = [
     "finish",
@@ -113,7 +116,9 @@ def settle(
     """The solver's steps from candidates to final ones in one compiled pass, for the poses (of ``n_poses``) where
     none of its rarer steps is due: ``(due, rows, w, inside, keep)``. ``due (n_poses,)`` marks the poses left to the
     solver's steps: a candidate is due a polish (``err_geo`` at most ``thresholds[0]``, ``thresholds[4]`` for a
-    multiple root's (``mult`` 2 or more), and above ``thresholds[1]``, or ``err_paper`` above ``thresholds[2]``), or
+    multiple root's (``mult`` 2 or more), and up to ``POLISH_SINGULAR_REL`` for a simple root's, whose configuration
+    the solver's steps polish if it is nearly singular; and above ``thresholds[1]``, or ``err_paper`` above
+    ``thresholds[2]``), or
     a certified one lies outside the limits by at most ``reach`` (per joint: the solver tries it at the limit). Of
     the other poses, ``rows`` are the certified candidates (finite, ``err_geo`` within ``thresholds[3]``), in order,
     with ``finish``'s wrapped configurations ``w``, limit check and duplicate mask: the values the solver's NumPy
@@ -475,7 +480,9 @@ def _settle(
             if not finite:
                 continue
             e = eg[k]
-            below = polish_multiple if mult[k] >= 2 else polish_below
+            # (a simple root's candidate further than polish_below: the solver's steps polish it if its configuration
+            # is nearly singular, ``settings.POLISH_SINGULAR_REL``)
+            below = polish_multiple if mult[k] >= 2 else polish_below * _SINGULAR_OVER_BELOW
             if e <= below and (e > polish_above or ep[k] > polish_paper_above):
                 due[pose[k]] = True  # a Newton polish (or, failing it, the fallback reduction)
                 continue

@@ -34,6 +34,13 @@ POLISH_BELOW_REL = 1e-6
 #: singular set: a double root 3e-9 rad from the edge, the edge's candidate missing the pose by 8e-6 of the arm's
 #: size, certified after the polish). Such candidates are few (singular poses): the common pose pays nothing.
 POLISH_MULTIPLE_REL = 1e-4
+#: ... and a simple root's candidate up to this when its configuration is nearly singular
+#: (``partners.nearly_singular``): a root 7.8e-7 rad inside a branch domain's edge, on a tangent bump 2e-6 wide that
+#: no sampling sees (an xArm 6 on its singular set), leaves the edge's candidate 1.3e-4 rad from it, missing the pose
+#: by 1.4e-6 of the arm's size; polished, it is the root. Up to ``POLISH_MULTIPLE_REL`` the C-Arm's single solves took
+#: 1.3 times as long (a tenth of its poses has such a candidate, mostly a residual's shallow minimum); up to this, a
+#: hundredth.
+POLISH_SINGULAR_REL = 1e-5
 
 #: ... and above this (already at rounding level: nothing to gain), ...
 POLISH_ABOVE_REL = 1e-14
