@@ -42,6 +42,25 @@ def _range(robot: Any) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
+def _brackets(f: Any, q: np.ndarray, joint: int, lo: float, hi: float, grid: int) -> tuple[np.ndarray, np.ndarray]:
+    """Where ``f`` (configurations ``(..., n)`` to values ``(...)``) changes sign as ``joint`` of ``q`` moves over
+    ``[lo, hi]`` on a grid: the grid ``xs`` and the indices ``i`` of the brackets ``[xs[i], xs[i + 1]]``."""
+    xs = np.linspace(lo, hi, grid)
+    Q = np.repeat(q[None], grid, axis=0)
+    Q[:, joint] = xs
+    vals = f(Q)
+    return xs, np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)
+
+
+def _zero(f: Any, q: np.ndarray, joint: int, a: float, b: float) -> float:
+    """The value of ``joint`` in ``[a, b]`` where ``f`` (as ``_brackets``) of ``q`` so moved vanishes."""
+    return float(brentq(lambda x: float(f(np.r_[q[:joint], x, q[joint + 1 :]])), a, b, xtol=1e-15))
+
+
+def _det(robot: Any) -> Any:
+    return lambda Q: np.linalg.det(robot.jacobian(Q))
+
+
 def singular_configurations(robot: Any, n: int, rng: np.random.Generator, grid: int = 721) -> np.ndarray:
     """``(n, n_joints)`` configurations on the singular set of ``robot`` (6 joints) and next to it."""
     lo, hi = _range(robot)
@@ -51,21 +70,11 @@ def singular_configurations(robot: Any, n: int, rng: np.random.Generator, grid: 
         tries += 1
         q = rng.uniform(lo, hi)
         k = int(rng.integers(robot.n_joints))
-        xs = np.linspace(lo[k], hi[k], grid)
-        Q = np.repeat(q[None], grid, axis=0)
-        Q[:, k] = xs
-        vals = np.linalg.det(robot.jacobian(Q))
-        idx = np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)
+        xs, idx = _brackets(_det(robot), q, k, lo[k], hi[k], grid)
         if idx.size == 0:
             continue
         i = int(rng.choice(idx))
-
-        def det(x: float, q: np.ndarray = q, k: int = k) -> float:
-            qq = q.copy()
-            qq[k] = x
-            return float(np.linalg.det(robot.jacobian(qq)))
-
-        x = brentq(det, xs[i], xs[i + 1], xtol=1e-15)
+        x = _zero(_det(robot), q, k, xs[i], xs[i + 1])
         step = float(rng.choice(OFFSETS)) * float(rng.choice([-1.0, 1.0]))
         qs = q.copy()
         qs[k] = x + (step if robot.is_revolute[k] else step * robot.length_scale)
@@ -81,14 +90,8 @@ def _wrist_straight(robot: Any, q: np.ndarray, grid: int = 721) -> list[float]:
         J = robot.jacobian(Q)
         return np.einsum("...i,...i->...", np.cross(J[..., 3:, 3], J[..., 3:, 5]), J[..., 3:, 4])
 
-    xs = np.linspace(-np.pi, np.pi, grid)
-    Q = np.repeat(q[None], grid, axis=0)
-    Q[:, 4] = xs
-    vals = cross(Q)
-    out = []
-    for i in np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0):
-        out.append(brentq(lambda x: float(cross(np.r_[q[:4], x, q[5:]])), xs[i], xs[i + 1], xtol=1e-15))
-    return out
+    xs, idx = _brackets(cross, q, 4, -np.pi, np.pi, grid)
+    return [_zero(cross, q, 4, xs[i], xs[i + 1]) for i in idx]
 
 
 def folds_with_a_straight_wrist(
@@ -106,20 +109,11 @@ def folds_with_a_straight_wrist(
         if not straight:
             continue
         q[4] = float(rng.choice(straight)) + float(rng.choice([-1.0, 1.0])) * 10.0 ** rng.uniform(-7.0, -4.0)
-        xs = np.linspace(-np.pi, np.pi, grid)
-        Q = np.repeat(q[None], grid, axis=0)
-        Q[:, joint] = xs
-        vals = np.linalg.det(robot.jacobian(Q))
-        idx = np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)
+        xs, idx = _brackets(_det(robot), q, joint, -np.pi, np.pi, grid)
         if idx.size == 0:
             continue
         i = int(rng.choice(idx))
-        q[joint] = brentq(
-            lambda x, q=q: float(np.linalg.det(robot.jacobian(np.r_[q[:joint], x, q[joint + 1 :]]))),
-            xs[i],
-            xs[i + 1],
-            xtol=1e-15,
-        )
+        q[joint] = _zero(_det(robot), q, joint, xs[i], xs[i + 1])
         out.append(q)
     return np.array(out)
 
