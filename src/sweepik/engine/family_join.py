@@ -17,7 +17,7 @@ from sweepik.engine.families import (
     unique_families,
 )
 from sweepik.engine.polish import geodesic_errors
-from sweepik.engine.settings import ACCEPT_TOL_REL, AT_LIMIT, PAST_END_REL, POLISH_BELOW_REL
+from sweepik.engine.settings import ACCEPT_TOL_REL, AT_LIMIT, INNER_PROBES, PAST_END_REL, POLISH_BELOW_REL
 from sweepik.engine.settle import per_joint
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
@@ -147,6 +147,28 @@ def add_crossing_families(
         fams.setdefault(i, []).extend(f for f, o in zip(found, inner_off(robot, found, known[i]), strict=True) if o)
 
 
+#: Where a family is asked whether it lies on others (its interval's fractions): ``INNER_PROBES`` and both ends.
+ENDS_AND_INNER = np.array((0.0, *INNER_PROBES, 1.0))
+
+
+def _not_repeated(robot: Robot, families: tuple[Family, ...]) -> tuple[Family, ...]:
+    """``families`` without those lying on an earlier one, ends included (``ENDS_AND_INNER``): one continuum found
+    twice, along two joints (a wrist with its slide at zero: the q4/q6 continuum traced along joint 4 and along joint
+    6), or a piece of one found whole too. One that lies on two others (a piece reaching 3.5e-4 rad past the end of the
+    one it crosses there) stays."""
+    if len(families) < 2:
+        return families
+    members = [f.at(f.interval[0] + (f.interval[1] - f.interval[0]) * ENDS_AND_INNER) for f in families]
+    pairs = [(i, j) for i in range(1, len(families)) for j in range(i)]  # (family i on family j: one batch)
+    offs = off_families(robot, [(members[i], (families[j],)) for i, j in pairs])
+    on = {pair for pair, off in zip(pairs, offs, strict=True) if not off.any()}
+    kept: list[int] = []
+    for i in range(len(families)):
+        if not any((i, j) in on for j in kept):
+            kept.append(i)
+    return tuple(families[i] for i in kept)
+
+
 def with_families(
     robot: Robot,
     red: Reduction,
@@ -172,6 +194,7 @@ def with_families(
         other = fallback.get(i)
         if other is not None:
             fam = unique_families(fam + other.families)
+        fam = _not_repeated(robot, fam)
         families[i] = fam
         rows = np.nonzero(pose_idx == i)[0]
         if other is not None and (rows.size == 0 or red.closed_form):
