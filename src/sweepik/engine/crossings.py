@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine.continuation import scaled_singular, second_singular
-from sweepik.engine.families import certified_members, certified_members_of
+from sweepik.engine.families import members_at
 from sweepik.engine.settings import (
     CROSS_RANK,
     CROSS_SAMPLES,
@@ -33,7 +33,7 @@ from sweepik.engine.settings import (
 )
 from sweepik.model.pose import wrap_angle
 from sweepik.model.robot import Robot
-from sweepik.results import Family, thetas_inside
+from sweepik.results import Family
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.intp]
@@ -59,27 +59,12 @@ def _singular_of(robot: Robot, probes: list[Array]) -> list[Array]:
 
 
 def _grid_probes(families: list[Family]) -> list[Array]:
-    """``_probe`` of each family at its ``CROSS_SAMPLES`` grid (``_grid``); the families of one reduction without
-    members of their own (``certified_members``, no joints held) at once (``certified_members_of``): the same
-    values."""
-    out: list[Array] = [np.zeros((0, 0))] * len(families)
-    groups: dict[int, list[int]] = {}
-    for k, f in enumerate(families):
-        red = f.reduction
-        if f.members is certified_members and f.held is None and getattr(red, "corrected", None) is None:
-            groups.setdefault(id(red), []).append(k)
-        else:
-            out[k] = _probe(f, _grid(f))
-    for ks in groups.values():
-        fs = [families[k] for k in ks]
-        red = fs[0].reduction
-        lo, hi = np.array([f.interval for f in fs], dtype=np.float64).T
-        theta = thetas_inside(lo[:, None], hi[:, None], red.periodic, np.linspace(lo, hi, CROSS_SAMPLES, axis=1))
-        chains = np.array([f.chain_pose for f in fs])
-        branch = np.array([f.branch for f in fs], dtype=np.intp)
-        q = red.robot.wrap(certified_members_of(red, chains, branch, theta, lo, hi))
-        for j, k in enumerate(ks):
-            out[k] = q[j]
+    """``_probe`` of each family at its ``CROSS_SAMPLES`` grid (``_grid``); the families whose probes are their
+    members (``Family.at``) at once (``members_at``): the same values."""
+    out = [_probe(f, _grid(f)) if _traced(f) else np.zeros((0, 0)) for f in families]
+    plain = [k for k, f in enumerate(families) if not _traced(f)]
+    for k, q in zip(plain, members_at([families[k] for k in plain], [_grid(families[k]) for k in plain]), strict=True):
+        out[k] = q
     return out
 
 
@@ -87,6 +72,11 @@ def _grid(f: Family) -> Array:
     """The ``CROSS_SAMPLES`` theta* values over the family's interval, ends included."""
     lo, hi = f.interval
     return np.linspace(lo, hi, CROSS_SAMPLES)
+
+
+def _traced(family: Family) -> bool:
+    """The family's members are probed where the Newton steps left them (``_probe``), not as ``Family.at`` gives."""
+    return getattr(family.reduction, "corrected", None) is not None and family.held is None
 
 
 def _probe(family: Family, theta: Array) -> Array:

@@ -31,7 +31,7 @@ from sweepik.model.pose import pose_error_geodesic
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
 from sweepik.reductions import Reduction
-from sweepik.results import Family, joint_distance
+from sweepik.results import Family, joint_distance, thetas_inside
 
 Array = NDArray[np.float64]
 
@@ -100,6 +100,31 @@ def certified_members_of(
         q[bad[okn]] = qn[okn]
         bad = bad[~okn]
     return q.reshape(F, M, -1)
+
+
+def members_at(families: Sequence[Family], theta: Sequence[Array]) -> list[Array]:
+    """``[f.at(t) for f, t in zip(families, theta)]``, the same values; the families of one reduction whose members
+    are the engine's (``certified_members``, no joints held, no members of the reduction's own) and asked at as many
+    values at once (``certified_members_of``: one call for a batch's families, not one each)."""
+    out: list[Array] = [np.zeros((0, 0))] * len(families)
+    groups: dict[tuple[int, int], list[int]] = {}
+    for k, (f, t) in enumerate(zip(families, theta, strict=True)):
+        if f.members is certified_members and f.held is None and getattr(f.reduction, "corrected", None) is None:
+            groups.setdefault((id(f.reduction), np.size(t)), []).append(k)
+        else:
+            out[k] = f.at(t)
+    for ks in groups.values():
+        fs = [families[k] for k in ks]
+        red = fs[0].reduction
+        lo, hi = np.array([f.interval for f in fs], dtype=np.float64).T
+        th = np.array([np.asarray(theta[k], dtype=np.float64).reshape(-1) for k in ks])
+        th = thetas_inside(lo[:, None], hi[:, None], red.periodic, th)
+        chains = np.array([f.chain_pose for f in fs])
+        branch = np.array([f.branch for f in fs], dtype=np.intp)
+        q = red.robot.wrap(certified_members_of(red, chains, branch, th, lo, hi))
+        for j, k in enumerate(ks):
+            out[k] = q[j].reshape(*np.shape(theta[k]), -1)
+    return out
 
 
 def _solve_chain(robot: Robot, q: Array, chain: Array, tol: float) -> NDArray[np.bool_]:
@@ -625,7 +650,8 @@ def inner_off(robot: Robot, found: Sequence[Family], known: tuple[Family, ...]) 
     ``INNER_PROBES`` of their interval is not a member of any of ``known``."""
     if not found:
         return np.zeros(0, dtype=bool)
-    members = [f.at(f.interval[0] + (f.interval[1] - f.interval[0]) * np.array(INNER_PROBES)) for f in found]
+    probes = np.array(INNER_PROBES)
+    members = members_at(found, [f.interval[0] + (f.interval[1] - f.interval[0]) * probes for f in found])
     return np.array([o.any() for o in off_families(robot, [(m, known) for m in members])], dtype=bool)
 
 

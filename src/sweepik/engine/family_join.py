@@ -13,6 +13,7 @@ from sweepik.engine.continuation import Traced, continuum_families, correct
 from sweepik.engine.crossings import crossing_grids, crossing_seeds
 from sweepik.engine.families import (
     inner_off,
+    members_at,
     off_families,
     unique_families,
 )
@@ -151,22 +152,31 @@ def add_crossing_families(
 ENDS_AND_INNER = np.array((0.0, *INNER_PROBES, 1.0))
 
 
-def _not_repeated(robot: Robot, families: tuple[Family, ...]) -> tuple[Family, ...]:
-    """``families`` without those lying on an earlier one, ends included (``ENDS_AND_INNER``): one continuum found
-    twice, along two joints (a wrist with its slide at zero: the q4/q6 continuum traced along joint 4 and along joint
-    6), or a piece of one found whole too. One that lies on two others (a piece reaching 3.5e-4 rad past the end of the
-    one it crosses there) stays."""
-    if len(families) < 2:
-        return families
-    members = [f.at(f.interval[0] + (f.interval[1] - f.interval[0]) * ENDS_AND_INNER) for f in families]
-    pairs = [(i, j) for i in range(1, len(families)) for j in range(i)]  # (family i on family j: one batch)
-    offs = off_families(robot, [(members[i], (families[j],)) for i, j in pairs])
-    on = {pair for pair, off in zip(pairs, offs, strict=True) if not off.any()}
-    kept: list[int] = []
-    for i in range(len(families)):
-        if not any((i, j) in on for j in kept):
-            kept.append(i)
-    return tuple(families[i] for i in kept)
+def _not_repeated(robot: Robot, families: dict[int, tuple[Family, ...]]) -> dict[int, tuple[Family, ...]]:
+    """Each pose's ``families`` without those lying on an earlier one, ends included (``ENDS_AND_INNER``): one
+    continuum found twice, along two joints (a wrist with its slide at zero: the q4/q6 continuum traced along joint 4
+    and along joint 6), or a piece of one found whole too. One that lies on two others (a piece reaching 3.5e-4 rad
+    past the end of the one it crosses there) stays. The batch's poses at once."""
+    several = {i: fs for i, fs in families.items() if len(fs) > 1}
+    flat = [f for fs in several.values() for f in fs]
+    members = iter(members_at(flat, [f.interval[0] + (f.interval[1] - f.interval[0]) * ENDS_AND_INNER for f in flat]))
+    checks: list[tuple[Array, tuple[Family, ...]]] = []
+    pairs: list[tuple[int, int, int]] = []  # (family a on family b of pose i)
+    for i, fs in several.items():
+        m = [next(members) for _ in fs]
+        for a in range(1, len(fs)):
+            for b in range(a):
+                checks.append((m[a], (fs[b],)))
+                pairs.append((i, a, b))
+    on = {pair for pair, off in zip(pairs, off_families(robot, checks), strict=True) if not off.any()}
+    out = dict(families)
+    for i, fs in several.items():
+        kept: list[int] = []
+        for a in range(len(fs)):
+            if not any((i, a, b) in on for b in kept):
+                kept.append(a)
+        out[i] = tuple(fs[a] for a in kept)
+    return out
 
 
 def with_families(
@@ -190,12 +200,12 @@ def with_families(
     checks: list[tuple[Array, tuple[Family, ...]]] = []  # (configurations, families) of each pose, checked at once
     targets: list[tuple[int, Solutions | None, NDArray[np.intp]]] = []
     for i in sorted(set(fams) | set(fallback)):
-        fam = tuple(fams.get(i, ()))
         other = fallback.get(i)
-        if other is not None:
-            fam = unique_families(fam + other.families)
-        fam = _not_repeated(robot, fam)
-        families[i] = fam
+        own = tuple(fams.get(i, ()))
+        families[i] = own if other is None else unique_families(own + other.families)
+    families = _not_repeated(robot, families)
+    for i, fam in families.items():
+        other = fallback.get(i)
         rows = np.nonzero(pose_idx == i)[0]
         if other is not None and (rows.size == 0 or red.closed_form):
             keep[rows] = False
