@@ -245,3 +245,20 @@ def test_vendor_arm_rewritten_keeps_a_double_root_the_polish_reaches_slowly() ->
         assert recovered(robot, sols, q) and len(sols) == 10
         dp, ang = pose_errors(robot.fk(sols.q), T, robot.length_scale)
         assert np.all(dp <= 1e-9) and np.all(ang <= 1e-9)
+
+
+def test_vendor_arm_rewritten_keeps_a_root_at_the_end_of_a_curved_valley() -> None:
+    """The big YAM as ``scripts/ssik_catalogue.py --rewrite --n 20 --singular 10`` writes it (``tests/data``), at its
+    singular-set configuration 20 (smallest singular value 2e-8 of the largest): along a curved valley ~0.1 rad long
+    the Jacobian is nearly singular (2e-8 all along) and the pose missed by 1e-10 ... 1e-9 only. The elimination's
+    candidates stalled in it 1e-2 rad from the root: a straight Newton step leaves the curved valley, and its error
+    grew. The step re-projected onto the valley converges (``elimination._onto_valley``): 6 roots, 4 before."""
+    robot = sweepik.load_robot(str(Path(__file__).parent / "data" / "big_yam_rewritten_2.toml"))
+    q = np.array([1.9921258439407326, 2.9092350581717223, -1.8907175030992338, -0.11774377258211377])
+    q = np.append(q, [1.5707924027614455, 0.6462187302704878])
+    assert np.linalg.cond(robot.jacobian(q[None])[0]) > 1e7
+    T = robot.fk(q)
+    for sols in (sweepik.solve(robot, T, limits=False), sweepik.solve_many(robot, T[None], limits=False)[0]):
+        assert recovered(robot, sols, q) and len(sols) % 2 == 0
+        dp, ang = pose_errors(robot.fk(sols.q), T, robot.length_scale)
+        assert np.all(dp <= 1e-9) and np.all(ang <= 1e-9)

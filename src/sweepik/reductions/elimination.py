@@ -494,6 +494,27 @@ def _solve6(J, r):
     return x, pmin / pmax
 
 
+#: The longest Newton step along a valley of near solutions that ``_polish`` re-projects onto it (radians; a slide's
+#: over the arm's scale).
+VALLEY_STEP = 0.05
+
+
+@njit(cache=True, error_model="numpy")
+def _onto_valley(H, P, rev, R_end, q, RT, pT):
+    """``q`` moved onto the valley of near solutions beside it: two Newton steps in the five well-conditioned
+    directions of the Jacobian only (``_polish``)."""
+    for _k in range(2):
+        r, p, dev = _residual6(H, P, rev, R_end, q, RT, pT)
+        J = _jac6(H, P, rev, q)
+        if not (np.all(np.isfinite(J)) and np.all(np.isfinite(r))):
+            break
+        U, S, Vt = np.linalg.svd(J)
+        ur = U.T @ r
+        for i in range(5):
+            q = q - (ur[i] / S[i]) * Vt[i]
+    return q
+
+
 @njit(cache=True, error_model="numpy")
 def _polish(H, P, rev, R_end, q0, RT, pT, max_iter, tol):
     """Newton on the full FK system, run until the residual stops decreasing (machine precision). Plain
@@ -548,20 +569,18 @@ def _polish(H, P, rev, R_end, q0, RT, pT, max_iter, tol):
             qn = q + step
             rn, pn, devn = _residual6(H, P, rev, R_end, qn, RT, pT)
             nn = math.sqrt(np.sum(rn * rn)) + devn
-            q2 = q + 2.0 * step
-            for _k in range(2):
-                r2, p2, dev2 = _residual6(H, P, rev, R_end, q2, RT, pT)
-                J2 = _jac6(H, P, rev, q2)
-                if not (np.all(np.isfinite(J2)) and np.all(np.isfinite(r2))):
+            for times in (2.0, 1.0):
+                # (the step itself re-projected only where neither gains and it is short: along a valley of near
+                # solutions, its Jacobian nearly singular all along it, the I2RT big YAM rewritten stalled 1e-2 rad
+                # from its root at 1e-10; tried first, or a longer one, it carried candidates along such valleys
+                # over to another root, 0.5 rad on)
+                if times == 1.0 and (nn < 0.9 * nr or np.max(np.abs(step)) > VALLEY_STEP):
                     break
-                U2, S2, Vt2 = np.linalg.svd(J2)
-                ur2 = U2.T @ r2
-                for i in range(5):
-                    q2 = q2 - (ur2[i] / S2[i]) * Vt2[i]
-            r2, p2, dev2 = _residual6(H, P, rev, R_end, q2, RT, pT)
-            n2 = math.sqrt(np.sum(r2 * r2)) + dev2
-            if n2 < nn:
-                qn, rn, nn = q2, r2, n2
+                q2 = _onto_valley(H, P, rev, R_end, q + times * step, RT, pT)
+                r2, p2, dev2 = _residual6(H, P, rev, R_end, q2, RT, pT)
+                n2 = math.sqrt(np.sum(r2 * r2)) + dev2
+                if n2 < nn:
+                    qn, rn, nn = q2, r2, n2
             if nn < 0.9 * nr:
                 q, r, nr = qn, rn, nn
                 continue
