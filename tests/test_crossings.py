@@ -157,8 +157,8 @@ def test_the_batch_grids_are_each_familys_own() -> None:
                 assert g is None
                 continue
             own = _second_singular(robot, f, _grid(f))
-            if g is None:  # (no dip to search: left out)
-                assert not _dips(own[None]).any()
+            if g is None:  # (no dip to search, or the screen shows no crossing: left out)
+                assert not _dips(own[None]).any() or not _full_grid_seeds(robot, f)
             else:
                 np.testing.assert_array_equal(g, own)
 
@@ -180,3 +180,59 @@ def test_continua_crossing_where_a_member_is_at_pi_are_found() -> None:
     along = [f for f in sol.families if f.free_joint == 3]
     assert len(along) == 2
     assert off_families(robot, [(along[1].sample(15), (along[0],))])[0].sum() >= 13
+
+
+def _full_grid_seeds(robot: sweepik.Robot, family: sweepik.Family) -> int:
+    """How many seeds ``crossing_seeds`` gives from the family's whole grid, without the screen."""
+    from sweepik.engine.crossings import _dips, _grid, _second_singular, crossing_seeds
+
+    own = _second_singular(robot, family, _grid(family))
+    return len(crossing_seeds(robot, (family,), [own if _dips(own[None]).any() else None])[1])
+
+
+def test_the_screen_passes_no_family_that_crosses_another() -> None:
+    """``crossings.screened`` (the cofactors' signs at every fourth member) lets no family through whose whole grid
+    the search finds a crossing on: the C-Arm with joints 5 and 6 swapped and the KR 6 (where a family's members go
+    over to the wrist turned by pi just past the crossing) on and next to their singular sets. And it does let most
+    families through (the C-Arm's grid poses: the screen is what saves their probes)."""
+    from singular import singular_configurations
+
+    from sweepik.engine.crossings import screened
+    from sweepik.experiments.bench import grid_configurations
+
+    crossing = 0
+    for name, seed in (("carm_swapped", 1), ("kuka_kr6_r900", 11)):
+        robot = sweepik.load_robot(name)
+        rng = np.random.default_rng(seed)
+        Q = singular_configurations(robot, 30, rng)
+        if name == "kuka_kr6_r900":
+            Q = np.array([_shoulder_singular(robot, rng) for _ in range(3)])
+        fams = [f for s in sweepik.solve_many(robot, robot.fk(Q), limits=False) for f in s.families]
+        fams = [f for f in fams if f.interval[1] > f.interval[0]]
+        for f, passed in zip(fams, screened(robot, fams), strict=True):
+            found = _full_grid_seeds(robot, f)
+            crossing += found > 0
+            assert not (passed and found), (name, f)
+    assert crossing >= 4
+    carm = sweepik.load_robot("carm")
+    q = grid_configurations(include_singular=False)[::7][:600]
+    fams = [f for s in sweepik.solve_many(carm, carm.fk(q)) for f in s.families]
+    assert np.mean(screened(carm, fams)) > 0.5
+
+
+def test_the_cofactors_give_the_determinant_with_the_column_replaced() -> None:
+    """``crossings._cofactors``: ``w . x`` is the determinant of the scaled Jacobian with the joint's column replaced
+    by ``x`` (so ``w`` is normal to the other five columns, and zero only where they are dependent)."""
+    from sweepik.engine.continuation import scaled_jacobians
+    from sweepik.engine.crossings import _cofactors
+
+    rng = np.random.default_rng(3)
+    for name in ("ur5", "carm"):
+        robot = sweepik.load_robot(name)
+        q = rng.uniform(robot.lower, robot.upper, (50, 6))
+        joint = rng.integers(0, 6, 50)
+        x = rng.normal(size=(50, 6))
+        w = _cofactors(robot, q, joint)
+        J = scaled_jacobians(robot, q)
+        J[np.arange(50), :, joint] = x
+        np.testing.assert_allclose(np.einsum("ki,ki->k", w, x), np.linalg.det(J), rtol=1e-9, atol=1e-12)

@@ -58,7 +58,7 @@ IntArray = NDArray[np.intp]
 def scaled_singular(robot: Robot, q: Array) -> tuple[Array, Array]:
     """Singular values ``(K, 6)`` (decreasing) and right singular vectors ``(K, n, n)`` (rows) of the Jacobian at
     configurations ``q (K, n)``, lengths over the arm's length scale (a slide's column: per length scale)."""
-    _, s, vt = np.linalg.svd(_scaled_jacobians(robot, q))
+    _, s, vt = np.linalg.svd(scaled_jacobians(robot, q))
     return s, vt
 
 
@@ -68,11 +68,13 @@ def second_singular(robot: Robot, q: Array, cold: NDArray[np.bool_]) -> Array:
     the crossing search asks for tens of thousands on a batch with families). Each row's rotations start from the
     last row's (neighbouring members of a family: one or two sweeps), but where ``cold``."""
     out = np.empty(q.shape[0])
-    _second_ratios(_scaled_jacobians(robot, q), np.ascontiguousarray(cold, dtype=np.bool_), out)
+    _second_ratios(scaled_jacobians(robot, q), np.ascontiguousarray(cold, dtype=np.bool_), out)
     return out
 
 
-def _scaled_jacobians(robot: Robot, q: Array) -> Array:
+def scaled_jacobians(robot: Robot, q: Array) -> Array:
+    """Jacobians ``(K, 6, n)`` at configurations ``q (K, n)`` as ``scaled_singular`` takes them: lengths over the arm's
+    length scale (a slide's column: per length scale)."""
     J = pose_and_jacobian(robot, q)[1]
     J[:, :3, :] /= robot.length_scale
     J[:, :, ~robot.is_revolute] *= robot.length_scale

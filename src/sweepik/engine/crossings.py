@@ -18,21 +18,27 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+from numba import float64, int64
 from numpy.typing import NDArray
 
-from sweepik.engine.continuation import scaled_singular, second_singular
+from sweepik.engine.continuation import scaled_jacobians, scaled_singular, second_singular
 from sweepik.engine.families import members_at
 from sweepik.engine.settings import (
     CROSS_RANK,
     CROSS_SAMPLES,
+    CROSS_SCREEN,
     CROSS_SINGULAR,
     CROSS_STEP,
     CROSS_STEPS,
+    SCREEN_JUMP,
+    SCREEN_ZERO,
     VERTEX_REL,
     VERTEX_WIDTH,
 )
+from sweepik.engine.settle import per_joint
 from sweepik.model.pose import wrap_angle
 from sweepik.model.robot import Robot
+from sweepik.reductions.kernels import lazy_njit
 from sweepik.results import Family
 
 Array = NDArray[np.float64]
@@ -58,12 +64,124 @@ def _singular_of(robot: Robot, probes: list[Array]) -> list[Array]:
     return np.split(out, np.cumsum([len(p) for p in probes[:-1]]).astype(np.intp))
 
 
-def _grid_probes(families: list[Family]) -> list[Array]:
-    """``_probe`` of each family at its ``CROSS_SAMPLES`` grid (``_grid``); the families whose probes are their
-    members (``Family.at``) at once (``members_at``): the same values."""
-    out = [_probe(f, _grid(f)) if _traced(f) else np.zeros((0, 0)) for f in families]
+#: The samples of the ``CROSS_SAMPLES`` grid the screen takes: every ``CROSS_SCREEN``-th, and all of the first and
+#: last stretch (a family's end is often a zero of the cofactors: where it folds back, or its closed form breaks down).
+_SCREEN = np.unique(
+    np.concatenate(
+        [
+            np.arange(0, CROSS_SAMPLES, CROSS_SCREEN),
+            np.arange(CROSS_SCREEN),
+            CROSS_SAMPLES - 1 - np.arange(CROSS_SCREEN),
+        ]
+    )
+)
+
+
+def screened(robot: Robot, families: list[Family]) -> list[bool]:
+    """Whether each family surely crosses no other continuum (``CROSS_SCREEN``): at its screen's members the cofactor
+    vectors of the arm's Jacobian without the family's joint (``_cofactors``) keep their sign from one to the next
+    (their inner product positive), none inside is zero (``SCREEN_ZERO``) and every member is finite. Along a family
+    the Jacobian has rank five, its null vector the family's tangent, which moves the family's joint: the other five
+    columns span what the Jacobian spans, so the cofactors (a vector normal to that span, of the size of its volume)
+    vanish where the arm loses a second rank, at a crossing, and change sign through it, however narrow the dip of
+    the second singular value there. (The ends may be zeros: an end sample's sign is not compared.) Nor may a joint
+    move by more than ``SCREEN_JUMP`` from one to the next: where a spherical wrist's family crosses A5 = 0 its members
+    go over to the wrist turned by pi one sample after (the closed form's branch keeps the sign of A5), which turns
+    the cofactors over a second time. Six-joint arms; False (probe it) for others and for families of held arms."""
+    out = [False] * len(families)
+    ks = [k for k, f in enumerate(families) if f.held is None]
+    if robot.n_joints != 6 or not ks:
+        return out
+    probes = _grid_probes([families[k] for k in ks], _SCREEN)
+    q = np.concatenate(probes)
+    joint = np.repeat(np.array([families[k].free_joint for k in ks], dtype=np.intp), _SCREEN.size)
+    finite = np.all(np.isfinite(q), axis=-1)
+    flat = np.full((q.shape[0], 6), np.nan)
+    if finite.any():
+        rows = np.nonzero(finite)[0]
+        flat[rows] = _cofactors(robot, np.ascontiguousarray(q[rows]), joint[rows])
+    w = flat.reshape(len(ks), _SCREEN.size, 6)
+    size = np.linalg.norm(w, axis=-1)
+    step = np.diff(q.reshape(len(ks), _SCREEN.size, 6), axis=1)
+    step[..., robot.is_revolute] = wrap_angle(step[..., robot.is_revolute])
+    with np.errstate(invalid="ignore"):
+        zero = size <= SCREEN_ZERO * np.max(size, axis=1, keepdims=True)
+        same = np.sum(w[:, 1:] * w[:, :-1], axis=-1) > 0.0
+        jump = np.any(np.abs(step) > per_joint(robot, SCREEN_JUMP), axis=-1)
+    compared = ~zero[:, 1:] & ~zero[:, :-1]
+    passed = np.isfinite(size).all(axis=1) & ~zero[:, 1:-1].any(axis=1) & np.all(same | ~compared, axis=1)
+    passed &= ~jump.any(axis=1)
+    for k, p in zip(ks, passed.tolist(), strict=True):
+        out[k] = p
+    return out
+
+
+def _cofactors(robot: Robot, q: Array, joint: NDArray[np.intp]) -> Array:
+    """``(K, 6)``: the cofactor vector of the scaled Jacobian at ``q (K, 6)`` without column ``joint (K,)``: ``w`` with
+    ``w . x = det`` of the Jacobian with that column replaced by ``x`` (compiled)."""
+    out = np.empty((q.shape[0], 6))
+    _cofactor_rows(scaled_jacobians(robot, q), np.ascontiguousarray(joint, dtype=np.int64), out)
+    return out
+
+
+@lazy_njit((float64[:, :, ::1], int64[::1], float64[:, ::1]), cache=True, nogil=True)
+def _cofactor_rows(J, joint, out):  # pragma: no cover
+    """``_cofactors``' kernel. With ``A`` the 6 x 5 matrix left and ``P A = L U`` (partial pivoting),
+    ``det [A | x] = det(P) prod(diag U) (L^-1 P x)_5``: ``w = det(P) prod(diag U) P^T z`` with ``L^T z = e_5``, and
+    the column put back in place of the joint's (``(-1)^(5 - joint)``)."""
+    A = np.empty((6, 5))
+    perm = np.empty(6, np.int64)
+    z = np.empty(6)
+    for k in range(J.shape[0]):
+        j = joint[k]
+        for r in range(6):
+            perm[r] = r
+            c = 0
+            for cc in range(6):
+                if cc != j:
+                    A[r, c] = J[k, r, cc]
+                    c += 1
+        det = 1.0 if (5 - j) % 2 == 0 else -1.0
+        for col in range(5):
+            piv = col
+            for i in range(col + 1, 6):
+                if abs(A[i, col]) > abs(A[piv, col]):
+                    piv = i
+            if piv != col:
+                for c in range(5):
+                    A[col, c], A[piv, c] = A[piv, c], A[col, c]
+                perm[col], perm[piv] = perm[piv], perm[col]
+                det = -det
+            det *= A[col, col]
+            if A[col, col] != 0.0:
+                for i in range(col + 1, 6):
+                    A[i, col] /= A[col, col]  # (L below the diagonal)
+                    for c in range(col + 1, 5):
+                        A[i, c] -= A[i, col] * A[col, c]
+            else:
+                for i in range(col + 1, 6):
+                    A[i, col] = 0.0
+        # L^T z = e_5 (L unit lower triangular, its last column e_5)
+        z[5] = 1.0
+        for i in range(4, -1, -1):
+            s = 0.0
+            for m in range(i + 1, 6):
+                s += A[m, i] * z[m]
+            z[i] = -s
+        for i in range(6):
+            out[k, perm[i]] = det * z[i]
+
+
+def _grid_probes(families: list[Family], index: NDArray[np.intp] | None = None) -> list[Array]:
+    """``_probe`` of each family at its ``CROSS_SAMPLES`` grid (``_grid``; the samples ``index`` of it, if given);
+    the families whose probes are their members (``Family.at``) at once (``members_at``): the same values."""
+
+    def grid(f: Family) -> Array:
+        return _grid(f) if index is None else _grid(f)[index]
+
+    out = [_probe(f, grid(f)) if _traced(f) else np.zeros((0, 0)) for f in families]
     plain = [k for k, f in enumerate(families) if not _traced(f)]
-    for k, q in zip(plain, members_at([families[k] for k in plain], [_grid(families[k]) for k in plain]), strict=True):
+    for k, q in zip(plain, members_at([families[k] for k in plain], [grid(families[k]) for k in plain]), strict=True):
         out[k] = q
     return out
 
@@ -141,9 +259,10 @@ def vertex_least(
 def crossing_grids(robot: Robot, families: list[Family]) -> list[Array | None]:
     """The second singular value (``_second_singular``) of each family at its ``CROSS_SAMPLES`` members over its
     interval, every family's in one pass (a batch's families: one compiled call for the members of each reduction's,
-    one for the singular values, where a call per family spent ~0.3 ms in Python); None for a family of one point or
-    one without a dip to search (``_dips``)."""
+    one for the singular values, where a call per family spent ~0.3 ms in Python); None for a family of one point,
+    one the screen passes (``screened``: no crossing) or one without a dip to search (``_dips``)."""
     ks = [k for k, f in enumerate(families) if f.interval[1] > f.interval[0]]
+    ks = [k for k, passed in zip(ks, screened(robot, [families[k] for k in ks]), strict=True) if not passed]
     out: list[Array | None] = [None] * len(families)
     if ks:
         grids = _singular_of(robot, _grid_probes([families[k] for k in ks]))

@@ -361,6 +361,18 @@ CROSS_RANK = 1e-5
 #: A least sampled value is searched only where the V through it and its neighbours reaches down to this fraction of
 #: it (exactly to zero for a crossing between two samples, up to the curvature of the singular value).
 VERTEX_REL = 0.25
+#: Before a family's ``CROSS_SAMPLES`` are probed, every ``CROSS_SCREEN``-th of them (and every one of the first and
+#: last stretch, next to its ends) is screened (``crossings.screened``): a crossing is where the arm loses a second
+#: rank, where the cofactors of its Jacobian without the family's joint (a vector normal to what the other five
+#: columns span: smooth and signed, zero only there, or where the family's parametrisation turns) pass through zero
+#: and change sign. A family whose screen shows no sign change between neighbours and no interior zero is not
+#: probed further.
+CROSS_SCREEN = 4
+#: ... a cofactor vector at most this fraction of the family's largest counts as zero (its sign is rounding).
+SCREEN_ZERO = 1e-9
+#: ... and a member this far from the last in any joint (radians; times the length scale for a slide) is not
+#: compared with it: the family's members may have gone over to another branch between them.
+SCREEN_JUMP = 1.0
 #: Distance of the seeds from the crossing along the second null direction (radians; times the length scale for a
 #: slide): far enough that the correction does not fall back onto the family, near enough to land on the continuum
 #: that crosses it.
