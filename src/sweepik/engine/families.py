@@ -85,7 +85,12 @@ def certified_members_of(
     F, M = theta.shape
     pose, br, x = np.repeat(np.arange(F), M), np.repeat(branch, M), theta.ravel()
 
+    world = robot.T_world_base @ chains @ robot.T_flange_tool if red.uses_kernel else chains
+
     def members(rows: NDArray[np.intp], xr: Array) -> tuple[Array, NDArray[np.bool_]]:
+        if red.uses_kernel:  # (compiled: configuration, FK and error per member, as ``_certified``)
+            q, err, _ = certify.certify(robot, red, chains, world, pose[rows], xr, br[rows], paper=False)
+            return q, np.all(np.isfinite(q), axis=-1) & (err <= tol)
         q = family_members(robot, red, chains, pose[rows], br[rows], xr)
         return q, _solve_chain(robot, q, chains[pose[rows]], tol)
 

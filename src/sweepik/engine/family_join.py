@@ -148,34 +148,31 @@ def add_crossing_families(
         fams.setdefault(i, []).extend(f for f, o in zip(found, inner_off(robot, found, known[i]), strict=True) if o)
 
 
-#: Where a family is asked whether it lies on others (its interval's fractions): ``INNER_PROBES`` and both ends.
-ENDS_AND_INNER = np.array((0.0, *INNER_PROBES, 1.0))
-
-
 def _not_repeated(robot: Robot, families: dict[int, tuple[Family, ...]]) -> dict[int, tuple[Family, ...]]:
-    """Each pose's ``families`` without those lying on an earlier one, ends included (``ENDS_AND_INNER``): one
+    """Each pose's ``families`` without those lying on an earlier one, ends and ``INNER_PROBES`` included: one
     continuum found twice, along two joints (a wrist with its slide at zero: the q4/q6 continuum traced along joint 4
     and along joint 6), or a piece of one found whole too. One that lies on two others (a piece reaching 3.5e-4 rad
-    past the end of the one it crosses there) stays. The batch's poses at once."""
+    past the end of the one it crosses there) stays. The batch's poses at once; the ends first, the inner probes only
+    of a family whose ends lie on the other."""
     several = {i: fs for i, fs in families.items() if len(fs) > 1}
-    flat = [f for fs in several.values() for f in fs]
-    members = iter(members_at(flat, [f.interval[0] + (f.interval[1] - f.interval[0]) * ENDS_AND_INNER for f in flat]))
-    checks: list[tuple[Array, tuple[Family, ...]]] = []
-    pairs: list[tuple[int, int, int]] = []  # (family a on family b of pose i)
-    for i, fs in several.items():
-        m = [next(members) for _ in fs]
-        for a in range(1, len(fs)):
-            for b in range(a):
-                checks.append((m[a], (fs[b],)))
-                pairs.append((i, a, b))
-    on = {pair for pair, off in zip(pairs, off_families(robot, checks), strict=True) if not off.any()}
+    pairs = [(i, a, b) for i, fs in several.items() for a in range(1, len(fs)) for b in range(a)]  # (a on b, pose i)
+    for fractions in (np.array([0.0, 1.0]), np.array(INNER_PROBES)):
+        if not pairs:
+            break
+        asked = sorted({(i, a) for i, a, _ in pairs})
+        probed = [several[i][a] for i, a in asked]
+        at = [f.interval[0] + (f.interval[1] - f.interval[0]) * fractions for f in probed]
+        members = dict(zip(asked, members_at(probed, at), strict=True))
+        offs = off_families(robot, [(members[i, a], (several[i][b],)) for i, a, b in pairs])
+        pairs = [pair for pair, off in zip(pairs, offs, strict=True) if not off.any()]
+    on = set(pairs)
     out = dict(families)
-    for i, fs in several.items():
+    for i, mine in several.items():
         kept: list[int] = []
-        for a in range(len(fs)):
+        for a in range(len(mine)):
             if not any((i, a, b) in on for b in kept):
                 kept.append(a)
-        out[i] = tuple(fs[a] for a in kept)
+        out[i] = tuple(mine[a] for a in kept)
     return out
 
 
