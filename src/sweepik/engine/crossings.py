@@ -176,12 +176,15 @@ def _grid_probes(families: list[Family], index: NDArray[np.intp] | None = None) 
     """``_probe`` of each family at its ``CROSS_SAMPLES`` grid (``_grid``; the samples ``index`` of it, if given);
     the families whose probes are their members (``Family.at``) at once (``members_at``): the same values."""
 
-    def grid(f: Family) -> Array:
-        return _grid(f) if index is None else _grid(f)[index]
-
-    out = [_probe(f, grid(f)) if _traced(f) else np.zeros((0, 0)) for f in families]
+    if not families:
+        return []
+    lo, hi = np.array([f.interval for f in families], dtype=np.float64).T
+    grids = np.linspace(lo, hi, CROSS_SAMPLES, axis=1)  # (each row ``_grid``'s, bit for bit)
+    if index is not None:
+        grids = grids[:, index]
+    out = [_probe(f, g) if _traced(f) else np.zeros((0, 0)) for f, g in zip(families, grids, strict=True)]
     plain = [k for k, f in enumerate(families) if not _traced(f)]
-    for k, q in zip(plain, members_at([families[k] for k in plain], [grid(families[k]) for k in plain]), strict=True):
+    for k, q in zip(plain, members_at([families[k] for k in plain], list(grids[plain])), strict=True):
         out[k] = q
     return out
 
