@@ -175,7 +175,6 @@ def _cofactor_rows(J, joint, out):  # pragma: no cover
 def _grid_probes(families: list[Family], index: NDArray[np.intp] | None = None) -> list[Array]:
     """``_probe`` of each family at its ``CROSS_SAMPLES`` grid (``_grid``; the samples ``index`` of it, if given);
     the families whose probes are their members (``Family.at``) at once (``members_at``): the same values."""
-
     if not families:
         return []
     lo, hi = np.array([f.interval for f in families], dtype=np.float64).T
