@@ -79,7 +79,7 @@ def singular_configurations(robot: Any, n: int, rng: np.random.Generator, grid: 
         qs = q.copy()
         qs[k] = x + (step if robot.is_revolute[k] else step * robot.length_scale)
         out.append(qs)
-    return np.array(out)
+    return np.array(out).reshape(-1, robot.n_joints)  # (none found: (0, n), e.g. an arm whose det J never vanishes)
 
 
 def _wrist_straight(robot: Any, q: np.ndarray, grid: int = 721) -> list[float]:
