@@ -78,8 +78,10 @@ _SCREEN = np.unique(
 
 
 def screened(robot: Robot, families: list[Family]) -> list[bool]:
-    """Whether each family surely crosses no other continuum (``CROSS_SCREEN``): at its screen's members the cofactor
-    vectors of the arm's Jacobian without the family's joint (``_cofactors``) keep their sign from one to the next
+    """Whether each family shows no sign of crossing another continuum (``CROSS_SCREEN``; checked against the whole
+    grid's search on the bundled and random arms' singular sets, docs/decomposition.md): at its screen's members
+    the cofactor vectors of the arm's Jacobian without the family's joint (``_cofactors``) keep their sign from one to
+    the next
     (their inner product positive), none inside is zero (``SCREEN_ZERO``) and every member is finite. Along a family
     the Jacobian has rank five, its null vector the family's tangent, which moves the family's joint: the other five
     columns span what the Jacobian spans, so the cofactors (a vector normal to that span, of the size of its volume)
