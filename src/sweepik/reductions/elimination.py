@@ -671,8 +671,8 @@ def _candidates_std(
     other joints: ``S(x)`` then has a two-dimensional null space, whose one vector from inverse iteration mixes the
     two roots. It is tried again from the two monomial vectors of that space (``_pair_vectors``)."""
     n = xs.shape[0]
-    out = np.empty((3 * n, 6))
-    prs = np.empty(3 * n)
+    out = np.empty((2 * n, 6))
+    prs = np.empty(2 * n)
     k = 0
     nfail = 0
     args = (ops_kind, ops_h, ops_c, ops_slot, n_pre, o, hl, Rt, pt, ref, q0, pinvQ, E_kind, E_idx, slots_idx, L_idx)
@@ -694,52 +694,16 @@ def _candidates_std(
                 if v.shape[0] == 0:
                     continue
                 ta, xa, tb, xb = _slot_ratios(v)
-            qp, ok, pr, nr = _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain)
-            # (the middle of two roots: those, if found; at most three rows a candidate: ``out``'s size)
-            if attempt == 0 and ok and nr > SPLIT_ABOVE and pr < SPLIT_PIVOT:
-                pair_q, count = _split_pair(H, P, rev, R_end, qp, nr, RT, pT)
-                for c in range(count):
-                    out[k], prs[k] = pair_q[c], pr
-                    k += 1
-                if count:
-                    found = True
-                    break
+            qp, ok, pr = _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain)
             if ok:
                 out[k], prs[k] = qp, pr
                 k += 1
                 found = True
-                # (a root found already, from a nearly equal eigenvalue: that one's partner may be the other root
-                # of a close pair, whose null vectors mix the two; tried from the pair's vectors too)
-                if attempt == 0 and not _found_before(out, k - 1, rev):
+                if attempt == 0:
                     break
         if not found and ims[i] < PAIR_IMAG:
             nfail += 1
     return out[:k].copy(), prs[:k].copy(), nfail
-
-
-#: A root the polish leaves missing the pose by more than this (the residual's measure in ``_polish``) with a nearly
-#: singular Jacobian (LU pivot ratio below ``SPLIT_PIVOT``) is taken for the middle of two roots a hair apart and
-#: split (``_split_pair``), from these steps along the nearly null direction.
-SPLIT_ABOVE = 1e-14
-SPLIT_PIVOT = 1e-6
-SPLIT_STEPS = (1e-6, 1e-5, 1e-4, 1e-3)
-
-
-@njit(cache=True, error_model="numpy")
-def _found_before(out, k, rev):
-    """Row ``k`` of ``out`` is one of its rows before it (``MERGE_TOL``, revolute joints modulo 2 pi)."""
-    for i in range(k):
-        far = False
-        for j in range(out.shape[1]):
-            d = out[k, j] - out[i, j]
-            if rev[j]:
-                d = (d + np.pi) % (2.0 * np.pi) - np.pi
-            if abs(d) >= MERGE_TOL:
-                far = True
-                break
-        if not far:
-            return True
-    return False
 
 
 #: A candidate eigenvalue with ``|Im x| / (1 + |x|^2)`` below this that does not polish is tried as one of a close
@@ -835,33 +799,7 @@ def _root_at(x, ta, xa, tb, xb, phi, slot_kind, slot_off, args, chain):
         for j in range(6):
             if rev[j]:
                 qp[j] = math.pi - ((math.pi - qp[j]) % (2.0 * math.pi))
-    return qp, ok, pr, nr
-
-
-@njit(cache=True, error_model="numpy")
-def _split_pair(H, P, rev, R_end, q, nr, RT, pT):
-    """The roots either side of ``q`` along the Jacobian's nearly null direction, where the polish stopped at ``q``
-    with the residual ``nr`` above rounding: the middle of two roots a hair apart (a near-double eigenvalue gives
-    their mean; the residual along the valley between them has its extremum there, so Newton does not move). From
-    ``SPLIT_STEPS`` along that direction, each way, polished: ``(roots (2, 6), count)``, the first that solves the
-    pose to a tenth of ``nr`` each way."""
-    out = np.empty((2, 6))
-    J = _jac6(H, P, rev, q)
-    if not np.all(np.isfinite(J)):
-        return out, 0
-    _, S, Vt = np.linalg.svd(J)
-    count = 0
-    for sign in (1.0, -1.0):
-        for h in SPLIT_STEPS:
-            qp, n2, ok, _ = _polish(H, P, rev, R_end, q + (sign * h) * Vt[5], RT, pT, 30, 1e-17)
-            if ok and n2 < 0.1 * nr:
-                for j in range(6):
-                    if rev[j]:
-                        qp[j] = math.pi - ((math.pi - qp[j]) % (2.0 * math.pi))
-                out[count] = qp
-                count += 1
-                break
-    return out, count
+    return qp, ok, pr
 
 
 @njit(cache=True, error_model="numpy")
