@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 from sweepik.engine import certify, one_pose, search
 from sweepik.engine.candidates import Candidates, Spans
+from sweepik.engine.chain_pose import chain_poses
 from sweepik.engine.companion import joined
 from sweepik.engine.continuation import continuum_families
 from sweepik.engine.dedupe import any_near, finish, settle
@@ -56,15 +57,6 @@ from sweepik.reductions.kernels import owned_kernel
 from sweepik.results import Block, Family, Solutions
 
 Array = NDArray[np.float64]
-
-
-def chain_poses(robot: Robot, poses: Array) -> Array:
-    out = poses
-    if not robot.base_is_identity:
-        out = robot.T_base_world @ out
-    if not robot.tool_is_identity:
-        out = out @ robot.T_tool_flange
-    return out
 
 
 def theta_range(robot: Robot, red: Reduction, chain: Array, paper_limits: bool = False) -> tuple[Array, Array]:

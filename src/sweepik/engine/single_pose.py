@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from sweepik._jit import inlined, writable
 from sweepik.engine import search
+from sweepik.engine.chain_pose import chain_into
 from sweepik.engine.dedupe import any_rows_within
 from sweepik.engine.one_pose import (
     _A_SING,
@@ -85,22 +86,33 @@ def pose_row(chain, base, tool, reverse, r_end, w_tool, row):  # pragma: no cove
     return params
 
 
+@inlined
+def chained(world, frames, has_base, has_tool):  # pragma: no cover
+    """The chain pose of ``world (4, 4)``, as ``chain_pose.chain_poses`` makes it (``frames (2, 4, 4)``: the arm's
+    ``T_base_world`` and ``T_tool_flange``, each applied where its flag is set): ``world`` itself without either."""
+    if not (has_base or has_tool):
+        return world
+    out = np.empty((4, 4))
+    chain_into(world, frames[0], frames[1], has_base, has_tool, np.empty((4, 4)), out)
+    return out
+
+
 #: ``pose_rows``' arguments after the poses and before the output.
 _ROW_SIG = (float64[:, ::1], float64[:, ::1], boolean, float64[:, ::1], float64[::1], float64[::1])
-_TARGET_SIG = (float64[:, ::1], float64[:, ::1])
+_TARGET_SIG = (float64[:, ::1], float64[:, :, ::1], boolean, boolean)
 
 
 @lazy_njit(_TARGET_SIG + _ROW_SIG + SETTLE_CLOSED_SIG[:1] + SETTLE_CLOSED_SIG[3:], cache=True, nogil=True)
 def _closed_pose(
-    world, chain, base, tool, reverse, r_end, w_tool, row, addr, nb, H, P, rev, R_end, weight, thr, lrev, lower,
+    world, frames, has_base, has_tool, base, tool, reverse, r_end, w_tool, row, addr, nb, H, P, rev, R_end, weight, thr, lrev, lower,
     upper, ltol, beyond, reach, tol, scale, s_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
-    """A closed form's target ``world (4, 4)`` (its chain pose ``chain``) checked, its row built (``pose_rows``'
+    """A closed form's target ``world (4, 4)`` checked, its chain pose made (``chained``), its row built (``pose_rows``'
     arguments ``base`` .. ``row``) and every branch settled (``every_branch_settled``'s arguments after them):
     ``(status, certified, reachable, q, error, error_geodesic, within_limits, multiplicity)``."""
     if not rigid_pose(world):
         return not_rigid(rev.shape[0])
-    params = pose_row(chain, base, tool, reverse, r_end, w_tool, row)
+    params = pose_row(chained(world, frames, has_base, has_tool), base, tool, reverse, r_end, w_tool, row)
     st, c, reachable, q, ep, eg, ins, mu, _ = every_branch_settled(
         addr, params, world.reshape((1, 4, 4)), nb, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond,
         reach, tol, scale, s_thr, meet, only_inside,
@@ -115,7 +127,7 @@ def _closed_pose(
     nogil=True,
 )  # fmt: skip
 def _swept_pose(
-    world, chain, base, tool, reverse, r_end, w_tool, row, addr, plan, branches, m_branches, steps, noise, s, ends,
+    world, frames, has_base, has_tool, base, tool, reverse, r_end, w_tool, row, addr, plan, branches, m_branches, steps, noise, s, ends,
     twins, max_cand, max_fam, limits, clip, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach,
     tol, scale, c_joints, c_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
@@ -124,7 +136,7 @@ def _swept_pose(
     them)."""
     if not rigid_pose(world):
         return not_rigid(rev.shape[0])
-    params = pose_row(chain, base, tool, reverse, r_end, w_tool, row)
+    params = pose_row(chained(world, frames, has_base, has_tool), base, tool, reverse, r_end, w_tool, row)
     return swept_settled(
         world, params, addr, plan, branches, m_branches, steps, noise, s, ends, twins, max_cand, max_fam, limits, clip,
         H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, c_joints, c_thr, meet,
@@ -155,7 +167,7 @@ class SinglePose:
     """One arm's reduction, ready for single poses: its fixed arguments worked out once (``of``), then
     ``solve(pose, limits)`` per pose."""
 
-    __slots__ = ("robot", "held", "_kernel", "_head", "_tail", "_sweeps", "_base", "_tool")
+    __slots__ = ("robot", "held", "_kernel", "_frames", "_head", "_tail", "_sweeps")
 
     def __init__(
         self, arm: Robot, held: HeldJoints | None, kernel: Any, head: tuple[Any, ...], tail: tuple[Any, ...]
@@ -164,12 +176,11 @@ class SinglePose:
         self.held = held
         # (the compiled entry point itself: ``solve`` passes the signature's types, its pose checked by the caller)
         self._kernel = kernel.unchecked
+        frames = np.stack([arm.T_base_world, arm.T_tool_flange])
+        self._frames = (frames, not arm.base_is_identity, not arm.tool_is_identity)  # (``chained``'s)
         self._head = head  # (pose_rows' arguments)
         self._tail = tail  # (the settling's, but the rows, targets and buffers; then the meeting reach)
         self._sweeps = kernel is _swept_pose
-        # (``chunk.chain_poses``' transforms, None for the identity)
-        self._base = None if arm.base_is_identity else arm.T_base_world
-        self._tool = None if arm.tool_is_identity else arm.T_tool_flange
 
     @classmethod
     def of(cls, robot: Robot, red: Reduction, held: HeldJoints | None = None) -> SinglePose | None:
@@ -216,16 +227,13 @@ class SinglePose:
         ``solve`` gives them (status ``OK``), or None where the general path must answer, with the status that says
         why (``one_pose``'s, or ``NOT_RIGID``; ``OK`` with more than ``MAX_ISOLATED_SOLUTIONS`` certified). Raises
         ``check_poses``' errors for a target that is not a rigid transform."""
-        chain = pose
-        if self._base is not None or self._tool is not None:  # (as ``chunk.chain_poses``: the same bits)
-            with np.errstate(all="ignore"):  # (a target not finite: the kernel says so, ``check_poses`` raises)
-                chain = pose[None] if self._base is None else self._base @ pose[None]
-                chain = (chain if self._tool is None else chain @ self._tool)[0]
         if self._sweeps:  # (the buffers read here: a test may cut them)
             head, tail = self._head, self._tail
-            out = self._kernel(pose, chain, *head, *tail[:3], search.MAX_CAND, search.MAX_FAM, *tail[3:], limits)
+            out = self._kernel(
+                pose, *self._frames, *head, *tail[:3], search.MAX_CAND, search.MAX_FAM, *tail[3:], limits
+            )
         else:
-            out = self._kernel(pose, chain, *self._head, *self._tail, limits)
+            out = self._kernel(pose, *self._frames, *self._head, *self._tail, limits)
         return answer(out, pose, self.robot, None if self.held is None else self.held.expand)
 
 
