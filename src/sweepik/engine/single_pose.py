@@ -104,8 +104,8 @@ _TARGET_SIG = (float64[:, ::1], float64[:, :, ::1], boolean, boolean)
 
 @lazy_njit(_TARGET_SIG + _ROW_SIG + SETTLE_CLOSED_SIG[:1] + SETTLE_CLOSED_SIG[3:], cache=True, nogil=True)
 def _closed_pose(
-    world, frames, has_base, has_tool, base, tool, reverse, r_end, w_tool, row, addr, nb, H, P, rev, R_end, weight, thr, lrev, lower,
-    upper, ltol, beyond, reach, tol, scale, s_thr, meet, only_inside,
+    world, frames, has_base, has_tool, base, tool, reverse, r_end, w_tool, row, addr, nb, H, P, rev, R_end, weight,
+    thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, s_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
     """A closed form's target ``world (4, 4)`` checked, its chain pose made (``chained``), its row built (``pose_rows``'
     arguments ``base`` .. ``row``) and every branch settled (``every_branch_settled``'s arguments after them):
@@ -127,9 +127,9 @@ def _closed_pose(
     nogil=True,
 )  # fmt: skip
 def _swept_pose(
-    world, frames, has_base, has_tool, base, tool, reverse, r_end, w_tool, row, addr, plan, branches, m_branches, steps, noise, s, ends,
-    twins, max_cand, max_fam, limits, clip, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach,
-    tol, scale, c_joints, c_thr, meet, only_inside,
+    world, frames, has_base, has_tool, base, tool, reverse, r_end, w_tool, row, addr, plan, branches, m_branches,
+    steps, noise, s, ends, twins, max_cand, max_fam, limits, clip, H, P, rev, R_end, weight, thr, lrev, lower, upper,
+    ltol, beyond, reach, tol, scale, c_joints, c_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
     """A sweep's target (as ``_closed_pose``) searched over the circle, certified and settled (``searched_settled``'s
     arguments); ``MEET`` where two of its solutions lie within ``meet`` (``dedupe.any_near``: the general path merges
