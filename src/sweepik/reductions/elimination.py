@@ -1515,6 +1515,26 @@ class GeneralIK:
         info["n_singular"] = int(np.sum(prs[keep] < 1e-5))
         return S_[keep], info
 
+    def _split_pairs(self, sols, RT, pT):
+        """``sols`` with each root the polish left at the middle of two roots a hair apart replaced by those two
+        (``_split_pair``): a root at a singular configuration (pivot ratio under ``SPLIT_PIVOT``) that misses the pose
+        by more than ``SPLIT_ABOVE``. Two roots a few 1e-5 rad apart give one near-double eigenvalue, and Newton from
+        its configuration stops between them, where the residual along the valley has its extremum (the I2RT big YAM
+        on its singular set: 2.5e-13 of the arm, over the certification's 2e-13, so both were lost)."""
+        out = []
+        for q in sols:
+            r, _, dev = _residual6(self.H, self.P, self.rev, self.R_end, q, RT, pT)
+            nr = math.sqrt(float(np.sum(r * r))) + dev
+            if nr > SPLIT_ABOVE:
+                _, pr = _solve6(_jac6(self.H, self.P, self.rev, q), np.zeros(6))
+                if pr < SPLIT_PIVOT:
+                    pair, count = _split_pair(self.H, self.P, self.rev, self.R_end, q, nr, RT, pT)
+                    if count == 2:
+                        out.extend(pair)
+                        continue
+            out.append(q)
+        return np.array(out, dtype=np.float64).reshape(-1, 6)
+
     def _merge_close(self, sols, RT, pT):
         """Second merging pass: two solutions closer than 1e-3 whose whole joining segment satisfies the FK to
         1e-12 (relative) are one solution known only that well (a double root along a flat direction, where
@@ -1568,6 +1588,7 @@ class GeneralIK:
                     break
             continuum = allsing
         if n_singular:
+            sols = self._split_pairs(sols, RT, pT)
             sols = np.array(self._merge_close(list(sols), RT, pT)).reshape(-1, 6)
             # continuum test at singular solutions: a solution on a curve of solutions
             if not continuum:
@@ -1579,6 +1600,38 @@ class GeneralIK:
         out = np.array(sols, dtype=np.float64).reshape(-1, 6)
         out[:, ~self.rev] *= self.scale
         return IKResult(out, continuum, {"tries": infos})
+
+
+#: A root at a singular configuration (LU pivot ratio under ``SPLIT_PIVOT``) that the polish leaves missing the pose
+#: by more than ``SPLIT_ABOVE`` (``_polish``'s measure, normalised lengths) is taken for the middle of two roots a
+#: hair apart and split (``GeneralIK._split_pairs``), from these steps along the nearly null direction.
+SPLIT_ABOVE = 1e-14
+SPLIT_PIVOT = 1e-5
+SPLIT_STEPS = (1e-6, 1e-5, 1e-4, 1e-3)
+
+
+@njit(cache=True, error_model="numpy")
+def _split_pair(H, P, rev, R_end, q, nr, RT, pT):
+    """The two roots either side of ``q`` along the Jacobian's nearly null direction, where the polish stopped at
+    ``q`` with the residual ``nr`` above rounding: from ``SPLIT_STEPS`` along that direction, each way, the first
+    that polishes to a tenth of ``nr`` (wrapped). ``(roots (2, 6), count)``."""
+    out = np.empty((2, 6))
+    J = _jac6(H, P, rev, q)
+    if not np.all(np.isfinite(J)):
+        return out, 0
+    _, _, Vt = np.linalg.svd(J)
+    count = 0
+    for sign in (1.0, -1.0):
+        for h in SPLIT_STEPS:
+            qp, n2, ok, _ = _polish(H, P, rev, R_end, q + (sign * h) * Vt[5], RT, pT, 30, 1e-17)
+            if ok and n2 < 0.1 * nr:
+                for j in range(6):
+                    if rev[j]:
+                        qp[j] = math.pi - ((math.pi - qp[j]) % (2.0 * math.pi))
+                out[count] = qp
+                count += 1
+                break
+    return out, count
 
 
 def _fin(x):
