@@ -222,7 +222,7 @@ _OWN_ROWS = tuple(_read_only(np.arange(k, dtype=np.intp)) for k in range(65))
 
 def own_rows(k: int) -> NDArray[np.intp]:
     """``winding_of`` of ``k`` rows without windings, ``arange(k)``: read-only, one shared array for each ``k`` up to
-    64 (a new ``np.arange`` each took ~0.4 us of a single closed-form solve's ~11)."""
+    64 (a new ``np.arange`` each took ~0.2-0.4 us of a single closed-form solve's ~11)."""
     return _OWN_ROWS[k] if k < len(_OWN_ROWS) else _read_only(np.arange(k, dtype=np.intp))
 
 
@@ -244,7 +244,8 @@ class Solutions:
         pose: the target ``(4, 4)``.
         winding_of: ``(k,)`` int, for each row the row of the solution it is a 2 pi winding of (``solve(...,
             windings=True)`` adds a row for every other value of the revolute joints, modulo 2 pi, inside their
-            limits); a row's own index when it is not a winding. The windings come after every base row.
+            limits); a row's own index when it is not a winding. The windings come after every base row. Without
+            windings it is read-only, shared with other results of as many rows.
         wound: the windings were listed; distances (``nearest``) then compare revolute values as they are, not
             modulo 2 pi, so that the winding nearest a reference is chosen.
     """
@@ -278,7 +279,7 @@ class Solutions:
         robot: Robot,
     ) -> Solutions:
         """The isolated solutions of one pose, without families or windings: the same object as the constructor's,
-        built in a tenth of its time (a single closed-form solve's; a frozen dataclass sets each field through
+        built in a fifth of its time (a single closed-form solve's; a frozen dataclass sets each field through
         ``object.__setattr__``), ``winding_of`` shared (``own_rows``)."""
         self = object.__new__(cls)
         self.__dict__.update(
