@@ -94,3 +94,30 @@ def test_certified_candidates_reproduce_the_pose() -> None:
     # every pose has a certified candidate: its generating configuration's neighbourhood
     certified = ok & (geo <= 1e-9 * robot.length_scale)
     assert set(cand.pose[certified].tolist()) == set(range(len(poses)))
+
+
+def test_every_branch_certified_at_once_is_each_branch_certified_alone() -> None:
+    """``certify_every_branch`` takes each branch's FK on from the joints it shares with the one before
+    (``_poe_fk_after``: a spherical wrist's flips share three, the shoulder's sides one): its configurations and both
+    errors are ``certify``'s, which works out every branch's FK whole, bit for bit; on wrist-singular poses too, and
+    on an arm whose two position branches coincide (the IRB 140's: all six joints shared)."""
+    from sweepik.engine.chunk import chain_poses
+    from sweepik.reductions import get_reduction
+
+    for name in ("puma560", "ur5", "abb_irb140", "stanford"):
+        robot = load_robot(name)
+        rng = np.random.default_rng(7)
+        q = rng.uniform(np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi), (40, 6))
+        q[:10, 4] = 0.0
+        poses = robot.fk(q)
+        red = get_reduction(robot, None)
+        chain = chain_poses(robot, poses)
+        every = certify.certify_every_branch(robot, red, chain, poses)
+        nb = red.n_branches
+        pose = np.repeat(np.arange(len(poses)), nb)
+        branch = np.tile(np.arange(nb), len(poses))
+        alone = certify.certify(robot, red, chain, poses, pose, np.zeros(pose.size), branch)
+        shared = np.array([np.argmax(np.r_[a != b, True]) for a, b in zip(every[0][1:], every[0][:-1], strict=True)])
+        assert (shared >= 1).sum() >= len(poses), name  # (branches do share joints)
+        for x, y in zip(every, alone, strict=True):
+            np.testing.assert_array_equal(x, y, err_msg=name)

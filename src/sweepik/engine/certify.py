@@ -67,27 +67,28 @@ def _turn(r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, angle):
 
 
 @inlined
-def _poe_fk(H, P, rev, R_end, q):
-    """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain as 12 scalars (rotation
-    row by row, then position): scalar locals only, no array allocated (this runs once per candidate)."""
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
-    px, py, pz = P[0, 0], P[0, 1], P[0, 2]
-    for i in range(H.shape[0]):
-        kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
-        if rev[i]:
-            r00, r01, r02, r10, r11, r12, r20, r21, r22 = _turn(
-                r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, q[i]
-            )
-        else:
-            d = q[i]
-            px += (r00 * kx + r01 * ky + r02 * kz) * d
-            py += (r10 * kx + r11 * ky + r12 * kz) * d
-            pz += (r20 * kx + r21 * ky + r22 * kz) * d
-        ax, ay, az = P[i + 1, 0], P[i + 1, 1], P[i + 1, 2]
-        px += r00 * ax + r01 * ay + r02 * az
-        py += r10 * ax + r11 * ay + r12 * az
-        pz += r20 * ax + r21 * ay + r22 * az
-    e = R_end
+def _poe_joint(r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz, H, P, rev, q, i):
+    """The chain's rotation (row by row) and position before joint ``i`` taken past it, at ``q[i]``."""
+    kx, ky, kz = H[i, 0], H[i, 1], H[i, 2]
+    if rev[i]:
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = _turn(
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, kx, ky, kz, q[i]
+        )
+    else:
+        d = q[i]
+        px += (r00 * kx + r01 * ky + r02 * kz) * d
+        py += (r10 * kx + r11 * ky + r12 * kz) * d
+        pz += (r20 * kx + r21 * ky + r22 * kz) * d
+    ax, ay, az = P[i + 1, 0], P[i + 1, 1], P[i + 1, 2]
+    px += r00 * ax + r01 * ay + r02 * az
+    py += r10 * ax + r11 * ay + r12 * az
+    pz += r20 * ax + r21 * ay + r22 * az
+    return r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz
+
+
+@inlined
+def _poe_end(r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz, e):
+    """The tool pose (12 scalars, as ``_poe_fk``) of the chain's rotation and position after its last joint."""
     return (
         r00 * e[0, 0] + r01 * e[1, 0] + r02 * e[2, 0],
         r00 * e[0, 1] + r01 * e[1, 1] + r02 * e[2, 1],
@@ -102,6 +103,42 @@ def _poe_fk(H, P, rev, R_end, q):
         py,
         pz,
     )
+
+
+@inlined
+def _poe_fk(H, P, rev, R_end, q):
+    """World tool pose of configuration ``q (n,)`` of a product-of-exponentials chain as 12 scalars (rotation
+    row by row, then position): scalar locals only, no array allocated (this runs once per candidate)."""
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+    px, py, pz = P[0, 0], P[0, 1], P[0, 2]
+    for i in range(H.shape[0]):
+        r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = _poe_joint(
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz, H, P, rev, q, i
+        )
+    return _poe_end(r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz, R_end)
+
+
+@inlined
+def _poe_fk_after(H, P, rev, R_end, q, start, st):
+    """``_poe_fk`` of ``q (n,)`` (the same bits) whose first ``start`` joints are those of the configuration last
+    given: the chain before joint ``start`` read from ``st[start]`` (unless ``start`` is 0), and each joint's state
+    after it written to ``st (n + 1, 12)``. A closed form's branches share their first joints in pairs and fours
+    (a spherical wrist's flip turns the last three only): 34 joint turns instead of 48 for eight branches."""
+    if start == 0:
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+        px, py, pz = P[0, 0], P[0, 1], P[0, 2]
+    else:
+        s = st[start]
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8]
+        px, py, pz = s[9], s[10], s[11]
+    for i in range(start, H.shape[0]):
+        r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz = _poe_joint(
+            r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz, H, P, rev, q, i
+        )
+        s = st[i + 1]
+        s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8] = r00, r01, r02, r10, r11, r12, r20, r21, r22
+        s[9], s[10], s[11] = px, py, pz
+    return _poe_end(r00, r01, r02, r10, r11, r12, r20, r21, r22, px, py, pz, R_end)
 
 
 @inlined
@@ -241,6 +278,27 @@ def _certify_row(H, P, rev, R_end, weight, q, Td, zd, k, err_geo, err_paper):
 
 
 @inlined
+def _certify_after(H, P, rev, R_end, weight, q, Td, zd, k, err_geo, err_paper, start, st):
+    """``_certify_row`` through ``_poe_fk_after`` (the same errors): whether the chain's states were written (the
+    row is finite)."""
+    if not _finite_row(q, k):
+        err_geo[k], err_paper[k] = np.inf, np.inf
+        return False
+    err_geo[k], err_paper[k] = _errors(_poe_fk_after(H, P, rev, R_end, q[k], start, st), Td, weight, zd)
+    return True
+
+
+@inlined
+def _shared_joints(q, a, b):
+    """How many leading joints rows ``a`` and ``b`` of ``q`` have equal, bit for bit."""
+    n = q.shape[1]
+    for j in range(n):
+        if q[a, j] != q[b, j]:
+            return j
+    return n
+
+
+@inlined
 def _geodesic_row(H, P, rev, R_end, weight, q, Td, k):
     """``_certify_row``'s geodesic error alone (where the paper's J is not wanted: its Z-Y-Z angles cost as much
     as the rest)."""
@@ -275,12 +333,16 @@ def _certify_every_branch(cfgs, params, world, nb, H, P, rev, R_end, weight, q, 
     )
     own_zd = np.empty(4)
     zd = unowned(own_zd)
+    own_st = np.empty((H.shape[0] + 1, 12))
+    st = unowned(own_st)
     for i in range(start, stop):
         cfgs(params[i], 0.0, q[i * nb : (i + 1) * nb])
         zd[0] = 0.0
+        done = False  # (``st`` holds the previous branch's chain)
         for k in range(i * nb, (i + 1) * nb):
-            _certify_row(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper)
-    alive(own_zd)
+            shared = _shared_joints(q, k, k - 1) if done else 0
+            done = _certify_after(H, P, rev, R_end, weight, q, world[i], zd, k, err_geo, err_paper, shared, st)
+    alive(own_zd, own_st)
 
 
 @lazy_njit(
