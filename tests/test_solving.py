@@ -360,3 +360,29 @@ def test_limits_that_lie_outside_one_turn_around_zero() -> None:
         qq = np.array(q)
         sols = solve(arm, arm.fk(qq), locked=locked)
         assert recovers(arm, sols, qq)
+
+
+@pytest.mark.parametrize("limits_deg", [(750.0, 850.0), (-850.0, -750.0), (720.0, 1080.0), (1500.0, 1600.0)])
+def test_limits_several_turns_from_zero_keep_their_solutions(limits_deg: tuple[float, float]) -> None:
+    """A revolute joint limited to a window two or more turns from zero: each solution's value is moved into the
+    window by as many turns as it takes (one turn only was tried before: every solution was dropped as outside the
+    limits, the reason saying so, though the configuration itself lies inside them). Single and batched, ``wrap``
+    and ``within_limits`` alike."""
+    import dataclasses
+
+    from oracles import recovers
+
+    base = sweepik.load_robot("ur5")
+    lo, hi = np.radians(limits_deg)
+    joints = list(base.joints)
+    joints[1] = dataclasses.replace(joints[1], lower=lo, upper=hi)
+    arm = dataclasses.replace(base, joints=tuple(joints))
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        q[1] = rng.uniform(lo, hi)
+        T = arm.fk(q)
+        for sols in (solve(arm, T), solve_many(arm, T[None])[0]):
+            assert recovers(arm, sols, q)
+            assert np.all(sols.q[:, 1] >= lo - 1e-9) and np.all(sols.q[:, 1] <= hi + 1e-9)
+        assert arm.within_limits(arm.wrap(q)) and abs(arm.wrap(q)[1] - q[1]) < 1e-9

@@ -235,11 +235,10 @@ def wrap_inside_row(q, rev, lower, upper, ltol, beyond):  # pragma: no cover
         if rev[j] and math.isfinite(x):
             x = wrap_pi(x)
             if beyond and (x < lower[j] - ltol[j] or x > upper[j] + ltol[j]):
-                for shift in (two_pi, -two_pi):
-                    c = x + shift
-                    if lower[j] - ltol[j] <= c <= upper[j] + ltol[j]:
-                        x = c
-                        break
+                # (the lowest value not below the lower limit, as ``Robot.wrap``: limits of any number of turns)
+                c = x + two_pi * math.ceil(((lower[j] - ltol[j]) - x) / two_pi)
+                if lower[j] - ltol[j] <= c <= upper[j] + ltol[j]:
+                    x = c
             q[j] = x
         if not (lower[j] - ltol[j] <= x <= upper[j] + ltol[j]):
             ok = False

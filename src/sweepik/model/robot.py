@@ -335,17 +335,18 @@ class Robot:
     def wrap(self, q: ArrayLike) -> Array:
         """Revolute joint values shifted by multiples of 2 pi into their limits where possible.
 
-        Each revolute value is first wrapped into (-pi, pi], then moved by +-2 pi if that brings it inside
-        the limits. Prismatic values are unchanged.
+        Each revolute value is first wrapped into (-pi, pi], then, where that is outside the limits, moved by the
+        multiple of 2 pi that brings it to the lowest value not below the lower limit, if that is inside them (limits
+        of any number of turns from zero: [750, 850] deg takes two). Prismatic values are unchanged.
         """
         qa = check_configuration(q, self.n_joints, finite=False)
+        two_pi = 2.0 * np.pi
         with np.errstate(invalid="ignore"):  # inf (a branch that does not exist) stays non-finite
-            w = np.pi - np.mod(np.pi - qa, 2.0 * np.pi)
-        for shift in (2.0 * np.pi, -2.0 * np.pi) if self._limits_beyond_pi else ():
-            cand = w + shift
-            better = (w < self.lower - self.limit_tol) | (w > self.upper + self.limit_tol)
-            ok = (cand >= self.lower - self.limit_tol) & (cand <= self.upper + self.limit_tol)
-            w = np.where(better & ok, cand, w)
+            w = np.pi - np.mod(np.pi - qa, two_pi)
+            if self._limits_beyond_pi:
+                lo, hi = self.lower - self.limit_tol, self.upper + self.limit_tol
+                cand = w + two_pi * np.ceil((lo - w) / two_pi)  # (the same bits as w +- 2 pi for one turn)
+                w = np.where(((w < lo) | (w > hi)) & (cand >= lo) & (cand <= hi), cand, w)
         return np.where(self.is_revolute, w, qa)
 
     def within_limits(self, q: ArrayLike) -> NDArray[np.bool_]:
