@@ -87,3 +87,19 @@ def test_free_joint_option(capsys):
     assert "from 1 to 6" in err
     code, out, _ = run(capsys, "solve", "ur5", "--matrix", *matrix, "--free-joint", "2", "--reduction", "auto")
     assert code == 0
+
+
+@pytest.mark.parametrize("n", [1, 3, 5])
+def test_analyze_an_arm_of_fewer_than_six_joints_says_why_nothing_solves_it(capsys, tmp_path: Path, n: int):
+    """An arm of fewer than six joints (a robot file with the last joints cut): ``analyze`` gives its structure and
+    the reason no decomposition applies; it raised an IndexError (the UR family's continuum check read axes 5 and 6)."""
+    import dataclasses
+
+    ur5 = sweepik.load_robot("ur5")
+    arm = dataclasses.replace(ur5, joints=ur5.joints[:n])
+    info = sweepik.analyze(arm)
+    assert info["chosen"] is None and f"has {n} joints" in info["reason"]
+    path = tmp_path / "short.toml"
+    path.write_text(sweepik.robot_to_toml(arm))
+    code, out, err = run(capsys, "analyze", str(path))
+    assert code == 0 and f"has {n} joints" in out and err == ""

@@ -95,13 +95,16 @@ def _continuum_refused(robot: Robot) -> bool:
     """The UR family's closed form applies but was refused for its continuum (``plan.continuum_covered``): at joint
     5 = 0 the solutions form a continuum that only a sweep can report, and no sweep fits the arm. The general
     method's elimination is singular there (every value of its eigen-joint a root) and finds no member either, so
-    the arm is refused rather than answered "unreachable" at a reachable pose."""
+    the arm is refused rather than answered "unreachable" at a reachable pose. (Six-joint arms only: the family's
+    axes 2-6 are not all there on fewer joints.)"""
+    if robot.n_joints != 6:
+        return False
     return any(parallel_plans(robot, chain, rev_chain, s) for rev_chain, chain, s in chain_structures(robot))
 
 
 def _missing(robot: Robot) -> str:
     if robot.n_joints != 6:
-        return f"robot {robot.name!r} has {robot.n_joints} joints: the decompositions solve 6-joint arms"
+        return f"robot {robot.name!r} has {robot.n_joints} joints: the decompositions solve 6-joint arms."
     st = robot.structure()
     head = f"robot {robot.name!r} ({st.describe()}) is outside sweepik's catalogue: "
     if _continuum_refused(robot):
@@ -182,6 +185,8 @@ def choice(robot: Robot, free_joint: int | None = None, hints: tuple[Plan, ...] 
         if not options:
             raise NoReductionError(not_sweepable(robot, free_joint))
     elif not options:  # (no structure to use: the general method, for six joints)
+        if robot.n_joints != 6:
+            raise NoReductionError(_missing(robot))
         if _continuum_refused(robot):  # (the general method too would answer "unreachable" on its continuum)
             raise NoReductionError(_missing(robot))
         why = general_refusal(robot)
