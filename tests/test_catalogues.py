@@ -184,3 +184,24 @@ def test_mjcf_refusals(tmp_path: Path) -> None:
         sweepik.load_robot(broken)
     with pytest.raises(sweepik.SweepikError):
         sweepik.load_robot(tmp_path / "missing.xml")
+
+
+def test_mjcf_refusals_say_one_thing_and_write_nothing(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A NaN in the file: MuJoCo's own warning ("XML contains a 'NaN'") went to the terminal and into
+    ``MUJOCO_LOG.TXT`` in the working directory before sweepik's error; now only the error, nothing written. A model
+    name that is not UTF-8: an MjcfError naming the file (a UnicodeDecodeError before)."""
+    pytest.importorskip("mujoco")
+    monkeypatch.chdir(tmp_path)
+    nan = tmp_path / "nan.xml"
+    nan.write_text(MJCF.replace('<body name="l3" pos="0.3 0 0">', '<body name="l3" pos="nan 0 0">'))
+    with pytest.raises(sweepik.MjcfError, match="NaN"):
+        sweepik.load_robot(nan, tip_link="tool")
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+    latin = tmp_path / "latin.xml"
+    latin.write_bytes(MJCF.encode().replace(b'model="toy"', b'model="\xff"'))
+    with pytest.raises(sweepik.MjcfError, match="latin.xml"):
+        sweepik.load_robot(latin, tip_link="tool")

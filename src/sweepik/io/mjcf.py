@@ -13,6 +13,7 @@ without a range gets +-pi (as a URDF continuous joint); a slide without one is r
 
 from __future__ import annotations
 
+import logging
 from os import PathLike
 from typing import Any
 
@@ -28,6 +29,7 @@ __all__ = ["read_mjcf"]
 Array = NDArray[np.float64]
 
 _HINGE, _SLIDE = 3, 2
+_log = logging.getLogger(__name__)
 _JOINT_KINDS = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 
 
@@ -40,8 +42,19 @@ def _mujoco() -> Any:
 
 
 def _compiled(path: str) -> Any:
-    """The file's compiled ``MjModel``, without meshes, height fields, textures or skins."""
+    """The file's compiled ``MjModel``, without meshes, height fields, textures or skins. MuJoCo's warnings (e.g.
+    "XML contains a 'NaN'") are logged rather than printed (MuJoCo would print them on the terminal and append them
+    to ``MUJOCO_LOG.TXT`` in the working directory): what they warn of, sweepik's own checks refuse with an error."""
     mujoco = _mujoco()
+    before = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda msg: _log.info("MuJoCo on %s: %s", path, msg))
+    try:
+        return _compile(mujoco, path)
+    finally:
+        mujoco.set_mju_user_warning(before)
+
+
+def _compile(mujoco: Any, path: str) -> Any:
     try:
         spec = mujoco.MjSpec.from_file(path)
         for g in spec.geoms:
@@ -137,6 +150,14 @@ def read_mjcf(path: str | PathLike[str], base_link: str | None = None, tip_link:
         raise MjcfError(f"MJCF file {str(p)!r} does not exist")
     source = str(p)
     model = _compiled(source)
+    try:
+        return _read(model, source, base_link, tip_link)
+    except UnicodeDecodeError:
+        raise MjcfError(f"{source}: a name in the file is not UTF-8 text") from None
+
+
+def _read(model: Any, source: str, base_link: str | None, tip_link: str | None) -> Robot:
+    """``read_mjcf`` of the compiled ``model``."""
     bodies = _names(model, "body", model.nbody)
     base = 0 if base_link is None else _find(bodies, base_link, "base_link (body)", source)
     tip_T = np.eye(4)
