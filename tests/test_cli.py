@@ -371,3 +371,28 @@ def test_paper_strategy_says_when_the_precise_one_finds_more(capsys: pytest.Capt
     assert json.loads(out)["poses"][0]["precise_strategy_finds"] == len(precise)
     code, out, _ = run(capsys, "solve", "--matrix", *m)
     assert "note:" not in out
+
+
+def test_a_file_that_cannot_be_written_or_read_is_one_line_and_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Writing fails after the output path's checks passed (a full disk, a path under /proc): one line naming the
+    file and exit status 2, as for any bad input (it was exit status 1 with Python's ``[Errno 28] ...`` text); a
+    robot file that cannot be read alike."""
+    import errno
+
+    out = tmp_path / "arm.toml"
+
+    def full_disk(self: Path, *args: object, **kwargs: object) -> int:
+        raise OSError(errno.ENOSPC, "No space left on device", str(self))
+
+    with monkeypatch.context() as m:
+        m.setattr(Path, "write_text", full_disk)
+        code = main(["convert", "ur5", "-o", str(out)])
+    _, err = capsys.readouterr()
+    assert code == 2 and err.strip() == f"sweepik: error: {out}: No space left on device"
+    unreadable = tmp_path / "arm_dir.toml"
+    unreadable.mkdir()
+    code = main(["fk", str(unreadable), "0", "0", "0", "0", "0", "0"])
+    _, err = capsys.readouterr()
+    assert code == 2 and len(err.strip().splitlines()) == 1 and str(unreadable) in err

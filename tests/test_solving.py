@@ -334,6 +334,11 @@ def test_bad_options_raise() -> None:
         solve(CARM, T, strategy="fast")  # type: ignore[arg-type]
     with pytest.raises(UnknownOptionError, match="carm-d1"):
         solve(CARM, T, reduction="nope")
+    import dataclasses
+
+    named = dataclasses.replace(CARM, default_reduction="nope")  # (a robot file's default_reduction, mistyped)
+    with pytest.raises(UnknownOptionError, match="default_reduction 'nope'"):
+        solve(named, T)
     with pytest.raises(ShapeError):
         solve_many(CARM, T)
     with pytest.raises(SweepikError, match="C-Arm"):

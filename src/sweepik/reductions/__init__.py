@@ -55,9 +55,13 @@ def get_reduction(robot: Robot, reduction: str | Reduction | None, free_joint: i
     if name == AUTO:
         return _automatic(robot, free_joint)
     if name not in REDUCTIONS:
-        raise UnknownOptionError(
-            f"unknown reduction {reduction!r}; choose one of {sorted(REDUCTIONS) + sorted(_ALIASES) + [AUTO]}"
-        )
+        names = sorted(REDUCTIONS) + sorted(_ALIASES) + [AUTO]
+        if reduction is None:  # (the robot file's default_reduction)
+            raise UnknownOptionError(
+                f"robot {robot.name!r}: its default_reduction {robot.default_reduction!r} is not a reduction; "
+                f"choose one of {names}"
+            )
+        raise UnknownOptionError(f"unknown reduction {reduction!r}; choose one of {names}")
     return _cached(robot, name)
 
 
