@@ -373,12 +373,12 @@ def test_paper_strategy_says_when_the_precise_one_finds_more(capsys: pytest.Capt
     assert "note:" not in out
 
 
-def test_a_file_that_cannot_be_written_or_read_is_one_line_and_exit_2(
+def test_a_file_that_cannot_be_written_or_read_is_one_line_naming_it(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Writing fails after the output path's checks passed (a full disk, a path under /proc): one line naming the
-    file and exit status 2, as for any bad input (it was exit status 1 with Python's ``[Errno 28] ...`` text); a
-    robot file that cannot be read alike."""
+    file and its error, exit status 1 (docs/cli.md: an operating-system error after the checks; Python's
+    ``[Errno 28] ...`` text before); a robot file that cannot be read (a directory) is bad input, exit status 2."""
     import errno
 
     out = tmp_path / "arm.toml"
@@ -390,7 +390,7 @@ def test_a_file_that_cannot_be_written_or_read_is_one_line_and_exit_2(
         m.setattr(Path, "write_text", full_disk)
         code = main(["convert", "ur5", "-o", str(out)])
     _, err = capsys.readouterr()
-    assert code == 2 and err.strip() == f"sweepik: error: {out}: No space left on device"
+    assert code == 1 and err.strip() == f"sweepik: error: {out}: No space left on device"
     unreadable = tmp_path / "arm_dir.toml"
     unreadable.mkdir()
     code = main(["fk", str(unreadable), "0", "0", "0", "0", "0", "0"])

@@ -45,6 +45,7 @@ from sweepik.cli.analyze import add_analyze_parser, cmd_analyze, plan_line, prin
 from sweepik.cli.batch import EXIT_INTERRUPTED, add_sample_parser, cmd_sample
 from sweepik.cli.common import (
     DEFAULT_ROBOT,
+    EXIT_IO,
     EXIT_USAGE,
     PROG,
     VERBOSE_HELP,
@@ -388,12 +389,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into a command that stopped reading (e.g. `| head`)
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except (OSError, UnicodeError) as exc:  # a file that cannot be read, decoded or written
+    except (OSError, UnicodeError) as exc:  # a file that cannot be read, decoded or written after the checks
         if isinstance(exc, OSError) and exc.filename and exc.strerror:
             _error(f"{exc.filename}: {exc.strerror}")
         else:
             _error(str(exc))
-        return EXIT_USAGE
+        return EXIT_IO
     except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback (what was printed so far stays printed)
         print(f"{PROG}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

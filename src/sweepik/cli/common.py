@@ -23,8 +23,10 @@ from sweepik.model.robot import Robot
 PROG = "sweepik"
 #: Robot used when a subcommand's optional ROBOT argument is left out.
 DEFAULT_ROBOT = "carm"
-#: Exit status for bad input (the same as argparse's usage errors), a file that cannot be read or written included.
+#: Exit status for bad input (the same as argparse's usage errors).
 EXIT_USAGE = 2
+#: Exit status for an operating-system error while a file is read or written after the checks (a full disk).
+EXIT_IO = 1
 #: Largest --precision (float64 carries 15-17 significant digits).
 MAX_PRECISION = 17
 VERBOSE_HELP = "print more detail (and log at INFO level)"
