@@ -107,6 +107,16 @@ _NEAREST_MINIMA = 4
 _GOLDEN_ITERS = 60
 
 
+def _nearest_winding(robot: Robot, q: Array, ref: Array) -> Array:
+    """``q (n,)`` with each revolute value turned by the whole turns that bring it nearest ``ref``'s while inside the
+    joint's limits (with ``limit_tol``; a value outside them stays)."""
+    two_pi = 2.0 * np.pi
+    lo, hi = robot.lower - robot.limit_tol, robot.upper + robot.limit_tol
+    k_lo, k_hi = np.ceil((lo - q) / two_pi), np.floor((hi - q) / two_pi)
+    k = np.where(k_lo <= k_hi, np.clip(np.round((ref - q) / two_pi), k_lo, k_hi), 0.0)
+    return np.where(robot.is_revolute, q + two_pi * k, q)
+
+
 def _nearest_on_family(robot: Robot, fam: Family, ref: Array, metric: DistanceFunction) -> tuple[Array, float]:
     """Member of ``fam`` nearest ``ref`` by ``metric`` (modulo 2 pi: families are not wound): dense sampling, then a
     golden-section search around each local minimum of the samples (``_NEAREST_MINIMA`` at most, the lowest first),
@@ -348,6 +358,9 @@ class Solutions:
             best, best_d = self.q[i], float(d[i])
         for fam in self.families:
             member, dm = _nearest_on_family(self.robot, fam, ref, fn)
+            if self.wound:  # (the rows are compared as they are: the member's winding nearest the reference too)
+                member = _nearest_winding(self.robot, member, ref)
+                dm = float(fn(self.robot, member[None], ref, False)[0])
             if dm < best_d:
                 best, best_d = member, dm
         if best is None or (limit is not None and best_d > limit):

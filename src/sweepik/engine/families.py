@@ -214,8 +214,8 @@ def _members_excess(
     ok, qz = _certified(robot, red, chain, world, pose, branch, theta, tol)
     if not limits:
         return ok, np.full(qz.shape, np.nan)
-    w, inside = robot.wrapped_within_limits(qz)
-    over = np.maximum((robot.lower - robot.limit_tol) - w, w - (robot.upper + robot.limit_tol))
+    inside = robot.within_limits(qz)
+    over = robot.limit_excess(qz) - robot.limit_tol
     return ok & inside, np.where(ok[..., None], over, np.nan)
 
 
@@ -288,8 +288,7 @@ def _joint_excess(
     """``(K, n)``: how far each joint of the family member at ``x (K,)`` lies outside its limits (<= 0 inside, inf
     where the member does not exist)."""
     q = family_members(robot, red, chain, pose, branch, x)
-    w = robot.wrap(np.nan_to_num(q, nan=np.inf))
-    return np.asarray(np.maximum(robot.lower - w, w - robot.upper))
+    return robot.limit_excess(np.nan_to_num(q, nan=np.inf))
 
 
 def _limit_excess(
@@ -523,8 +522,7 @@ def families_of(
     # its member: of the piece's ends and middle, the one deepest inside the limits
     three = np.stack([lo[point], 0.5 * (lo + hi)[point], hi[point]], axis=1)
     q3 = red.solve_rest(chain[pose[pk]], three, np.broadcast_to(branch[pk][:, None], three.shape))
-    w = robot.wrap(np.nan_to_num(q3, nan=np.inf))
-    over = np.sum(np.maximum(robot.lower - w, 0.0) + np.maximum(w - robot.upper, 0.0), axis=-1)
+    over = np.sum(np.maximum(robot.limit_excess(np.nan_to_num(q3, nan=np.inf)), 0.0), axis=-1)
     mid = three[np.arange(pk.size), np.argmin(over, axis=1)] if pk.size else np.zeros(0)
     q_pts = (
         red.solve_rest(chain[pose[pk]], mid[:, None], branch[pk][:, None])[:, 0]

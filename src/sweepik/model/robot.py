@@ -349,6 +349,18 @@ class Robot:
                 w = np.where(((w < lo) | (w > hi)) & (cand >= lo) & (cand <= hi), cand, w)
         return np.where(self.is_revolute, w, qa)
 
+    def limit_excess(self, q: ArrayLike) -> Array:
+        """``(..., n)``: how far each joint value lies outside its limits (<= 0 inside; ``limit_tol`` not added),
+        a revolute one measured from the middle of its limits modulo 2 pi: continuous along a motion whatever turn the
+        limits lie in (a window 0.1 rad wide one turn from zero, or [750, 850] deg), where the value ``wrap`` gives
+        jumps by a turn. NaN for a revolute value that is not finite."""
+        qa = np.asarray(q, dtype=np.float64)
+        mid = 0.5 * (self.lower + self.upper)
+        with np.errstate(invalid="ignore"):
+            near = mid + (np.pi - np.mod(np.pi - (qa - mid), 2.0 * np.pi))
+        w = np.where(self.is_revolute, near, qa)
+        return np.asarray(np.maximum(self.lower - w, w - self.upper))
+
     def within_limits(self, q: ArrayLike) -> NDArray[np.bool_]:
         """``(...)`` bool: all joint values inside their limits (revolute ones after ``wrap``), with ``limit_tol``."""
         return self.wrapped_within_limits(q)[1]
