@@ -159,3 +159,60 @@ def test_members_of_many_families_at_once_are_each_familys() -> None:
     )
     for f, th, m in zip(fams, theta, many, strict=True):
         np.testing.assert_array_equal(m, certified_members(f.reduction, f.chain_pose, f.branch, th, *f.interval))
+
+
+@pytest.mark.parametrize(
+    ("name", "q", "locked"),
+    [
+        ("stanford", [0.3, -0.5, 0.8, np.radians(170), 0.0, np.radians(170)], None),
+        ("kuka_iiwa14", [0.5, -0.7, 0.3, -1.5, np.radians(170), 0.0, np.radians(175)], {"A1": 0.5}),
+        ("kuka_iiwa14", [0.5, -0.7, 0.3, -1.5, np.radians(170), 0.0, np.radians(175)], {"A3": 0.3}),
+        ("carm", [300.0, np.pi / 2, np.radians(116), np.radians(66), np.pi, 0.3], None),
+    ],
+)
+def test_a_family_touching_a_corner_of_the_limits_keeps_that_point(name: str, q: list[float], locked: Any) -> None:
+    """A configuration on a self-motion with two joints at their limits at once (the wrist's two joints on its
+    singular circle; the C-Arm's joints 3 and 4): inside the limits the family is a stretch plus that one point,
+    where one joint leaves its limits as the other comes back in. The point was dropped (the worst joint's excess, a
+    V touching zero there, is no local minimum among the samples next to an inside stretch); now the crossing is
+    located between the two samples outside (``families._limit_corners``) and the point is an isolated solution.
+    Found by a property-testing helper."""
+    from oracles import recovers
+
+    robot = load_robot(name)
+    qq = np.array(q)
+    assert robot.within_limits(qq)
+    T = robot.fk(qq)
+    for sols in (sweepik.solve(robot, T, locked=locked), sweepik.solve_many(robot, T[None], locked=locked)[0]):
+        assert recovers(robot, sols, qq)
+        assert robot.within_limits(sols.q).all()
+
+
+def test_a_family_in_a_narrow_window_a_turn_from_zero_is_kept() -> None:
+    """UR5 with its wrist straight (joint 5 at pi: a continuum) and joint 4 limited to a window 0.1 rad wide one turn
+    from zero: the family was dropped whole (its members' limit excess, measured from the value ``wrap`` gives,
+    jumped by a turn outside the window, and no cut was found); the same window without the turn kept it. Now the
+    excess is measured from the middle of the limits (``Robot.limit_excess``). Found by a property-testing helper."""
+    import dataclasses
+
+    from oracles import recovers
+
+    base = load_robot("ur5")
+    for turn in (0.0, 2.0 * np.pi, -2.0 * np.pi):
+        joints = list(base.joints)
+        joints[3] = dataclasses.replace(joints[3], lower=0.45 + turn, upper=0.55 + turn)
+        arm = dataclasses.replace(base, joints=tuple(joints))
+        q = np.array([0.3, -1.0, 1.2, 0.5 + turn, np.pi, 0.2])
+        sols = sweepik.solve(arm, arm.fk(q))
+        assert sols.families and recovers(arm, sols, q), turn
+
+
+def test_nearest_with_windings_takes_the_family_members_winding() -> None:
+    """``windings=True`` compares rows as they are, not modulo 2 pi: a family member must be turned to its winding
+    nearest the reference too (it was compared modulo 2 pi and returned a turn away). Found by a property-testing
+    helper: PUMA 560 with its wrist straight, joint 6 at -226 deg (limits +-266)."""
+    robot = load_robot("puma560")
+    q = np.array([2.457662365440189, 0.04128659553241709, 3.9269908169872414, 0.19905312751236304, 0.0, -3.94246786])
+    sols = sweepik.solve(robot, robot.fk(q), windings=True)
+    assert sols.families
+    np.testing.assert_allclose(sols.nearest(q), q, atol=1e-9)

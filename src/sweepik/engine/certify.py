@@ -464,10 +464,13 @@ def _limit_excess_row(q, jrev, lower, upper, ltol, beyond):
             bad = True
     if bad:
         return math.inf
-    wrap_inside_row(q, jrev, lower, upper, ltol, beyond)
     out = -math.inf
     for j in range(q.shape[0]):
-        out = max(out, max(lower[j] - q[j], q[j] - upper[j]))
+        x = q[j]
+        if jrev[j]:  # (from the middle of the limits modulo 2 pi, as ``Robot.limit_excess``)
+            mid = 0.5 * (lower[j] + upper[j])
+            x = mid + wrap_pi(x - mid)
+        out = max(out, max(lower[j] - x, x - upper[j]))
     return out
 
 

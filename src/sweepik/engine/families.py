@@ -16,6 +16,7 @@ from sweepik.engine.settings import (
     CLUSTER_FAMILY_REL,
     CONTINUUM_LINK,
     CONTINUUM_THIN,
+    CORNER_BISECT,
     CUT_BISECT,
     DIP_STEPS,
     FAMILY_SAMPLES,
@@ -326,13 +327,63 @@ def _limit_dips(
         best_x, best_e = certify.dip_search(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e, DIP_STEPS)
     else:
         best_x, best_e = _golden_dips(robot, red, chain, pose[k], branch[k], a, b, best_x, best_e)
-    found = best_e <= 0.0
+    # (inside the limits as ``_members_ok`` takes them: within their tolerance; a family touching a corner of the
+    # limits, two joints at theirs at once, meets them at one point only, which the search gets within ~1e-11)
+    found = best_e <= np.min(robot.limit_tol)
     rows = k[found]
     width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
     extra = np.repeat(grid[:, :1], width, axis=1)
     # the j-th dip of a span goes to column j (rows are sorted: k comes from np.nonzero)
     col = np.arange(rows.size) - np.searchsorted(rows, rows)
     extra[rows, col] = best_x[found]
+    return extra
+
+
+def _limit_corners(
+    robot: Robot,
+    red: Reduction,
+    chain: Array,
+    pose: NDArray[np.intp],
+    branch: NDArray[np.intp],
+    grid: Array,
+    e: Array,
+) -> Array:
+    """``(K, D)`` extra samples, as ``_limit_dips``'s: where two neighbouring samples both lie outside the limits,
+    one joint leaving its limits between them and another coming back in (and none outside at both), the leaving
+    joint's crossing of its limit is located (bisection, to ``2**-CORNER_BISECT`` of the step); where the member
+    there is inside the limits (their tolerance), it is an extra sample. A family can touch the limits at one point
+    only, two joints at theirs at once (a wrist's two joints at their limits on its singular circle: one leaves its
+    limits where the other comes back in): the excess of the worst joint there is a V reaching zero, which is not
+    a local minimum among the samples when an inside stretch lies next to it, so ``_limit_dips`` does not see it.
+    ``e (K, M, n)``: each joint's excess."""
+    K, M = grid.shape
+    tol = float(np.min(robot.limit_tol))
+    with np.errstate(invalid="ignore"):
+        worst = np.max(e, axis=-1)
+        outside = np.isfinite(worst) & (worst > tol)
+        before, after = e[:, :-1] > 0.0, e[:, 1:] > 0.0
+        leaves, enters = ~before & after, before & ~after
+        finite = np.all(np.isfinite(e[:, :-1]) & np.isfinite(e[:, 1:]), axis=-1)
+        # (both samples outside, one joint leaving its limits and another coming back, no joint outside at both)
+        corner = outside[:, :-1] & outside[:, 1:] & finite & leaves.any(axis=-1) & enters.any(axis=-1)
+        corner &= ~np.any(before & after, axis=-1)
+    k, i = np.nonzero(corner)
+    if k.size == 0:
+        return np.zeros((K, 0))
+    j = np.argmax(leaves[k, i], axis=-1)  # (a joint that leaves: its crossing is the corner, if there is one)
+    a, b = grid[k, i], grid[k, i + 1]  # (the joint inside its limits at a, outside at b)
+    rows = np.arange(k.size)
+    for _ in range(CORNER_BISECT):
+        m = 0.5 * (a + b)
+        out = _joint_excess(robot, red, chain, pose[k], branch[k], m)[rows, j] > 0.0
+        a, b = np.where(out, a, m), np.where(out, m, b)
+    found = _limit_excess(robot, red, chain, pose[k], branch[k], a) <= tol
+    x = a
+    rows_k = k[found]
+    width = int(np.bincount(rows_k, minlength=K).max()) if rows_k.size else 0
+    extra = np.repeat(grid[:, :1], width, axis=1)
+    col = np.arange(rows_k.size) - np.searchsorted(rows_k, rows_k)
+    extra[rows_k, col] = x[found]
     return extra
 
 
@@ -470,7 +521,8 @@ def families_of(
         e = _joint_excess(robot, red, chain, np.repeat(pose, M), np.repeat(branch, M), grid.ravel()).reshape(S, M, -1)
         dips = _limit_dips(robot, red, chain, pose, branch, grid, np.max(e, axis=-1))
         peaks = _limit_peaks(robot, red, chain, pose, branch, grid, e)
-        grid = np.sort(np.concatenate([grid, dips, peaks], axis=1), axis=1)
+        corners = _limit_corners(robot, red, chain, pose, branch, grid, e)
+        grid = np.sort(np.concatenate([grid, dips, peaks, corners], axis=1), axis=1)
     ok = _members_ok(robot, red, chain, world, pose, branch, grid, limits, tol)
     pad = np.zeros((len(spans), 1), np.int8)
     edges = np.diff(np.concatenate([pad, ok.astype(np.int8), pad], axis=1), axis=1)
