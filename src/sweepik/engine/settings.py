@@ -284,8 +284,9 @@ NUDGE_REL = 2.0**-30
 #: ~1e-8 mm on the C-Arm's rail (``_locate_cuts``).
 CUT_BISECT = 32
 #: Bisection steps locating a joint's crossing of its limit between two samples outside the limits (``families.
-#: _limit_corners``): ~1e-16 of a step, a family touching the limits at one point (two joints at theirs) found there.
-CORNER_BISECT = 52
+#: _limit_corners``): ~1.5e-11 of a step (a few 1e-12 rad), well inside the limits' tolerance (1e-9) at a point where a
+#: family touches the limits (two joints at theirs).
+CORNER_BISECT = 36
 #: Golden-section steps locating the least limit excess between samples (the bracket shrinks 0.618x a step;
 #: the search stops once every bracket has a point inside the limits).
 DIP_STEPS = 50
