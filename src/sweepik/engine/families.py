@@ -330,12 +330,16 @@ def _limit_dips(
     # (inside the limits as ``_members_ok`` takes them: within their tolerance; a family touching a corner of the
     # limits, two joints at theirs at once, meets them at one point only, which the search gets within ~1e-11)
     found = best_e <= np.min(robot.limit_tol)
-    rows = k[found]
-    width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
+    return _extra_samples(grid, k[found], best_x[found])
+
+
+def _extra_samples(grid: Array, rows: NDArray[np.intp], x: Array) -> Array:
+    """``(K, D)``: the extra samples ``x`` of the spans ``rows`` (sorted: they come from ``np.nonzero``), the j-th of
+    a span in column j; shorter rows repeat the span's first sample (``D``: the most of one span)."""
+    width = int(np.bincount(rows, minlength=grid.shape[0]).max()) if rows.size else 0
     extra = np.repeat(grid[:, :1], width, axis=1)
-    # the j-th dip of a span goes to column j (rows are sorted: k comes from np.nonzero)
     col = np.arange(rows.size) - np.searchsorted(rows, rows)
-    extra[rows, col] = best_x[found]
+    extra[rows, col] = x
     return extra
 
 
@@ -378,13 +382,7 @@ def _limit_corners(
         out = _joint_excess(robot, red, chain, pose[k], branch[k], m)[rows, j] > 0.0
         a, b = np.where(out, a, m), np.where(out, m, b)
     found = _limit_excess(robot, red, chain, pose[k], branch[k], a) <= tol
-    x = a
-    rows_k = k[found]
-    width = int(np.bincount(rows_k, minlength=K).max()) if rows_k.size else 0
-    extra = np.repeat(grid[:, :1], width, axis=1)
-    col = np.arange(rows_k.size) - np.searchsorted(rows_k, rows_k)
-    extra[rows_k, col] = x[found]
-    return extra
+    return _extra_samples(grid, k[found], a[found])
 
 
 def _golden_dips(
@@ -469,12 +467,7 @@ def _limit_peaks(
     slope = PEAK_REACH * rise[k, i, j] / np.maximum(0.5 * (b - a), np.finfo(float).tiny)
     best_x, best_e = golden_least(negated, a, b, grid[k, i], -big[k, i, j], PEAK_STEPS, slope)
     found = best_e < 0.0
-    rows = k[found]
-    width = int(np.bincount(rows, minlength=K).max()) if rows.size else 0
-    extra = np.repeat(grid[:, :1], width, axis=1)
-    col = np.arange(rows.size) - np.searchsorted(rows, rows)
-    extra[rows, col] = best_x[found]
-    return extra
+    return _extra_samples(grid, k[found], best_x[found])
 
 
 def merge_spans(spans: Spans) -> Spans:
