@@ -260,6 +260,8 @@ def test_lock_values_per_pose_errors() -> None:
         ([0.1, float("nan"), 0.2], "pose 1: .*finite"),
         ([0.1, 0.2, 3.1], "pose 2: .*outside its limits"),
         (["a", "b", "c"], "numbers"),
+        (["0.1", "0.2", "0.3"], "numbers, one per pose, got '0.1'"),  # (text NumPy would read as numbers)
+        ([None, 0.1, 0.2], "numbers, one per pose, got None"),
         (np.zeros((3, 1)), "shape"),
         ([True, False, True], "not booleans"),  # (as a single True is refused: not a joint value)
         (np.ones(3, dtype=bool), "not booleans"),

@@ -217,9 +217,13 @@ def lock_runs(robot: Robot, locked: Mapping[Any, Any], n: int) -> list[tuple[int
             if _booleans(value):
                 raise LockedJointError(f"locked: joint {name!r} needs numbers, one per pose, not booleans")
             try:
-                col = np.asarray(value, dtype=np.float64)
-            except (TypeError, ValueError):
+                raw = np.asarray(value)
+            except (TypeError, ValueError):  # (ragged)
                 raise LockedJointError(f"locked: joint {name!r} needs numbers, one per pose") from None
+            if raw.dtype.kind not in "iuf":  # (text NumPy would convert, None, ...: refused as one such value is)
+                bad = next((x for x in raw.ravel().tolist() if not isinstance(x, int | float)), raw.dtype)
+                raise LockedJointError(f"locked: joint {name!r} needs numbers, one per pose, got {bad!r}")
+            col = raw.astype(np.float64)
             if col.shape != (n,):
                 raise LockedJointError(
                     f"locked: joint {name!r} has values of shape {col.shape}; give one number, or one per pose ({n})"
