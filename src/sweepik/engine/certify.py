@@ -445,7 +445,7 @@ def _member(cfg, p, x, br, q, Td, H, P, rev, R_end, weight, tol, limits, jrev, l
 
 
 @inlined
-def _limit_excess_row(q, jrev, lower, upper, ltol, beyond):
+def _limit_excess_row(q, jrev, lower, upper):
     """``families._limit_excess`` of one member ``q (n,)`` (changed in place), value for value: NaN becomes
     inf and +-inf the largest float (``np.nan_to_num``); an infinite revolute value wraps to NaN."""
     bad = False
@@ -493,9 +493,9 @@ def _dip_search(
         i, br, lo, hi, bx, be = pose[k], branch[k], a[k], b[k], best_x[k], best_e[k]
         c, d = hi - g * (hi - lo), lo + g * (hi - lo)
         cfg(params[i], c, br, q)
-        ec = _limit_excess_row(q, jrev, lower, upper, ltol, beyond)
+        ec = _limit_excess_row(q, jrev, lower, upper)
         cfg(params[i], d, br, q)
-        ed = _limit_excess_row(q, jrev, lower, upper, ltol, beyond)
+        ed = _limit_excess_row(q, jrev, lower, upper)
         for t in range(hist_x.shape[1]):
             if ec < be:
                 bx, be = c, ec
@@ -512,7 +512,7 @@ def _dip_search(
                 new_c, new_d = d, lo + g * (hi - lo)
                 fresh = new_d
             cfg(params[i], fresh, br, q)
-            e_fresh = _limit_excess_row(q, jrev, lower, upper, ltol, beyond)
+            e_fresh = _limit_excess_row(q, jrev, lower, upper)
             if left:
                 ec, ed = e_fresh, ec
             else:
