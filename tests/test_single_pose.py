@@ -5,54 +5,19 @@ targets that are not rigid transforms raise what they raised; other arrays take 
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
 
 import numpy as np
 import pytest
+from one_call import answered_by_one_call, assert_reproduced, assert_same, configurations, general_path
 from rewrites import rewrite
 
 import sweepik
 from sweepik import load_robot, solving
-from sweepik.engine import chunk
 from sweepik.engine.single_pose import SinglePose
 from sweepik.results import Solutions
 
 CLOSED = ["puma560", "puma560_std", "ur5", "abb_irb140", "kuka_kr6_r900", "stanford", "standardbots_spark"]
 SWEPT = ["kinova_jaco2", "fanuc_crx10ia", "xarm6", "yaskawa_hc10"]
-
-
-def _configurations(robot: sweepik.Robot, rng: np.random.Generator, n: int = 24) -> np.ndarray:
-    """Random configurations, a quarter with the wrist straight (joint 5 at 0), a quarter with joint 3 at 0."""
-    q = rng.uniform(np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi), (n, robot.n_joints))
-    q[: n // 4, 4] = 0.0
-    q[n // 4 : n // 2, 2] = 0.0
-    return q
-
-
-def _general(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, T: np.ndarray, **kw: Any) -> Solutions:
-    """``solve`` without the one call (neither this module's nor ``chunk.settled``)."""
-    with monkeypatch.context() as m:
-        m.setattr(solving, "_single_pose", lambda *args: None)
-        m.setattr(solving, "settled", lambda *args: None)
-        m.setattr(chunk, "settled", lambda *args: None)
-        return sweepik.solve(robot, T, **kw)
-
-
-def _assert_same(a: Solutions, b: Solutions) -> None:
-    for f in dataclasses.fields(Solutions):
-        x, y = getattr(a, f.name), getattr(b, f.name)
-        if isinstance(x, np.ndarray):
-            assert x.dtype == y.dtype, f.name
-            np.testing.assert_array_equal(x, y, err_msg=f.name)
-        elif f.name == "families":
-            assert len(x) == len(y)
-        else:
-            assert x == y, f.name
-
-
-def _answered(robot: sweepik.Robot, T: np.ndarray, limits: bool = True, locked: Any = None) -> bool:
-    fast = solving._single_pose(robot, locked)
-    return fast is not None and fast.solve(np.ascontiguousarray(T), limits)[1] is not None
 
 
 @pytest.mark.parametrize("name", CLOSED + SWEPT)
@@ -67,21 +32,14 @@ def test_the_one_call_is_the_general_path_on_arms_written_otherwise(
     rng = np.random.default_rng(seed)
     if seed:
         robot = rewrite(robot, rng).robot
-    q = _configurations(robot, rng, 24 if name in CLOSED else 8)
+    q = configurations(robot, rng, 24 if name in CLOSED else 8)
     answered = 0
     for qq, T in zip(q, robot.fk(q), strict=True):
         for limits in (True, False):
             sol = sweepik.solve(robot, T, limits=limits)
-            _assert_same(sol, _general(monkeypatch, robot, T, limits=limits))
-            answered += _answered(robot, T, limits)
-        sol = sweepik.solve(robot, T, limits=False)
-        scale = robot.length_scale
-        for s in sol.q:
-            F = robot.fk(s)
-            assert np.max(np.abs(F[:3, 3] - T[:3, 3])) < 1e-9 * scale and np.max(np.abs(F[:3, :3] - T[:3, :3])) < 1e-9
-        d = np.abs(sol.q - qq)
-        d[:, robot.is_revolute] = np.abs(np.angle(np.exp(1j * d[:, robot.is_revolute])))
-        assert sol.families or (len(sol) and np.min(np.max(d, axis=1)) < 1e-6)
+            assert_same(sol, general_path(monkeypatch, robot, T, limits=limits))
+            answered += answered_by_one_call(robot, T, limits)
+        assert_reproduced(robot, sweepik.solve(robot, T, limits=False), T, qq)
     assert answered >= len(q)  # (half of the 2 x 24 solves: the random quarter and more)
 
 
@@ -98,8 +56,8 @@ def test_a_locked_arm_at_new_values(name: str, joint: str, monkeypatch: pytest.M
     for qq, T in zip(q, robot.fk(q), strict=True):
         locked = {joint: float(qq[k])}
         sol = sweepik.solve(robot, T, locked=locked)
-        _assert_same(sol, _general(monkeypatch, robot, T, locked=locked))
-        assert _answered(robot, T, locked=locked)
+        assert_same(sol, general_path(monkeypatch, robot, T, locked=locked))
+        assert answered_by_one_call(robot, T, locked=locked)
         assert np.all(sol.q[:, k] == qq[k]) and np.min(np.max(np.abs(sol.q - qq), axis=1)) < 1e-6
 
 
@@ -125,7 +83,7 @@ def test_targets_that_are_no_rigid_transform_raise_as_before(name: str, monkeypa
         with pytest.raises(sweepik.SweepikError) as fast:
             sweepik.solve(robot, B)
         with pytest.raises(sweepik.SweepikError) as general:
-            _general(monkeypatch, robot, B)
+            general_path(monkeypatch, robot, B)
         assert type(fast.value) is type(general.value) and str(fast.value) == str(general.value)
 
 
@@ -138,18 +96,19 @@ def test_other_arrays_and_options_take_the_general_path(monkeypatch: pytest.Monk
     frozen = T.copy()
     frozen.flags.writeable = False
     for other in (frozen, np.asfortranarray(T), T.tolist()):
-        _assert_same(sweepik.solve(robot, other), want)
+        assert_same(sweepik.solve(robot, other), want)
     single = sweepik.solve(robot, T.astype(np.float32))
     assert len(single) == len(want)
     with pytest.raises(sweepik.ShapeError, match="solve_many"):
         sweepik.solve(robot, T[None])
-    _assert_same(sweepik.solve(robot, T, limits=True, strategy="precise"), want)
+    assert_same(sweepik.solve(robot, T, limits=True, strategy="precise"), want)
 
 
 def test_which_reductions_qualify() -> None:
     """Closed forms and sweeps of a revolute theta* whose checks are compiled qualify; the C-Arm (a prismatic theta*,
-    its own reduction) and arms solved with a companion (the Doosan M0609, the I2RT YAM) do not."""
-    for name in ("carm", "doosan_m0609", "i2rt_yam"):
+    its own reduction) does not; nor an arm solved with a companion whose first plan's candidates are mostly due a
+    polish (the I2RT YAM: ``test_joined_pose``)."""
+    for name in ("carm", "i2rt_yam"):
         assert solving._single_pose(load_robot(name), None) is None
     for name in CLOSED + SWEPT:
         assert isinstance(solving._single_pose(load_robot(name), None), SinglePose)
@@ -164,7 +123,7 @@ def test_settled_solutions_are_the_constructors() -> None:
     a = Solutions.settled(**args, robot=robot)  # type: ignore[arg-type]
     b = Solutions(**args, families=(), robot=robot)  # type: ignore[arg-type]
     assert set(vars(a)) == set(vars(b)) == {f.name for f in dataclasses.fields(Solutions)}
-    _assert_same(a, b)
+    assert_same(a, b)
 
 
 def test_the_default_reduction_named_takes_the_one_call_too(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -173,6 +132,6 @@ def test_the_default_reduction_named_takes_the_one_call_too(monkeypatch: pytest.
     robot = load_robot("ur5")
     T = robot.fk(np.array([0.1, -1.2, 1.3, -0.4, 1.1, 0.3]))
     assert isinstance(solving._single_pose(robot, None, "auto"), SinglePose)
-    _assert_same(sweepik.solve(robot, T, reduction="auto"), sweepik.solve(robot, T))
+    assert_same(sweepik.solve(robot, T, reduction="auto"), sweepik.solve(robot, T))
     carm = load_robot("carm")
     assert solving._single_pose(carm, None, "auto") is None and solving._single_pose(carm, None, "carm-d1") is None

@@ -472,6 +472,17 @@ class Block:
             return self.empty_reason
         return no_solution_reason(int(self.n_reachable[i]))
 
+    def expanded(self, held: HeldJoints | None) -> Block:
+        """This block of the held arm as a block of the full arm (``held``: how it was held; None: itself):
+        configurations full length, families too."""
+        if held is None:
+            return self
+        families = {
+            i: tuple(dataclasses.replace(f, free_joint=held.free[f.free_joint], held=held) for f in fams)
+            for i, fams in self.families.items()
+        }
+        return dataclasses.replace(self, robot=held.robot, q=held.expand(self.q), families=families)
+
     def solutions(self, i: int, copy: bool = True) -> Solutions:
         """The :class:`Solutions` of pose ``i``: arrays copied (the block stays as it is), or views of the block's
         (``copy=False``, for a block made for this one result)."""

@@ -6,7 +6,6 @@ configurations -> FK check against the target -> joint limits -> duplicates remo
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Iterator, Mapping
 from functools import lru_cache
 from typing import Any, Literal, NamedTuple
@@ -18,6 +17,7 @@ from sweepik._jit import writable
 from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
 from sweepik.engine.held_pose import SPECIAL, HeldPose
+from sweepik.engine.joined_pose import JoinedPose
 from sweepik.engine.one_pose import DUE
 from sweepik.engine.paper_sweep import COARSE_STEP_DEG, COARSE_STEP_MM
 from sweepik.engine.settings import N_SAMPLES
@@ -417,21 +417,10 @@ def _held_free_joint(held: HeldJoints, free_joint: object) -> int | str:
     return held.free.index(k)
 
 
-def _expanded(block: Block, held: HeldJoints | None) -> Block:
-    """``block`` of the held arm as a block of the full arm: configurations full length, families too."""
-    if held is None:
-        return block
-    families = {
-        i: tuple(dataclasses.replace(f, free_joint=held.free[f.free_joint], held=held) for f in fams)
-        for i, fams in block.families.items()
-    }
-    return dataclasses.replace(block, robot=held.robot, q=held.expand(block.q), families=families)
-
-
 def _finished(block: Block, held: HeldJoints | None, windings: bool) -> Block:
-    """``block`` of the solved arm as the caller's: full length (``_expanded``), with the 2 pi windings of every
+    """``block`` of the solved arm as the caller's: full length (``Block.expanded``), with the 2 pi windings of every
     solution when asked (``engine.windings``; held joints keep their values)."""
-    out = _expanded(block, held)
+    out = block.expanded(held)
     return wound_block(out, _free_mask(out.robot, held)) if windings else out
 
 
@@ -554,7 +543,7 @@ def _solve_one(
             arm, P, reduction, strategy, limits, n_samples, 1, free_joint, held
         )
     block = solve_chunk(arm, red, P, strategy, limits, n_samples, one_call=one_call)
-    return _expanded(block, held).solutions(0, copy=False)
+    return block.expanded(held).solutions(0, copy=False)
 
 
 def _defaults(robot: object, free_joint: object, strategy: object, limits: object, n_samples: object) -> bool:
@@ -579,7 +568,9 @@ def _default_reduction(robot: Robot, held: HeldJoints | None = None) -> Reductio
     return prepare(robot, np.zeros((0, 4, 4)), None, "precise", True, N_SAMPLES, 1, None, held)[0]
 
 
-def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> SinglePose | HeldAt | TurnedAt | None:
+def _single_pose(
+    robot: Robot, locked: object, reduction: str | None = None
+) -> SinglePose | JoinedPose | HeldAt | TurnedAt | None:
     """``robot``'s default reduction (``reduction``: None, or a name of it) ready for single poses with the default
     options and ``locked`` joints (None: it does not qualify, ``SinglePose.of``, or the arm, ``locked`` or
     ``reduction`` is refused: the general path then raises, after the pose's checks). One joint of a seven-joint arm
@@ -605,7 +596,9 @@ def _single_pose(robot: Robot, locked: object, reduction: str | None = None) -> 
 
 
 @lru_cache(maxsize=16)
-def _reference_pose(robot: Robot, k: int, value: float, reduction: str | None) -> SinglePose | HeldAt | None:
+def _reference_pose(
+    robot: Robot, k: int, value: float, reduction: str | None
+) -> SinglePose | JoinedPose | HeldAt | None:
     """``_single_pose`` of ``robot`` with joint ``k`` held at the reference ``value`` (kept: every value asks)."""
     fast = _single_pose(robot, {k: value}, reduction)
     return None if isinstance(fast, TurnedAt) else fast
@@ -615,7 +608,7 @@ class TurnedAt(NamedTuple):
     """A turned lock (``engine.turned_lock``) solved as a ``SinglePose`` is: the pose turned, solved by the held arm
     at the reference value, its solutions turned back."""
 
-    fast: SinglePose | HeldAt
+    fast: SinglePose | JoinedPose | HeldAt
     turn: TurnedLock
     robot: Robot
 
@@ -649,13 +642,13 @@ def _held_pose(robot: Robot, k: int) -> HeldPose | None:
 
 
 @lru_cache(maxsize=16)
-def _single_pose_of(robot: Robot, held: HeldJoints | None) -> SinglePose | None:
+def _single_pose_of(robot: Robot, held: HeldJoints | None) -> SinglePose | JoinedPose | None:
     arm = robot if held is None else held.arm
     try:
         red = _default_reduction(arm, held)
     except SweepikError:
         return None
-    return SinglePose.of(arm, red, held)
+    return SinglePose.of(arm, red, held) or JoinedPose.of(arm, red, held)
 
 
 def solve(

@@ -128,16 +128,22 @@ def solve_chunk(
     n_samples: int,
     use_fallback: bool = True,
     one_call: bool = True,
+    given: tuple[Block | None, Block | None] = (None, None),
 ) -> Block:
     """The solutions of the chunk ``poses``; ``one_call``: a single pose may take the one compiled call (False: the
     caller found that it cannot). A reduction with a ``companion`` (an arm with a near-structure): both solve, and
-    the companion's solutions that the first lacks are joined (:mod:`.companion`)."""
+    the companion's solutions that the first lacks are joined (:mod:`.companion`). ``given``: the blocks of ``red``
+    and of its companion that the caller's one call settled already (``joined_pose``), None for each to solve here."""
     comp = getattr(red, "companion", None)
+    first, second = given
     try:
-        block = _solve_chunk_by(robot, red, poses, strategy, limits, n_samples, use_fallback, one_call)
+        if first is None:
+            first = _solve_chunk_by(robot, red, poses, strategy, limits, n_samples, use_fallback, one_call)
         if comp is None or strategy != "precise":
-            return block
-        return joined(block, _solve_chunk_by(robot, comp, poses, strategy, limits, n_samples, use_fallback, False))
+            return first
+        if second is None:
+            second = _solve_chunk_by(robot, comp, poses, strategy, limits, n_samples, use_fallback, False)
+        return joined(first, second)
     finally:  # (what the reductions kept for these poses: dropped; most keep nothing, and pay nothing)
         keeping = [r for r in (red, comp) if r is not None and type(r).release is not Reduction.release]
         if keeping:
@@ -463,17 +469,28 @@ def _settled_single(
     out = settled(robot, red, poses, chain, limits, n_samples)
     if out is None:
         return None
+    return one_block(
+        robot, poses, out.q, out.error, out.error_geodesic, out.within_limits, out.multiplicity, out.reachable
+    )
+
+
+def one_block(
+    robot: Robot, poses: Array, q: Array, error: Array, error_geodesic: Array, within_limits: NDArray[np.bool_],
+    multiplicity: NDArray[np.intp], reachable: int,
+) -> Block:  # fmt: skip
+    """The block of the one pose ``poses (1, 4, 4)`` (copied) that the one compiled call settled: its solutions and
+    how many certified configurations it reached."""
     return Block(
         robot=robot,
         poses=poses.copy(),
-        bounds=np.array([0, out.q.shape[0]], dtype=np.intp),
-        q=out.q,
-        error=out.error,
-        error_geodesic=out.error_geodesic,
-        within_limits=out.within_limits,
-        multiplicity=out.multiplicity,
+        bounds=np.array([0, q.shape[0]], dtype=np.intp),
+        q=q,
+        error=error,
+        error_geodesic=error_geodesic,
+        within_limits=within_limits,
+        multiplicity=multiplicity,
         families={},
-        n_reachable=np.array([out.reachable], dtype=np.intp),
+        n_reachable=np.array([reachable], dtype=np.intp),
         empty_reason=None,
     )
 
@@ -483,7 +500,8 @@ def settled(
 ) -> one_pose.Settled | None:
     """One pose's solutions from the one compiled call (``one_pose``); None where the pose needs one of its rarer
     steps (a polish, families, special solutions, a continuum along another joint, the fallback, branches of a
-    closed form that meet) or a second reduction's solutions (a ``companion``)."""
+    closed form that meet) or a second reduction's solutions (a ``companion``: ``joined_pose`` tries both one
+    calls where they settle the arm's poses often)."""
     if getattr(red, "companion", None) is not None:
         return None
     params = red.kernel_params(chain)

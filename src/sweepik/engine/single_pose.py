@@ -51,7 +51,7 @@ from sweepik.reductions.geometric import N_PARAMS, pose_rows
 from sweepik.reductions.kernels import defining_class, lazy_njit
 from sweepik.results import Solutions, no_solution_reason
 
-__all__ = ["SinglePose", "NOT_RIGID", "rigid_pose", "not_rigid", "pose_row", "answer", "swept_settled"]
+__all__ = ["SinglePose", "NOT_RIGID", "rigid_pose", "not_rigid", "pose_row", "answer", "settles", "swept_settled"]
 
 Array = NDArray[np.float64]
 
@@ -183,11 +183,12 @@ class SinglePose:
         self._sweeps = kernel is _swept_pose
 
     @classmethod
-    def of(cls, robot: Robot, red: Reduction, held: HeldJoints | None = None) -> SinglePose | None:
+    def of(cls, robot: Robot, red: Reduction, held: HeldJoints | None = None, alone: bool = False) -> SinglePose | None:
         """``robot`` (with ``held``: the held arm, ``held.arm``) solved by ``red`` this way, or None where ``red``
-        does not qualify (module docstring)."""
+        does not qualify (module docstring); ``alone``: ``red`` without its companion (``joined_pose`` joins
+        them)."""
         rc = type(red)
-        if getattr(red, "companion", None) is not None:
+        if not alone and getattr(red, "companion", None) is not None:
             return None
         for hook in ("special_solutions", "blind_spot"):
             if defining_class(rc, hook) is not Reduction:
@@ -227,23 +228,34 @@ class SinglePose:
         ``solve`` gives them (status ``OK``), or None where the general path must answer, with the status that says
         why (``one_pose``'s, or ``NOT_RIGID``; ``OK`` with more than ``MAX_ISOLATED_SOLUTIONS`` certified). Raises
         ``check_poses``' errors for a target that is not a rigid transform."""
+        return answer(self.call(pose, limits), pose, self.robot, None if self.held is None else self.held.expand)
+
+    def call(self, pose: Array, limits: bool) -> tuple[Any, ...]:
+        """The compiled call's answer for ``pose``: ``(status, certified, reachable, q, error, error_geodesic,
+        within_limits, multiplicity)``, ``q`` the solved arm's (the held arm's, with ``held``)."""
         if self._sweeps:  # (the buffers read here: a test may cut them)
             head, tail = self._head, self._tail
-            out = self._kernel(
+            return self._kernel(
                 pose, *self._frames, *head, *tail[:3], search.MAX_CAND, search.MAX_FAM, *tail[3:], limits
             )
-        else:
-            out = self._kernel(pose, *self._frames, *self._head, *self._tail, limits)
-        return answer(out, pose, self.robot, None if self.held is None else self.held.expand)
+        return self._kernel(pose, *self._frames, *self._head, *self._tail, limits)
+
+
+def settles(out: tuple[Any, ...], pose: Array) -> bool:
+    """Whether a one-pose kernel's ``out`` is the answer (status ``OK``, at most ``MAX_ISOLATED_SOLUTIONS``
+    certified); raises ``check_poses``' errors where ``pose`` is not a rigid transform (``NOT_RIGID``)."""
+    if out[0] == OK and out[1] <= MAX_ISOLATED_SOLUTIONS:
+        return True
+    if out[0] == NOT_RIGID:
+        check_poses(pose)
+    return False
 
 
 def answer(out: tuple[Any, ...], pose: Array, robot: Robot, expand: Any = None) -> tuple[int, Solutions | None]:
     """A one-pose kernel's ``out`` as ``SinglePose.solve`` returns it (``expand``: the held arm's configurations
     made full length)."""
     status, c, reachable, q, ep, eg, ins, mu = out
-    if status != OK or c > MAX_ISOLATED_SOLUTIONS:
-        if status == NOT_RIGID:
-            check_poses(pose)
+    if not settles(out, pose):
         return status, None
     reason = None if q.shape[0] else no_solution_reason(reachable)
     if expand is not None:

@@ -1,0 +1,66 @@
+"""An arm solved with a companion plan, its plans' one calls joined (``engine.joined_pose``): which arms take them,
+and the general path's answer bit for bit, as bundled and rewritten at random, held at a joint too."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from one_call import answered_by_one_call, assert_reproduced, assert_same, configurations, general_path
+from rewrites import rewrite
+
+import sweepik
+from sweepik import load_robot, solving
+from sweepik.engine.joined_pose import JoinedPose
+
+
+def test_which_arms_join_which_one_calls() -> None:
+    """Both one calls where each settles the probes often (the Gen3 lite), the first alone where the companion's
+    candidates are mostly due a polish (the Doosan M0609), neither where the first's are (the I2RT YAM)."""
+    lite, doosan, yam = (
+        solving._single_pose(load_robot(name), None) for name in ("kinova_gen3_lite", "doosan_m0609", "i2rt_yam")
+    )
+    assert isinstance(lite, JoinedPose) and lite.second is not None
+    assert isinstance(doosan, JoinedPose) and doosan.second is None
+    assert yam is None
+
+
+@pytest.mark.parametrize("name", ["kinova_gen3_lite", "doosan_m0609"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_an_arm_with_a_companion_joins_the_one_calls_as_the_general_path(
+    name: str, seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An arm solved with a companion plan (``engine.joined_pose``), as bundled and rewritten at random: each pose's
+    solutions are the general path's bit for bit, limits on and off, most poses answered by the one calls; every
+    solution reproduces the pose and the generating configuration is among them."""
+    robot = load_robot(name)
+    rng = np.random.default_rng(seed)
+    if seed:
+        robot = rewrite(robot, rng).robot
+    q = configurations(robot, rng, 8)
+    answered = 0
+    for qq, T in zip(q, robot.fk(q), strict=True):
+        for limits in (True, False):
+            sol = sweepik.solve(robot, T, limits=limits)
+            assert_same(sol, general_path(monkeypatch, robot, T, limits=limits))
+            answered += answered_by_one_call(robot, T, limits)
+        assert_reproduced(robot, sweepik.solve(robot, T, limits=False), T, qq)
+    assert answered >= len(q)
+
+
+def test_a_held_arm_with_a_companion_joins_the_one_calls_as_the_general_path(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The Gen3 held at joint 3 (a fixed value): its held arm is solved with a companion, both one calls joined; the
+    general path's solutions bit for bit, full length."""
+    robot = load_robot("kinova_gen3")
+    locked = {"joint_3": 0.7}
+    assert isinstance(solving._single_pose(robot, locked), JoinedPose)
+    rng = np.random.default_rng(5)
+    q = configurations(robot, rng, 8)
+    q[:, 2] = 0.7
+    answered = 0
+    for qq, T in zip(q, robot.fk(q), strict=True):
+        for limits in (True, False):
+            sol = sweepik.solve(robot, T, limits=limits, locked=locked)
+            assert_same(sol, general_path(monkeypatch, robot, T, limits=limits, locked=locked))
+            answered += answered_by_one_call(robot, T, limits, locked)
+        assert_reproduced(robot, sweepik.solve(robot, T, limits=False, locked=locked), T, qq)
+    assert answered >= len(q)
