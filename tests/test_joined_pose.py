@@ -14,17 +14,18 @@ from sweepik.engine.joined_pose import JoinedPose
 
 
 def test_which_arms_join_which_one_calls() -> None:
-    """Both one calls where each settles the probes often (the Gen3 lite), the first alone where the companion's
-    candidates are mostly due a polish (the Doosan M0609), neither where the first's are (the I2RT YAM)."""
+    """Both plans' one calls where each answers the probes often, settled or from their candidates (the Gen3 lite;
+    the Doosan M0609, whose companion's candidates are all due a polish); the first alone where the companion is the
+    general method (the I2RT YAM)."""
     lite, doosan, yam = (
         solving._single_pose(load_robot(name), None) for name in ("kinova_gen3_lite", "doosan_m0609", "i2rt_yam")
     )
     assert isinstance(lite, JoinedPose) and lite.second is not None
-    assert isinstance(doosan, JoinedPose) and doosan.second is None
-    assert yam is None
+    assert isinstance(doosan, JoinedPose) and doosan.second is not None
+    assert isinstance(yam, JoinedPose) and yam.second is None
 
 
-@pytest.mark.parametrize("name", ["kinova_gen3_lite", "doosan_m0609"])
+@pytest.mark.parametrize("name", ["kinova_gen3_lite", "doosan_m0609", "i2rt_yam"])
 @pytest.mark.parametrize("seed", [0, 1])
 def test_an_arm_with_a_companion_joins_the_one_calls_as_the_general_path(
     name: str, seed: int, monkeypatch: pytest.MonkeyPatch

@@ -13,6 +13,7 @@ from rewrites import rewrite
 
 import sweepik
 from sweepik import load_robot, solving
+from sweepik.engine import chunk, one_pose, single_pose
 from sweepik.engine.single_pose import SinglePose
 from sweepik.results import Solutions
 
@@ -41,6 +42,34 @@ def test_the_one_call_is_the_general_path_on_arms_written_otherwise(
             answered += answered_by_one_call(robot, T, limits)
         assert_reproduced(robot, sweepik.solve(robot, T, limits=False), T, qq)
     assert answered >= len(q)  # (half of the 2 x 24 solves: the random quarter and more)
+
+
+@pytest.mark.parametrize("name", ["xarm6", "kinova_jaco2"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_pose_due_a_polish_resumes_from_the_calls_candidates(
+    name: str, seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A sweep's pose with a candidate due a polish (status ``DUE``: 2-22 % of random poses of these arms) is not
+    searched again: the rest of the general way takes the call's candidates (``chunk.resumed``), and the answer is
+    the general path's bit for bit, limits on and off."""
+    robot = load_robot(name)
+    rng = np.random.default_rng(seed)
+    if seed:
+        robot = rewrite(robot, rng).robot
+    fast = solving._single_pose(robot, None)
+    assert isinstance(fast, SinglePose)
+    q = rng.uniform(np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi), (150, robot.n_joints))
+    T = np.ascontiguousarray(robot.fk(q))
+    due = [i for i in range(len(T)) if fast.call(T[i], True)[0] == one_pose.DUE][:6]
+    assert due
+    calls = []
+    monkeypatch.setattr(single_pose, "resumed", lambda *a: calls.append(1) or chunk.resumed(*a))
+    for i in due:
+        for limits in (True, False):
+            sol = sweepik.solve(robot, T[i], limits=limits)
+            assert_same(sol, general_path(monkeypatch, robot, T[i], limits=limits))
+        assert_reproduced(robot, sweepik.solve(robot, T[i], limits=False), T[i], q[i])
+    assert len(calls) == 3 * len(due)
 
 
 @pytest.mark.parametrize(("name", "joint"), [("kuka_iiwa14", "A3"), ("franka_panda", "joint7")])
@@ -106,10 +135,8 @@ def test_other_arrays_and_options_take_the_general_path(monkeypatch: pytest.Monk
 
 def test_which_reductions_qualify() -> None:
     """Closed forms and sweeps of a revolute theta* whose checks are compiled qualify; the C-Arm (a prismatic theta*,
-    its own reduction) does not; nor an arm solved with a companion whose first plan's candidates are mostly due a
-    polish (the I2RT YAM: ``test_joined_pose``)."""
-    for name in ("carm", "i2rt_yam"):
-        assert solving._single_pose(load_robot(name), None) is None
+    its own reduction) does not (arms solved with a companion: ``test_joined_pose``)."""
+    assert solving._single_pose(load_robot("carm"), None) is None
     for name in CLOSED + SWEPT:
         assert isinstance(solving._single_pose(load_robot(name), None), SinglePose)
 

@@ -188,20 +188,23 @@ def _solve_chunk_by(
     n_samples: int,
     use_fallback: bool = True,
     one_call: bool = True,
+    found: _Found | None = None,
 ) -> Block:
     """:func:`solve_chunk` with ``red`` alone: the candidates, settled (certified, deduplicated, limits), the meeting
-    branches of a closed form merged, the fallback reduction where this one cannot answer, the families."""
+    branches of a closed form merged, the fallback reduction where this one cannot answer, the families; ``found``:
+    the candidates found already (``resumed``)."""
     chain = chain_poses(robot, poses)  # (one array: the reduction keeps its parameters for it)
-    if len(poses) == 1 and strategy == "precise" and use_fallback and one_call and red.uses_kernel:
-        block = _settled_single(robot, red, poses, chain, limits, n_samples)
-        if block is not None:
-            return block
-    if strategy == "precise" or red.closed_form:
-        found = _precise_candidates(robot, red, poses, chain, strategy, limits, n_samples, use_fallback)
-    else:  # the paper's strategy, swept
-        lo, hi = theta_range(robot, red, chain, paper_limits=limits)
-        pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
-        found = _Found(pose_idx, q, np.ones(pose_idx.size, dtype=np.intp), None, None, {})
+    if found is None:
+        if len(poses) == 1 and strategy == "precise" and use_fallback and one_call and red.uses_kernel:
+            block = _settled_single(robot, red, poses, chain, limits, n_samples)
+            if block is not None:
+                return block
+        if strategy == "precise" or red.closed_form:
+            found = _precise_candidates(robot, red, poses, chain, strategy, limits, n_samples, use_fallback)
+        else:  # the paper's strategy, swept
+            lo, hi = theta_range(robot, red, chain, paper_limits=limits)
+            pose_idx, q = paper_candidates(robot, red, chain, lo, hi, limits)
+            found = _Found(pose_idx, q, np.ones(pose_idx.size, dtype=np.intp), None, None, {})
     pose_idx, q, err_paper, err_geo, mult, inside, keep = _settled_rows(
         robot, red, poses, strategy, limits, n_samples, use_fallback, found
     )
@@ -472,6 +475,20 @@ def _settled_single(
     return one_block(
         robot, poses, out.q, out.error, out.error_geodesic, out.within_limits, out.multiplicity, out.reachable
     )
+
+
+def resumed(
+    robot: Robot, red: Reduction, poses: Array, q: Array, error: Array, error_geodesic: Array,
+    multiplicity: NDArray[np.int64], limits: bool,
+) -> Block:  # fmt: skip
+    """``solve_chunk``'s block of the one pose ``poses (1, 4, 4)`` for ``red`` alone (default options), from the
+    candidates its one call found (``single_pose``'s, for a sweep: status ``DUE``, one of them due a polish or a snap
+    to a limit) without searching again: what ``_precise_candidates`` gives for such a reduction and pose (no special
+    solutions, no families along theta*, no continuum along another joint through a certified candidate: the call
+    checked those), then the rest of the general way. The same values as ``solve_chunk``'s."""
+    pose = np.zeros(q.shape[0], dtype=np.intp)
+    found = _Found(pose, q, multiplicity.astype(np.intp), error_geodesic, error, {})
+    return _solve_chunk_by(robot, red, poses, "precise", limits, N_SAMPLES, found=found)
 
 
 def one_block(

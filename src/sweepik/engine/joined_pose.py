@@ -16,19 +16,17 @@ its plan qualifies (``SinglePose.of``: a general method's companion does not).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.engine.chunk import one_block, solve_chunk
+from sweepik.engine.chunk import solve_chunk
 from sweepik.engine.one_pose import OK
 from sweepik.engine.settings import N_SAMPLES
-from sweepik.engine.single_pose import SinglePose, settles
+from sweepik.engine.single_pose import SinglePose
 from sweepik.model.origin_axis import HeldJoints
 from sweepik.model.robot import Robot
 from sweepik.reductions import Reduction
-from sweepik.results import Block, Solutions
+from sweepik.results import Solutions
 
 __all__ = ["JoinedPose", "PROBES", "SETTLES_OFTEN"]
 
@@ -76,31 +74,24 @@ class JoinedPose:
         """``SinglePose.solve``: the solutions, or None with the first plan's status where it does not settle
         ``pose``."""
         out = self.first.call(pose, limits)
-        if not settles(out, pose):
+        first = self.first.block(pose, out, limits)
+        if first is None:
             return out[0], None
-        poses = pose.reshape(1, 4, 4)
-        first = self._block(poses, out)
-        second = None  # (unless its one call settles the pose, the general way answers for the companion)
+        second = None  # (unless its one call answers the pose, the general way answers for the companion)
         if self.second is not None:
-            out = self.second.call(pose, limits)
-            if settles(out, pose):
-                second = self._block(poses, out)
+            second = self.second.block(pose, self.second.call(pose, limits), limits)
+        poses = pose.reshape(1, 4, 4)
         block = solve_chunk(
             self.arm, self.reduction, poses, "precise", limits, N_SAMPLES, one_call=False, given=(first, second)
         )
         return OK, block.expanded(self.held).solutions(0, copy=False)
 
-    def _block(self, poses: Array, out: tuple[Any, ...]) -> Block:
-        """The block of a settled kernel answer ``out``."""
-        _, _, reachable, q, ep, eg, ins, mu = out
-        return one_block(self.arm, poses, q, ep, eg, ins, mu, reachable)
-
 
 def _settles_often(arm: Robot, fast: SinglePose) -> bool:
-    """Whether ``fast``'s one call settles at least ``SETTLES_OFTEN`` of ``PROBES`` poses of ``arm`` (the solved
-    arm)."""
+    """Whether ``fast``'s one call answers at least ``SETTLES_OFTEN`` of ``PROBES`` poses of ``arm`` (the solved
+    arm), settled or from its candidates (``SinglePose.block``)."""
     rng = np.random.default_rng(0)
     q = rng.uniform(np.maximum(arm.lower, -np.pi), np.minimum(arm.upper, np.pi), (PROBES, arm.n_joints))
     poses = np.ascontiguousarray(arm.fk(q))
-    settled = sum(settles(fast.call(pose, True), pose) for pose in poses)
-    return settled >= SETTLES_OFTEN * PROBES
+    answered = sum(fast.block(pose, fast.call(pose, True), True) is not None for pose in poses)
+    return answered >= SETTLES_OFTEN * PROBES

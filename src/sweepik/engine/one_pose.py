@@ -64,7 +64,8 @@ Array = NDArray[np.float64]
 OK = 0
 #: ... its search needs the general path (family spans, a buffer overflow, a multiple root at a limit of theta*) ...
 SEARCH_ELSEWHERE = 1
-#: ... a candidate is due one of the solver's rarer steps (a polish, a snap to a limit) ...
+#: ... a candidate is due one of the solver's rarer steps (a polish, a snap to a limit; a sweep's call gives its
+#: candidates then: ``searched_settled``) ...
 DUE = 2
 #: ... or a continuum may run along another joint through a certified one (``Reduction.continuum_joints``) ...
 CONTINUUM = 3
@@ -206,7 +207,9 @@ def searched_settled(
     limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
     c_joints, c_thr, only_inside,
 ):  # pragma: no cover  # fmt: skip
-    """Pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``), certified and settled;
+    """Pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``), certified and settled (with
+    status ``DUE``: the candidates instead, ``(DUE, K, 0, q, error, error_geodesic, -, multiplicity)``, each
+    certified, none on a continuum along another joint; the rest of the general way takes them, ``chunk.resumed``);
     ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped to them
     (``chunk._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of the
     continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``only_inside``: the
@@ -250,7 +253,7 @@ def searched_settled(
     )
     if due and status == OK:
         status, c = DUE, 0
-    if status == OK and addr[_A_ROWS] != 0 and K > 0:
+    if (status == OK or status == DUE) and addr[_A_ROWS] != 0 and K > 0:
         free = np.empty(K, dtype=np.int64)
         nt = c_thr.shape[0] - 1
         flagged = _as_continuum(addr[_A_ROWS])(
@@ -258,6 +261,8 @@ def searched_settled(
         )
         if flagged > 0:
             status, c = CONTINUUM, 0
+    if status == DUE:  # (its certified candidates, for the solver's rarer steps: ``chunk.resumed``)
+        return status, K, 0, q, ep, eg, np.empty(0, dtype=np.bool_), mult
     reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
     return status, c, reachable, qf, e_p, e_g, ins, mu
 

@@ -29,9 +29,11 @@ from numpy.typing import NDArray
 from sweepik._jit import inlined, writable
 from sweepik.engine import search
 from sweepik.engine.chain_pose import chain_into
+from sweepik.engine.chunk import one_block, resumed
 from sweepik.engine.dedupe import any_rows_within
 from sweepik.engine.one_pose import (
     _A_SING,
+    DUE,
     MEET,
     OK,
     SETTLE_CLOSED_SIG,
@@ -49,7 +51,7 @@ from sweepik.model.validate import check_poses, rigid_values
 from sweepik.reductions import GeometricReduction, Reduction
 from sweepik.reductions.geometric import N_PARAMS, pose_rows
 from sweepik.reductions.kernels import defining_class, lazy_njit
-from sweepik.results import Solutions, no_solution_reason
+from sweepik.results import Block, Solutions, no_solution_reason
 
 __all__ = ["SinglePose", "NOT_RIGID", "rigid_pose", "not_rigid", "pose_row", "answer", "settles", "swept_settled"]
 
@@ -167,13 +169,16 @@ class SinglePose:
     """One arm's reduction, ready for single poses: its fixed arguments worked out once (``of``), then
     ``solve(pose, limits)`` per pose."""
 
-    __slots__ = ("robot", "held", "_kernel", "_frames", "_head", "_tail", "_sweeps")
+    __slots__ = ("robot", "held", "arm", "reduction", "_kernel", "_frames", "_head", "_tail", "_sweeps")
 
     def __init__(
-        self, arm: Robot, held: HeldJoints | None, kernel: Any, head: tuple[Any, ...], tail: tuple[Any, ...]
-    ) -> None:
+        self, arm: Robot, red: Reduction, held: HeldJoints | None, kernel: Any, head: tuple[Any, ...],
+        tail: tuple[Any, ...],
+    ) -> None:  # fmt: skip
         self.robot = arm if held is None else held.robot  # (the solutions' arm)
         self.held = held
+        self.arm = arm  # (the solved arm: the held arm with ``held``)
+        self.reduction = red
         # (the compiled entry point itself: ``solve`` passes the signature's types, its pose checked by the caller)
         self._kernel = kernel.unchecked
         frames = np.stack([arm.T_base_world, arm.T_tool_flange])
@@ -204,7 +209,7 @@ class SinglePose:
             if closed is None or closed[0][_A_SING] == 0:
                 return None  # (its singular set checked in Python: the general path)
             addr, nb, _, _, tail, s_thr = closed
-            return cls(robot, held, _closed_pose, head, (addr, nb, *tail, s_thr, meet))
+            return cls(robot, red, held, _closed_pose, head, (addr, nb, *tail, s_thr, meet))
         return cls._swept(robot, red, held, head, bounds, reach, meet)
 
     @classmethod
@@ -221,14 +226,33 @@ class SinglePose:
         if fixed is None or fixed.hint_range not in (None, GeometricReduction._range):  # (the circle either way)
             return None
         tail = (*fixed.middle, fixed.limits, float(CLIP_REACH_REL * 2.0 * math.pi), *fixed.tail, meet)
-        return cls(robot, held, _swept_pose, head + fixed.head, tail)
+        return cls(robot, red, held, _swept_pose, head + fixed.head, tail)
 
     def solve(self, pose: Array, limits: bool) -> tuple[int, Solutions | None]:
         """``(status, solutions)``: the solutions of ``pose`` (a C-contiguous, writable float64 ``(4, 4)``) as
         ``solve`` gives them (status ``OK``), or None where the general path must answer, with the status that says
         why (``one_pose``'s, or ``NOT_RIGID``; ``OK`` with more than ``MAX_ISOLATED_SOLUTIONS`` certified). Raises
-        ``check_poses``' errors for a target that is not a rigid transform."""
-        return answer(self.call(pose, limits), pose, self.robot, None if self.held is None else self.held.expand)
+        ``check_poses``' errors for a target that is not a rigid transform. A sweep's pose with a candidate due a
+        polish or a snap to a limit (``DUE``): the rest of the general way from the call's candidates."""
+        out = self.call(pose, limits)
+        if out[0] == DUE and self._sweeps:
+            return OK, self._resumed(pose, out, limits).expanded(self.held).solutions(0, copy=False)
+        return answer(out, pose, self.robot, None if self.held is None else self.held.expand)
+
+    def block(self, pose: Array, out: tuple[Any, ...], limits: bool) -> Block | None:
+        """The solved arm's block of ``pose`` from the call's answer ``out``: settled, or from a sweep's candidates
+        (``DUE``); None where the general way answers. Raises as ``solve`` does."""
+        if out[0] == DUE and self._sweeps:
+            return self._resumed(pose, out, limits)
+        if not settles(out, pose):
+            return None
+        _, _, reachable, q, ep, eg, ins, mu = out
+        return one_block(self.arm, pose.reshape(1, 4, 4), q, ep, eg, ins, mu, reachable)
+
+    def _resumed(self, pose: Array, out: tuple[Any, ...], limits: bool) -> Block:
+        """``block`` from a sweep's candidates (``out``'s status ``DUE``: ``chunk.resumed``)."""
+        _, _, _, q, ep, eg, _, mu = out
+        return resumed(self.arm, self.reduction, pose.reshape(1, 4, 4), q, ep, eg, mu, limits)
 
     def call(self, pose: Array, limits: bool) -> tuple[Any, ...]:
         """The compiled call's answer for ``pose``: ``(status, certified, reachable, q, error, error_geodesic,
