@@ -574,7 +574,8 @@ def _single_pose(
     """``robot``'s default reduction (``reduction``: None, or a name of it) ready for single poses with the default
     options and ``locked`` joints (None: it does not qualify, ``SinglePose.of``, or the arm, ``locked`` or
     ``reduction`` is refused: the general path then raises, after the pose's checks). One joint of a seven-joint arm
-    held: its lock value an argument of the compiled call where the plan allows (``HeldPose``)."""
+    held: its lock value an argument of the compiled call where the plan allows (``HeldPose``). An arm solved with a
+    companion: both plans' one calls (``JoinedPose``; a held arm's at a value asked for before: ``_asked_before``)."""
     held = None
     if locked is not None:
         try:
@@ -592,7 +593,10 @@ def _single_pose(
             return None
     if reduction is not None and not is_default(robot if held is None else held.arm, reduction):
         return None
-    return _single_pose_of(robot, held)
+    single = _single_pose_of(robot, held)
+    if single is None and (held is None or _asked_before(held)):
+        return _joined_pose_of(robot, held)
+    return single
 
 
 @lru_cache(maxsize=16)
@@ -642,13 +646,39 @@ def _held_pose(robot: Robot, k: int) -> HeldPose | None:
 
 
 @lru_cache(maxsize=16)
-def _single_pose_of(robot: Robot, held: HeldJoints | None) -> SinglePose | JoinedPose | None:
-    arm = robot if held is None else held.arm
+def _single_pose_of(robot: Robot, held: HeldJoints | None) -> SinglePose | None:
+    red = _solved_by(robot, held)
+    return None if red is None else SinglePose.of(robot if held is None else held.arm, red, held)
+
+
+@lru_cache(maxsize=16)
+def _joined_pose_of(robot: Robot, held: HeldJoints | None) -> JoinedPose | None:
+    red = _solved_by(robot, held)
+    return None if red is None else JoinedPose.of(robot if held is None else held.arm, red, held)
+
+
+def _solved_by(robot: Robot, held: HeldJoints | None) -> Reduction | None:
+    """The default reduction of ``robot`` (the held arm with ``held``), None where it is refused."""
     try:
-        red = _default_reduction(arm, held)
+        return _default_reduction(robot if held is None else held.arm, held)
     except SweepikError:
         return None
-    return SinglePose.of(arm, red, held) or JoinedPose.of(arm, red, held)
+
+
+#: The held arms ``_single_pose`` was asked for (bounded): an arm solved with a companion has its two plans' one
+#: calls built (``JoinedPose.of``: 3-5 ms on the Kinova Gen3, its probes included) at a value asked for again, not
+#: at each new lock value, where the general way answers sooner.
+_HELD_ASKED: dict[HeldJoints, None] = {}
+
+
+def _asked_before(held: HeldJoints) -> bool:
+    """Whether ``held`` was asked for before (and note that it is now)."""
+    if held in _HELD_ASKED:
+        return True
+    if len(_HELD_ASKED) > 256:
+        _HELD_ASKED.clear()
+    _HELD_ASKED[held] = None
+    return False
 
 
 def solve(
