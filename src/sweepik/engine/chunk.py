@@ -18,7 +18,7 @@ from sweepik.engine.candidates import Candidates, Spans
 from sweepik.engine.chain_pose import chain_poses
 from sweepik.engine.companion import joined
 from sweepik.engine.continuation import continuum_families
-from sweepik.engine.dedupe import any_near, finish, settle
+from sweepik.engine.dedupe import any_near, finish, inside_limits, settle
 from sweepik.engine.families import (
     MAX_ISOLATED_SOLUTIONS,
     collapse_continua,
@@ -613,7 +613,7 @@ def _settle_stepwise(
             eg, ep = errors_of(robot, polished, target, weight)
             # at a singular configuration the step can drift along the near-null space: never out of the limits
             # for a configuration that was inside them and already certified
-            drift = (err_geo[near] <= accept) & robot.within_limits(q[near]) & ~robot.within_limits(polished)
+            drift = (err_geo[near] <= accept) & inside_limits(robot, q[near]) & ~inside_limits(robot, polished)
             take = np.nonzero(~drift)[0]
             q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
             # a sweep's solution next to a fold of the solution set: a valley's bottom, a close partner (a closed form

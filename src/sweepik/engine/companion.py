@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from sweepik.engine.dedupe import DEDUPE_ANGLE, DEDUPE_LENGTH_REL
 from sweepik.engine.settings import MEET_REL
 from sweepik.engine.settle import one_root, per_joint
-from sweepik.results import Block
+from sweepik.results import Block, joint_distance
 
 __all__ = ["joined"]
 
@@ -41,8 +41,7 @@ def joined(first: Block, second: Block) -> Block:
             continue
         b = second.q[b_rows]
         if a.shape[0]:
-            d = b[:, None, :] - a[None, :, :]
-            d = np.abs(np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d))
+            d = joint_distance(robot, b[:, None, :], a[None, :, :])
             new = ~np.any(np.all(d <= tol, axis=-1), axis=1)
             # (one within MEET_REL of the first's may be the same root, to the precision the pose fixes it)
             for k in np.flatnonzero(new & np.any(np.all(d <= near, axis=-1), axis=1)):

@@ -68,7 +68,16 @@ def second_singular(robot: Robot, q: Array, cold: NDArray[np.bool_]) -> Array:
     the crossing search asks for tens of thousands on a batch with families). Each row's rotations start from the
     last row's (neighbouring members of a family: one or two sweeps), but where ``cold``."""
     out = np.empty(q.shape[0])
-    _second_ratios(scaled_jacobians(robot, q), np.ascontiguousarray(cold, dtype=np.bool_), out)
+    _ratios(scaled_jacobians(robot, q), np.ascontiguousarray(cold, dtype=np.bool_), 2, out)
+    return out
+
+
+def least_singular(robot: Robot, q: Array) -> Array:
+    """``(K,)``: the least singular value over the largest of ``scaled_singular``'s Jacobians at ``q (K, n)``,
+    compiled as ``second_singular`` (each row on its own: ~1.5 us a configuration, where NumPy's SVD of a few took
+    ~40 us in all)."""
+    out = np.empty(q.shape[0])
+    _ratios(scaled_jacobians(robot, q), np.ones(q.shape[0], dtype=np.bool_), 1, out)
     return out
 
 
@@ -81,15 +90,16 @@ def scaled_jacobians(robot: Robot, q: Array) -> Array:
     return J
 
 
-@lazy_njit((float64[:, :, ::1], types.boolean[::1], float64[::1]), cache=True, nogil=True)
-def _second_ratios(J, cold, out):  # pragma: no cover
-    """``second_singular``'s kernel."""
+@lazy_njit((float64[:, :, ::1], types.boolean[::1], types.int64, float64[::1]), cache=True, nogil=True)
+def _ratios(J, cold, back, out):  # pragma: no cover
+    """``second_singular``'s and ``least_singular``'s kernel: the ``back``-th singular value from the least (1: the
+    least) over the largest."""
     K, m, n = J.shape
     r = min(m, n)
     B, V, s = np.empty((m, n)), np.empty((n, n)), np.empty(r)
     for k in range(K):  # (warm from the last row, unless cold or its values were NaN)
         singular_values(J[k], B, V, s, k > 0 and not cold[k] and out[k - 1] == out[k - 1])
-        out[k] = s[r - 2] / s[0]
+        out[k] = s[r - back] / s[0]
 
 
 def _singular_along(robot: Robot, q: Array, joint: int) -> NDArray[np.bool_]:

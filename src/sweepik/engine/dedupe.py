@@ -85,6 +85,12 @@ def wrap_inside(robot: Robot, q: Array) -> tuple[Array, NDArray[np.bool_]]:
     return w, inside
 
 
+def inside_limits(robot: Robot, q: Array) -> NDArray[np.bool_]:
+    """``robot.within_limits(q)`` of configurations ``q (K, n)``, the same values in one compiled pass
+    (``wrap_inside``: ~1.4 us where ``Robot.within_limits``' NumPy steps take ~15)."""
+    return wrap_inside(robot, q)[1]
+
+
 def finish(
     robot: Robot,
     pose_idx: NDArray[np.intp],

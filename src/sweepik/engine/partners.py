@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from sweepik.engine.continuation import scaled_singular
+from sweepik.engine.continuation import least_singular, scaled_singular
 from sweepik.engine.families import golden_least
 from sweepik.engine.polish import geodesic_errors, polished
 from sweepik.engine.settings import (
@@ -47,10 +47,7 @@ from sweepik.results import joint_distance
 def nearly_singular(robot: Robot, q: Array) -> NDArray[np.bool_]:
     """``(K,)``: the configurations ``q (K, n)`` whose Jacobian's smallest singular value is at most
     ``PARTNER_SINGULAR`` of its largest (the only ones ``close_partners`` and ``valley_bottoms`` look at)."""
-    if q.shape[0] == 0:
-        return np.zeros(0, dtype=bool)
-    s, _ = scaled_singular(robot, q)
-    return np.asarray(s[:, -1] <= PARTNER_SINGULAR * s[:, 0])
+    return np.asarray(least_singular(robot, q) <= PARTNER_SINGULAR)
 
 
 def close_partners(robot: Robot, q: Array, world: Array, tol: float) -> tuple[IntArray, Array, Array]:

@@ -10,7 +10,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import certify
-from sweepik.engine.dedupe import duplicate_tolerance, finish, merged_multiplicity, near_pairs, wrap_inside
+from sweepik.engine.dedupe import (
+    duplicate_tolerance,
+    finish,
+    inside_limits,
+    merged_multiplicity,
+    near_pairs,
+    wrap_inside,
+)
 from sweepik.engine.families import (
     MAX_ISOLATED_SOLUTIONS,
 )
@@ -87,7 +94,7 @@ def snap_to_limits(
     target = poses[pose_idx[k]]
     moved = polish(robot, start, target, weight, SNAP_ITERATIONS, fixed=held)
     eg, ep = errors_of(robot, moved, target, weight)
-    ok = (eg <= ACCEPT_TOL_REL * robot.length_scale) & robot.within_limits(moved)
+    ok = (eg <= ACCEPT_TOL_REL * robot.length_scale) & inside_limits(robot, moved)
     k = k[ok]
     q[k], err_geo[k], err_paper[k] = moved[ok], eg[ok], ep[ok]
     if k.size:
@@ -250,7 +257,7 @@ def next_to_folds(
     weight = orientation_weight(robot.length_unit)
     q_v, moved = valley_bottoms(robot, q[rows], poses[pose_idx[rows]], accept)
     if moved.any():
-        moved &= robot.within_limits(q_v) | ~robot.within_limits(q[rows])
+        moved &= inside_limits(robot, q_v) | ~inside_limits(robot, q[rows])
         m = rows[moved]
         q[m] = q_v[moved]
         err_geo[m], err_paper[m] = errors_of(robot, q[m], poses[pose_idx[m]], weight)
