@@ -86,9 +86,9 @@ def wrap_inside(robot: Robot, q: Array) -> tuple[Array, NDArray[np.bool_]]:
 
 
 def inside_limits(robot: Robot, q: Array) -> NDArray[np.bool_]:
-    """``robot.within_limits(q)`` of configurations ``q (K, n)``, the same values in one compiled pass
-    (``wrap_inside``: ~1.4 us where ``Robot.within_limits``' NumPy steps take ~15)."""
-    return wrap_inside(robot, q)[1]
+    """``robot.within_limits(q)`` of configurations ``q (..., n)``, the same values in one compiled pass
+    (``wrap_inside``: ~1.4 us for a few where ``Robot.within_limits``' NumPy steps take ~15)."""
+    return wrap_inside(robot, q.reshape(-1, q.shape[-1]))[1].reshape(q.shape[:-1])
 
 
 def finish(

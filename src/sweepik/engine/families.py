@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from sweepik.engine import certify
 from sweepik.engine.candidates import Spans
+from sweepik.engine.dedupe import inside_limits
 from sweepik.engine.settings import (
     ACCEPT_TOL_REL,
     CLUSTER_FAMILY_REL,
@@ -196,7 +197,7 @@ def _members_ok(
     """``theta (K, M)``: members exist, are certified by FK (error <= ``tol``) and (with limits) lie inside the
     limits."""
     ok, qz = _certified(robot, red, chain, world, pose, branch, theta, tol)
-    return np.asarray(ok & robot.within_limits(qz)) if limits else ok
+    return np.asarray(ok & inside_limits(robot, qz)) if limits else ok
 
 
 def _members_excess(
@@ -215,7 +216,7 @@ def _members_excess(
     ok, qz = _certified(robot, red, chain, world, pose, branch, theta, tol)
     if not limits:
         return ok, np.full(qz.shape, np.nan)
-    inside = robot.within_limits(qz)
+    inside = inside_limits(robot, qz)
     over = robot.limit_excess(qz) - robot.limit_tol
     return ok & inside, np.where(ok[..., None], over, np.nan)
 

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine import certify
+from sweepik.engine.dedupe import inside_limits
 from sweepik.engine.settings import COARSE_STEP_DEG, COARSE_STEP_MM, HALF_WIDTH, LEVELS
 from sweepik.model.pose import pose_error_paper
 from sweepik.model.robot import Robot
@@ -29,7 +30,7 @@ def _best_error(robot: Robot, red: Reduction, chain: Array, theta: Array, limits
     T = np.linalg.inv(robot.T_world_base) @ flange  # chain frame, like the target
     J = pose_error_paper(T, chain[:, None, None], orientation_weight(robot.length_unit))
     if limits:
-        ok &= robot.within_limits(qz)
+        ok &= inside_limits(robot, qz)
     return np.where(ok, J, np.inf), q
 
 

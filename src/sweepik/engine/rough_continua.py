@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 from sweepik.engine import search
 from sweepik.engine.candidates import Spans
 from sweepik.engine.continuation import continuum_families, correct
+from sweepik.engine.dedupe import inside_limits
 from sweepik.engine.families import off_families
 from sweepik.engine.polish import geodesic_errors
 from sweepik.engine.settings import FAMILY_MIN_RUN
@@ -87,7 +88,7 @@ def rough_continua(
         mine = np.nonzero(seed_p == i)[0]
         covered[mine] = ~off_families(robot, [(seed_q[mine], tuple(out.get(i, ())))])[0]
     if limits:
-        covered |= ~robot.within_limits(seed_q)
+        covered |= ~inside_limits(robot, seed_q)
     mask = np.zeros(N * M * B, dtype=bool)
     mask[k[k_on[covered]]] = True
     return out, iso_p, iso_q, _stretches(_runs(mask.reshape(N, M, B), theta, lo, hi), theta)
