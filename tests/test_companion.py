@@ -7,8 +7,9 @@ import dataclasses
 
 import numpy as np
 
-from sweepik import load_robot, solve_many
+from sweepik import load_robot, solve, solve_many
 from sweepik.engine.companion import joined
+from sweepik.engine.families import off_families
 from sweepik.reductions import GeometricReduction
 from sweepik.reductions.plan import plans
 from sweepik.results import Block
@@ -54,3 +55,20 @@ def test_joined_is_the_union_without_duplicates() -> None:
             d = np.abs(mine.q - q)
             d = np.minimum(d % (2 * np.pi), -d % (2 * np.pi))
             assert np.sum(np.max(d, axis=1) < 1e-6) == 1
+
+
+def test_a_companion_adds_no_member_of_the_first_answers_families() -> None:
+    """A companion's solution on one of the first answer's families is reported by the family, not as a row. The
+    iiwa held at A5 = -170 deg, a pose with four self-motion families (A2 = A6 = 0): after a value near 0 (whose plan
+    the next values take as their companion: ``reductions.automatic_for_held``) the companion's four isolated
+    solutions, members of those families, were added as rows (6 rows where a fresh process gave 2)."""
+    robot = load_robot("kuka_iiwa14")
+    q = np.array([1.1835548360898351, 0.0, 0.11879735902081068, -1.7997463918365746, -2.9670597283903604, 0.0, 1.26])
+    other = np.array([0.3, 0.5, -0.2, 0.8, 1e-9, 0.6, 0.1])
+    solve(robot, robot.fk(other), locked={"A5": 1e-9})
+    sol = solve(robot, robot.fk(q), locked={"A5": q[4]})
+    assert len(sol.families) == 4 and len(sol) == 2
+    assert off_families(robot, [(sol.q, sol.families)])[0].all()
+    # the pose is reached: by the rows and by the families
+    for s in sol.q:
+        assert np.allclose(robot.fk(s), robot.fk(q), atol=1e-9)

@@ -8,7 +8,8 @@ near-structure is solved by its chosen plan and its **companion** (``decompose.c
 plan sweeping another joint or the other chain), and the two answers are joined pose by pose: a solution of the
 companion is added where the first answer has none within the duplicate tolerance (``dedupe.DEDUPE_ANGLE``,
 ``DEDUPE_LENGTH_REL``), nor one that is the same root to the precision the pose fixes it (``settle.one_root``).
-Families are the first answer's. Arms without a near-structure have no companion and pay nothing.
+Families are the first answer's, and a solution of the companion that is a member of one of them is not added (the
+first's own are reported by their family too). Arms without a near-structure have no companion and pay nothing.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sweepik.engine.dedupe import DEDUPE_ANGLE, DEDUPE_LENGTH_REL
+from sweepik.engine.families import off_families
 from sweepik.engine.settings import MEET_REL
 from sweepik.engine.settle import one_root, per_joint
 from sweepik.results import Block, joint_distance
@@ -40,6 +42,7 @@ def joined(first: Block, second: Block) -> Block:
         if b_rows.size == 0:
             continue
         b = second.q[b_rows]
+        new = np.ones(b_rows.size, dtype=bool)
         if a.shape[0]:
             d = joint_distance(robot, b[:, None, :], a[None, :, :])
             new = ~np.any(np.all(d <= tol, axis=-1), axis=1)
@@ -54,6 +57,10 @@ def joined(first: Block, second: Block) -> Block:
                         mult = mult.copy() if mult is first.multiplicity else mult
                         mult[at] = max(mult[at], second.multiplicity[row], 2)
                         break
+        fams = first.families.get(i)
+        if fams and new.any():  # (a member of the first's families is reported by its family, as the first's own)
+            new[np.flatnonzero(new)[~off_families(robot, [(b[new], tuple(fams))])[0]]] = False
+        if not new.all():
             b_rows = b_rows[new]
         take.append(b_rows)
         counts[i] = b_rows.size
