@@ -72,6 +72,31 @@ def test_a_pose_due_a_polish_resumes_from_the_calls_candidates(
     assert len(calls) == 3 * len(due)
 
 
+@pytest.mark.parametrize(
+    ("name", "seed", "q0"),
+    [
+        ("xarm6", 1005, [-0.80246608601609, 0.71138588657811, -2.52734510425291, -2.53380923469828, 1.86142383934798,
+                         2.87485880270184]),
+        ("doosan_m0609", 1012, [2.76303058512111, 1.35688672768910, -2.62519766853518, 2.07338640588516,
+                                -2.11570463910082, -0.33389360475117]),
+    ],
+)  # fmt: skip
+def test_two_roots_that_meet_outside_the_limits_are_counted_once(
+    name: str, seed: int, q0: list[float], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A pose none of whose solutions lies within the limits, two of them one root (a fold): the one call handed it on
+    only when two solutions within the limits met, and its reason counted the pair twice ("6 solution(s) reach the
+    pose but violate the limits" where the general path says 5). Found by an auditing helper on arms rewritten at
+    random (xarm6 a plain sweep, the M0609 with a companion)."""
+    robot = rewrite(load_robot(name), np.random.default_rng(seed)).robot
+    T = robot.fk(np.array(q0))
+    for limits in (True, False):
+        sol = sweepik.solve(robot, T, limits=limits)
+        assert_same(sol, general_path(monkeypatch, robot, T, limits=limits))
+    assert sweepik.solve(robot, T).reason == general_path(monkeypatch, robot, T).reason
+    assert "violate the limits" in str(sweepik.solve(robot, T).reason)
+
+
 @pytest.mark.parametrize(("name", "joint"), [("kuka_iiwa14", "A3"), ("franka_panda", "joint7")])
 def test_a_locked_arm_at_new_values(name: str, joint: str, monkeypatch: pytest.MonkeyPatch) -> None:
     """A seven-joint arm held at a new value each pose, its held arm built for the value (not ``engine.held_pose``'s

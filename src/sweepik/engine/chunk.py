@@ -18,7 +18,7 @@ from sweepik.engine.candidates import Candidates, Spans
 from sweepik.engine.chain_pose import chain_poses
 from sweepik.engine.companion import joined
 from sweepik.engine.continuation import continuum_families
-from sweepik.engine.dedupe import any_near, finish, inside_limits, settle
+from sweepik.engine.dedupe import finish, inside_limits, settle
 from sweepik.engine.families import (
     MAX_ISOLATED_SOLUTIONS,
     collapse_continua,
@@ -528,13 +528,12 @@ def settled(
     else:
         lo, hi = theta_range(robot, red, chain)
         seed_tol = SEED_TOL_REL * robot.length_scale  # (its continua: checked in the call)
+        meet = per_joint(robot, MEET_REL)  # (two solutions that may be one root: merged stepwise, ``settle.meetings``)
         out = one_pose.settle_one(
-            robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL, seed_tol, limits
+            robot, red, chain, poses, lo, hi, n_samples, params, bounds, reach, CLIP_REACH_REL, seed_tol, meet, limits
         )
     if out is None or out.status != one_pose.OK or out.certified > MAX_ISOLATED_SOLUTIONS:
         return None
-    if not red.closed_form and out.q.shape[0] > 1 and any_near(robot, out.q, per_joint(robot, MEET_REL)):
-        return None  # (two solutions that may be one root: merged stepwise, ``settle.meetings``)
     special, _ = special_solutions(red, chain)
     if special is not None and np.isfinite(special).all(-1).any():
         return None

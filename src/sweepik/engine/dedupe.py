@@ -41,7 +41,6 @@ __all__ = [
     "finish",
     "settle",
     "wrap_inside",
-    "any_near",
     "limit_args",
     "merged_multiplicity",
     "near_pairs",
@@ -218,13 +217,6 @@ def near_pairs(
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))] if pairs.shape[0] > 1 else pairs
 
 
-def any_near(robot: Robot, w: Array, reach: Array) -> bool:
-    """Two rows of one pose's configurations ``w (K, n)`` lie within ``reach (n,)`` of each other, joint by joint
-    (revolute ones modulo 2 pi): ``near_pairs``' question for a single pose, answered in one compiled call (the one
-    compiled call's answer is checked for it on every single pose)."""
-    return bool(_any_within(np.ascontiguousarray(w, dtype=np.float64), limit_args(robot)[0], reach))
-
-
 @lazy_njit((float64[:, ::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean, boolean[::1]), cache=True)
 def _wrap_inside(q, rev, lower, upper, ltol, beyond, inside):  # pragma: no cover
     for k in range(q.shape[0]):
@@ -312,22 +304,6 @@ def _near_compiled(pose, w, keep, rev, reach, out, count):  # pragma: no cover
                     c += 1
         start = stop
     count[0] = c
-
-
-@lazy_njit(boolean(float64[:, ::1], boolean[::1], float64[::1]), cache=True, nogil=True)
-def _any_within(w, rev, reach):  # pragma: no cover
-    """``any_near``'s kernel."""
-    return any_rows_within(w, rev, reach)
-
-
-@inlined
-def any_rows_within(w, rev, reach):  # pragma: no cover
-    """Some two rows of ``w`` within ``reach`` of each other (``_rows_within``)."""
-    for a in range(w.shape[0]):
-        for b in range(a + 1, w.shape[0]):
-            if _rows_within(w, a, b, rev, reach):
-                return True
-    return False
 
 
 @lazy_njit(

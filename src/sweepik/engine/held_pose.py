@@ -241,7 +241,7 @@ def _full(q, k, value):  # pragma: no cover
 
 @lazy_njit(
     (float64[:, ::1],) + _GEOMETRY_SIG + SETTLE_ONE_SIG[:6] + SETTLE_ONE_SIG[11:18] + SETTLE_ONE_SIG[21:22]
-    + SETTLE_ONE_SIG[23:35] + (float64[::1],) + SETTLE_ONE_SIG[35:],
+    + SETTLE_ONE_SIG[23:],
     cache=True,
     nogil=True,
 )  # fmt: skip

@@ -146,6 +146,17 @@ def _branches_meet(c, w, keep, rev, meet):
 
 
 @internal
+def _kept_meet(c, w, keep, rev, meet):
+    """Two of the ``c`` settled candidates that are kept (no duplicate) lie within ``meet`` of each other."""
+    for a in range(c):
+        if keep[a]:
+            for b in range(a + 1, c):
+                if keep[b] and _rows_within(w, a, b, rev, meet):
+                    return True
+    return False
+
+
+@internal
 def _final(c, rows, w, inside, keep, eg, ep, mult, only_inside):
     """The solutions of the ``c`` settled candidates (``_settled``'s): the rows kept (with ``only_inside``, those
     within the limits too), in order, as the solver's block holds them; and how many were kept."""
@@ -178,7 +189,7 @@ SETTLE_ONE_SIG = (
     + (float64[::1], float64[::1], float64[::1], float64[::1], float64[::1], int64[:, ::1], int64, int64)
     + (float64[::1], float64, float64[:, :, ::1], float64[:, ::1], float64[:, ::1], boolean[::1])
     + (float64[:, ::1], float64, float64[::1], boolean[::1], float64[::1], float64[::1], float64[::1], boolean)
-    + (float64[::1], float64[::1], float64, int64[::1], float64[::1], boolean)
+    + (float64[::1], float64[::1], float64, int64[::1], float64[::1], float64[::1], boolean)
 )
 SETTLE_CLOSED_SIG = (
     (int64[::1], float64[:, ::1], float64[:, :, ::1], int64, float64[:, ::1], float64[:, ::1], boolean[::1])
@@ -191,13 +202,13 @@ SETTLE_CLOSED_SIG = (
 def _settle_one(
     addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
     limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
-    c_joints, c_thr, only_inside,
+    c_joints, c_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
     """``settle_one``'s kernel (``searched_settled``)."""
     return searched_settled(
         addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
         limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
-        c_joints, c_thr, only_inside,
+        c_joints, c_thr, meet, only_inside,
     )  # fmt: skip
 
 
@@ -205,15 +216,18 @@ def _settle_one(
 def searched_settled(
     addr, plan, branches, m_branches, steps, noise, params, hlo, hhi, lo, hi, s, ends, twins, max_cand, max_fam,
     limits, clip, world, H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale,
-    c_joints, c_thr, only_inside,
+    c_joints, c_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
     """Pose 0 of ``params``/``world`` searched (one-pass kernel at ``addr[_A_SEARCH]``), certified and settled (with
     status ``DUE``: the candidates instead, ``(DUE, K, 0, q, error, error_geodesic, -, multiplicity)``, each
     certified, none on a continuum along another joint; the rest of the general way takes them, ``chunk.resumed``);
     ``limits``: theta*'s limits, ``clip``: how far outside them a multiple root is clipped to them
     (``chunk._limit_copies``: the general path's); ``c_joints``, ``c_thr``: the joints and thresholds of the
-    continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``only_inside``: the
-    solutions within the limits only (``_final``). Compiled callers only (``settle_one``, ``single_pose``)."""
+    continuum check (``addr[_A_ROWS]``, unless 0), the seed tolerance after the thresholds; ``MEET`` where two of
+    the certified solutions (within the limits or not) lie within ``meet`` of each other (per joint, revolute ones
+    modulo 2 pi: the general way merges them, ``settle.meetings``, and counts them once in ``reachable``);
+    ``only_inside``: the solutions within the limits only (``_final``). Compiled callers only (``settle_one``,
+    ``single_pose``)."""
     # (np.empty and explicit loops: np.zeros, slice copies and the like each add to the first compilation)
     n = rev.shape[0]
     out_t = np.empty((1, max_cand))
@@ -263,6 +277,8 @@ def searched_settled(
             status, c = CONTINUUM, 0
     if status == DUE:  # (its certified candidates, for the solver's rarer steps: ``chunk.resumed``)
         return status, K, 0, q, ep, eg, np.empty(0, dtype=np.bool_), mult
+    if status == OK and _kept_meet(c, w, keep, lrev, meet):
+        status, c = MEET, 0
     reachable, qf, e_p, e_g, ins, mu = _final(c, rows, w, inside, keep, eg, ep, mult, only_inside)
     return status, c, reachable, qf, e_p, e_g, ins, mu
 
@@ -417,6 +433,7 @@ def settle_one(
     reach: Array,
     clip_rel: float,
     seed_tol: float,
+    meet: Array,
     only_inside: bool,
 ) -> Settled | None:
     """The one pose of ``chain``/``world (1, 4, 4)`` searched over ``[lo, hi]`` (``(1,)`` each), certified and settled
@@ -424,7 +441,8 @@ def settle_one(
     search for ``n_samples``. ``thresholds`` and ``reach``: ``dedupe.settle``'s; ``clip_rel``: the
     reach (relative to ``hi - lo``) within which a multiple root outside theta*'s limits is clipped to them;
     ``seed_tol``: the pose error within which a candidate is checked for a continuum (``continuum_joints``);
-    ``only_inside``: the solutions within the joint limits only (the solver's ``limits``)."""
+    ``meet``: the reach per joint within which two solutions may be one root (``MEET``); ``only_inside``: the
+    solutions within the joint limits only (the solver's ``limits``)."""
     fixed = sweep_fixed(robot, red, n_samples, thresholds, reach, seed_tol)
     if fixed is None:
         return None
@@ -435,7 +453,7 @@ def settle_one(
     buffers = (search.MAX_CAND, search.MAX_FAM)  # (read here: a test may cut them)
     status, c, reachable, q, ep, eg, inside, mult = _settle_one(
         *fixed.head, p, hlo, hhi, lo, hi, *fixed.middle, *buffers, fixed.limits, clip, writable(world), *fixed.tail,
-        bool(only_inside),
+        writable(meet), bool(only_inside),
     )  # fmt: skip
     return Settled(status, c, reachable, q, ep, eg, inside, mult, _NONE, _NO_BRANCH, _NONE)
 

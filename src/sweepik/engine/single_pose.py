@@ -30,11 +30,9 @@ from sweepik._jit import inlined, writable
 from sweepik.engine import search
 from sweepik.engine.chain_pose import chain_into
 from sweepik.engine.chunk import one_block, resumed
-from sweepik.engine.dedupe import any_rows_within
 from sweepik.engine.one_pose import (
     _A_SING,
     DUE,
-    MEET,
     OK,
     SETTLE_CLOSED_SIG,
     SETTLE_ONE_SIG,
@@ -123,8 +121,7 @@ def _closed_pose(
 
 
 @lazy_njit(
-    _TARGET_SIG + _ROW_SIG + SETTLE_ONE_SIG[:6] + SETTLE_ONE_SIG[11:18] + SETTLE_ONE_SIG[19:35] + (float64[::1],)
-    + SETTLE_ONE_SIG[35:],
+    _TARGET_SIG + _ROW_SIG + SETTLE_ONE_SIG[:6] + SETTLE_ONE_SIG[11:18] + SETTLE_ONE_SIG[19:],
     cache=True,
     nogil=True,
 )  # fmt: skip
@@ -134,8 +131,7 @@ def _swept_pose(
     ltol, beyond, reach, tol, scale, c_joints, c_thr, meet, only_inside,
 ):  # pragma: no cover  # fmt: skip
     """A sweep's target (as ``_closed_pose``) searched over the circle, certified and settled (``searched_settled``'s
-    arguments); ``MEET`` where two of its solutions lie within ``meet`` (``dedupe.any_near``: the general path merges
-    them)."""
+    arguments)."""
     if not rigid_pose(world):
         return not_rigid(rev.shape[0])
     params = pose_row(chained(world, frames, has_base, has_tool), base, tool, reverse, r_end, w_tool, row)
@@ -155,14 +151,11 @@ def swept_settled(
     """``_swept_pose`` once the target is checked and its row ``params (1, N_PARAMS)`` built."""
     lo, hi = np.empty(1), np.empty(1)
     lo[0], hi[0] = -math.pi, math.pi
-    st, c, reachable, q, ep, eg, ins, mu = searched_settled(
+    return searched_settled(
         addr, plan, branches, m_branches, steps, noise, params, lo, hi, lo, hi, s, ends, twins, max_cand, max_fam,
         limits, clip, world.reshape((1, 4, 4)), H, P, rev, R_end, weight, thr, lrev, lower, upper, ltol, beyond, reach,
-        tol, scale, c_joints, c_thr, only_inside,
+        tol, scale, c_joints, c_thr, meet, only_inside,
     )  # fmt: skip
-    if st == OK and q.shape[0] > 1 and any_rows_within(q, lrev, meet):
-        st = MEET
-    return st, c, reachable, q, ep, eg, ins, mu
 
 
 class SinglePose:
