@@ -68,3 +68,22 @@ def test_a_held_arm_with_a_companion_joins_the_one_calls_as_the_general_path(mon
             answered += answered_by_one_call(robot, T, limits, locked)
         assert_reproduced(robot, sweepik.solve(robot, T, limits=False, locked=locked), T, qq)
     assert answered >= len(q)
+
+
+def test_a_turned_lock_whose_reference_has_a_companion_joins_at_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The Gen3's first joint held (a turned lock: every value solved by the held arm at one reference value,
+    ``engine.turned_lock``): its reference held arm has a companion, and every value asks for it, so its one calls
+    are joined at the first value asked for; the general path's solutions bit for bit at new values."""
+    robot = load_robot("kinova_gen3")
+    monkeypatch.setattr(solving, "_HELD_ASKED", {})
+    solving._reference_pose.cache_clear()
+    rng = np.random.default_rng(9)
+    q = configurations(robot, rng, 6)
+    for qq, T in zip(q, robot.fk(q), strict=True):
+        locked = {"joint_1": float(qq[0])}
+        fast = solving._single_pose(robot, locked)
+        assert isinstance(fast, solving.TurnedAt) and isinstance(fast.fast, JoinedPose)
+        for limits in (True, False):
+            sol = sweepik.solve(robot, T, limits=limits, locked=locked)
+            assert_same(sol, general_path(monkeypatch, robot, T, limits=limits, locked=locked))
+        assert_reproduced(robot, sweepik.solve(robot, T, limits=False, locked=locked), T, qq)

@@ -569,13 +569,14 @@ def _default_reduction(robot: Robot, held: HeldJoints | None = None) -> Reductio
 
 
 def _single_pose(
-    robot: Robot, locked: object, reduction: str | None = None
+    robot: Robot, locked: object, reduction: str | None = None, reused: bool = False
 ) -> SinglePose | JoinedPose | HeldAt | TurnedAt | None:
     """``robot``'s default reduction (``reduction``: None, or a name of it) ready for single poses with the default
     options and ``locked`` joints (None: it does not qualify, ``SinglePose.of``, or the arm, ``locked`` or
     ``reduction`` is refused: the general path then raises, after the pose's checks). One joint of a seven-joint arm
     held: its lock value an argument of the compiled call where the plan allows (``HeldPose``). An arm solved with a
-    companion: both plans' one calls (``JoinedPose``; a held arm's at a value asked for before: ``_asked_before``)."""
+    companion: both plans' one calls (``JoinedPose``; a held arm's at a value asked for before, ``_asked_before``, or
+    ``reused``: a value every pose asks for, a turned lock's reference)."""
     held = None
     if locked is not None:
         try:
@@ -594,7 +595,7 @@ def _single_pose(
     if reduction is not None and not is_default(robot if held is None else held.arm, reduction):
         return None
     single = _single_pose_of(robot, held)
-    if single is None and (held is None or _asked_before(held)):
+    if single is None and (held is None or reused or _asked_before(held)):
         return _joined_pose_of(robot, held)
     return single
 
@@ -604,7 +605,7 @@ def _reference_pose(
     robot: Robot, k: int, value: float, reduction: str | None
 ) -> SinglePose | JoinedPose | HeldAt | None:
     """``_single_pose`` of ``robot`` with joint ``k`` held at the reference ``value`` (kept: every value asks)."""
-    fast = _single_pose(robot, {k: value}, reduction)
+    fast = _single_pose(robot, {k: value}, reduction, reused=True)
     return None if isinstance(fast, TurnedAt) else fast
 
 

@@ -4,13 +4,13 @@ Such an arm is solved by its chosen plan and a companion plan, their answers joi
 for both (``chunk.solve_chunk``): ~330 us on the Kinova Gen3 lite and ~550 on the Doosan M0609, where ssik takes
 ~410 and a plan's compiled call 50-130. Here:
 
-* the chosen plan's one call (``single_pose``) answers first; where it does not settle the pose, the general way
-  answers all of it, as before;
-* where it does, the companion's one call answers next, or else the general way for the companion alone;
+* the chosen plan's one call (``single_pose``) answers first, settled or from its candidates (a pose due a polish:
+  ``chunk.resumed``); where it hands the pose on, the general way answers all of it, as before;
+* where it answers, the companion's one call answers next, or else the general way for the companion alone;
 * and the two are joined as ``solve_chunk`` joins them: the same answer to the bit, since each one call's answer is
   its plan's general answer (``tests/test_single_pose.py``).
 
-A plan's one call is tried only where it settles at least half of the poses it is probed on (``PROBES``), and where
+A plan's one call is tried only where it answers at least half of the poses it is probed on (``PROBES``), and where
 its plan qualifies (``SinglePose.of``: a general method's companion does not).
 """
 
@@ -32,10 +32,12 @@ __all__ = ["JoinedPose", "PROBES", "SETTLES_OFTEN"]
 
 Array = NDArray[np.float64]
 
-#: How many poses of random configurations within the limits (a fixed seed) probe whether a plan's one call settles
-#: often enough to be tried first: ``SETTLES_OFTEN`` of them. A plan that is an exact structure near the arm's has
-#: most candidates due a polish (the Doosan M0609's companion, the AgileX Piper's: 0 and 1 of 40 poses settled; the
-#: I2RT YAM's chosen plan: 17 of 40), and its one call (~50-190 us) is then mostly paid on top of the general way.
+#: How many poses of random configurations within the limits (a fixed seed) probe whether a plan's one call answers
+#: often enough to be tried first (settled, or from its candidates: ``SinglePose.block``): ``SETTLES_OFTEN`` of them.
+#: A call that hands most poses on (a search that needs the general path, families, roots that meet) would be paid on
+#: top of the general way's answer. Every plan of the bundled and ssik's companion arms passes since a call's
+#: candidates are taken on; before, the M0609's and the Piper's companions settled 0 and 1 of 40 poses, the I2RT
+#: YAM's chosen plan 17.
 PROBES = 16
 SETTLES_OFTEN = 0.5
 
@@ -59,8 +61,8 @@ class JoinedPose:
     @classmethod
     def of(cls, robot: Robot, red: Reduction, held: HeldJoints | None = None) -> JoinedPose | None:
         """``robot`` (the held arm with ``held``) solved by ``red`` and its companion this way; None where ``red``
-        has no companion, does not qualify alone (``SinglePose.of``) or settles too few of the poses it is probed on
-        (``PROBES``: each pose it does not settle pays its one call on top of the general way's answer)."""
+        has no companion, does not qualify alone (``SinglePose.of``) or answers too few of the poses it is probed on
+        (``PROBES``: each pose it hands on pays its one call on top of the general way's answer)."""
         comp = getattr(red, "companion", None)
         if comp is None:
             return None
@@ -71,8 +73,8 @@ class JoinedPose:
         return cls(robot, red, held, first, second if second is not None and _settles_often(robot, second) else None)
 
     def solve(self, pose: Array, limits: bool) -> tuple[int, Solutions | None]:
-        """``SinglePose.solve``: the solutions, or None with the first plan's status where it does not settle
-        ``pose``."""
+        """``SinglePose.solve``: the solutions, or None with the first plan's status where its call hands ``pose``
+        on (the general way answers for both plans)."""
         out = self.first.call(pose, limits)
         first = self.first.block(pose, out, limits)
         if first is None:
