@@ -9,6 +9,7 @@ import pytest
 import sweepik
 from sweepik import load_robot
 from sweepik.engine import chunk, search
+from sweepik.reductions import geometric
 
 
 def _pair_reductions() -> list[sweepik.reductions.GeometricReduction]:
@@ -45,7 +46,7 @@ def test_pair_family_all_branch_kernels_are_bitwise_the_one_branch_kernels(
     ck = red._case_kernels
     branches, margins, amplitudes = red.search_branches, red._steps[0], red._steps[1]
     assert branches and search._kernel_residuals(red) is ck.pair_residuals
-    out = np.full(max(3, red.n_branches), np.nan)
+    out = np.full(max(geometric.SWING_STEPS, red.n_branches), np.nan)
     every = red.edge_search().every != 0
     assert every == (red.n_branches == 4 and {b // 2 for b in branches} == {0, 1})  # (both first-step branches)
     shared = np.full(red.n_branches + 3, np.nan)

@@ -373,3 +373,31 @@ def test_a_domain_edge_hidden_between_two_samples_is_searched() -> None:
     lo, hi = np.array([-np.pi]), np.array([np.pi])
     for cand in (search.search(red, chain, lo, hi, 64)[0], sweep.find_candidates(red, chain, lo, hi, 64)[0]):
         assert np.any((cand.branch == 3) & (np.abs(cand.theta - q[0]) < 1e-9))
+
+
+def test_a_double_root_where_the_last_joint_swings_is_searched() -> None:
+    """The CRX-10iA rewritten at random (``tests/rewrites.py``, seed 1001), at an exactly singular configuration (an
+    isolated double root: axes 2 and 5 in line): joint 2, the one its ``ab_par`` case turns last, swings by pi
+    within 1.3e-4 of theta* where the wrist centre passes 2e-5 from its axis. Branch 3's residual touches zero there,
+    2.6e-4 from a simple root with a maximum between them, all in one interval the bend test left alone: only the
+    simple root was bracketed, and the configuration was missed (found by an auditing helper). The swing hints now
+    sample the windows of the final step's gap too (``geometric.SWING_STEPS``): the compiled search and its NumPy
+    reference find the root, and the solve gives the configuration back."""
+    from rewrites import rewrite
+    from singular import recovered
+
+    from sweepik.engine.chunk import chain_poses
+
+    robot = rewrite(load_robot("fanuc_crx10ia"), np.random.default_rng(1001)).robot
+    q = np.array([0.46033568027046856, 0.4304670839774083, 0.24395417189640398, -2.2633087173669666,
+                  2.0769880108359935, 0.5162850825294347])  # fmt: skip
+    T = robot.fk(q)
+    sols = sweepik.solve(robot, T, limits=False)
+    assert np.abs(robot.fk(sols.q) - T).max() < 1e-9 * robot.length_scale
+    # (a double root: given once, multiplicity 2, 3e-6 from q along the direction the pose fixes only to second order)
+    near = np.max(joint_distance(robot, sols.q, q), axis=1) < 1e-5
+    assert recovered(robot, sols, q) and np.count_nonzero(near) == 1 and sols.multiplicity[near][0] == 2
+    red = sweepik.solving._default_reduction(robot, None)
+    chain, lo, hi = chain_poses(robot, T[None]), np.array([-np.pi]), np.array([np.pi])
+    for cand in (search.search(red, chain, lo, hi, 64)[0], sweep.find_candidates(red, chain, lo, hi, 64)[0]):
+        assert np.any((cand.branch == 3) & (np.abs(cand.theta - q[0]) < 1e-6))

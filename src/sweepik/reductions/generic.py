@@ -143,15 +143,15 @@ class GeometricReduction(Reduction):
 
     @cached_property
     def _steps(self) -> tuple[list[int], list[int]]:
-        """The margins and the amplitudes (``pair_margin``, ``amplitude`` of ``geometric.case_kernels``: k = 0, 1, 2)
-        worth sweeping:
-        not constant (a step with one solution, or a circle that always meets its plane) and not the twin of an
-        earlier one."""
+        """The margins and the amplitudes (``pair_margin``, ``amplitude`` of ``geometric.case_kernels``: k = 0, 1, 2;
+        then the final step's gaps, k = 3 ... 6) worth sweeping: not constant (a step with one solution, or a circle
+        that always meets its plane; no final step, or a slide) and not the twin of an earlier one."""
         m = self._probe(self._case_kernels.pair_margin, 3)
-        a = self._probe(self._case_kernels.amplitude, 3)
+        a = self._probe(self._case_kernels.amplitude, 7)
         margins = [c[0] for c in _classes(m) if not np.all(m[..., c[0]] == 1.0)]
-        amplitudes = [c[0] for c in _classes(a) if not np.all(np.isinf(a[..., c[0]]))]
-        return margins, amplitudes
+        steps = [c[0] for c in _classes(a[..., :3]) if not np.all(np.isinf(a[..., c[0]]))]
+        gaps = [3 + c[0] for c in _classes(a[..., 3:]) if np.isfinite(a[..., 3 + c[0]]).any()]
+        return margins, steps + gaps
 
     @cached_property
     def _step_scales(self) -> Array:

@@ -438,7 +438,10 @@ SWING_LOCATE = 0.01
 #: Only minima below this times the rise to the next sample are located (a window narrower than the grid step
 #: has r* < |r'| h, while the rise is at most |r'| h).
 SWING_DEPTH = 2.0
-SWING_PER_POSE = 3 * SWING_MINIMA * (SWING_SAMPLES + 1)
+#: The amplitudes a swing can be looked for in: the position case's steps (k = 0, 1, 2) and the final step's gap on
+#: each position branch (k = 3 ... 6: the joint it turns swings where ``W`` passes next to its axis).
+SWING_STEPS = 7
+SWING_PER_POSE = SWING_STEPS * SWING_MINIMA * (SWING_SAMPLES + 1)
 
 
 def _swing(amp, amps, params, lo, hi, n, periodic, ks, out, start, stop):
@@ -447,8 +450,8 @@ def _swing(amp, amps, params, lo, hi, n, periodic, ks, out, start, stop):
     amplitude links the whole position case), ``amps`` every step's at once (``amplitudes``, for the scan's samples);
     one function rather than a loop calling a per-pose one, for the same reason."""
     amp, amps = as_residual(amp), as_residuals(amps)
-    scan = np.empty((n + 3, 3))  # the amplitudes at lo - h, lo, lo + h, ..., lo + (n + 1) h
-    vals = np.empty(3)
+    scan = np.empty((n + 3, SWING_STEPS))  # the amplitudes at lo - h, lo, lo + h, ..., lo + (n + 1) h
+    vals = np.empty(SWING_STEPS)
     for i in range(start, stop):
         g = (math.sqrt(5.0) - 1.0) / 2.0
         p = params[i]
@@ -456,7 +459,7 @@ def _swing(amp, amps, params, lo, hi, n, periodic, ks, out, start, stop):
         cnt = 0
         for j in range(n + 3 if ks.shape[0] > 0 else 0):
             amps(p, lo[i] - h if j == 0 else (lo[i] if j == 1 else lo[i] + (j - 1) * h), vals)
-            for m in range(3):
+            for m in range(SWING_STEPS):
                 scan[j, m] = vals[m]
         for k in ks:
             found = 0
@@ -830,16 +833,20 @@ def _step_kernels(case: int, free: int, rev: tuple[bool, ...]) -> tuple[Any, ...
         return arm[5]
 
     def amplitudes(p, x, out):
-        """``amplitude`` of the steps wanted (``LAYOUT['need_amplitude']``: bit k for step k) at once."""
+        """``amplitude`` of the steps wanted (``LAYOUT['need_amplitude']``: bit k for step k, k >= 3 the final
+        step's gaps) at once, into ``out (SWING_STEPS,)``."""
         need = int(p[_NEED_AMPLITUDE])
-        neither = NEITHER + 0 * need
-        if need & 3:
-            arm = _arm(p, x, 0 * need, neither, case, free, rev)
-            out[0] = arm[4]
-            out[1] = arm[5]
-        if need & 4:
-            arm = _arm(p, x, 1 + 0 * need, neither, case, free, rev)
+        neither, both = NEITHER + 0 * need, BOTH + 0 * need
+        if need & 27:  # (steps 0, 1; the gaps of position branches 0, 1)
+            arm = _arm(p, x, 0 * need, both if need & 24 else neither, case, free, rev)
+            out[0], out[1] = arm[4], arm[5]
+            if need & 24:
+                out[3], out[4] = arm[6], arm[7]
+        if need & 100:  # (step 2; the gaps of position branches 2, 3)
+            arm = _arm(p, x, 1 + 0 * need, both if need & 96 else neither, case, free, rev)
             out[2] = arm[5]
+            if need & 96:
+                out[5], out[6] = arm[6], arm[7]
 
     return configuration, margin, margins, amplitude, amplitudes
 
