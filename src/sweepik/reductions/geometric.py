@@ -509,8 +509,9 @@ def _swing(amp, amps, params, lo, hi, n, periodic, ks, out, start, stop):
 
 def swing_hints(params, lo, hi, n, periodic, ks, out, amplitude, amplitudes):
     """Samples of theta* ``out (N, SWING_PER_POSE)`` (NaN-padded) where a step of the position case is nearly
-    degenerate: around each local minimum ``r*`` of its amplitude ``r(theta*)`` narrower than the grid step
-    ``h``, where its angles turn by up to pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
+    degenerate, or the wrist centre passes next to the axis of the joint it turns last: around each local minimum
+    ``r*`` of the amplitude (or gap) ``r(theta*)`` narrower than the grid step ``h``, where the angle turns by up to
+    pi within ``w = r* / |r'|``. ``ks``: the amplitudes to examine (see
     ``amplitude`` of ``case_kernels``: the arm's kernel, given as ``amplitude``, with ``amplitudes`` its all-step
     kernel, which must compute at least the steps ``ks``). Batches use both cores, as the engine's search."""
     parallel.run(
