@@ -26,7 +26,7 @@ def configurations(robot: sweepik.Robot, rng: np.random.Generator, n: int = 24) 
 def general_path(monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, T: np.ndarray, **kw: Any) -> Solutions:
     """``solve`` without the one call (neither ``single_pose``'s, ``joined_pose``'s nor ``chunk.settled``)."""
     with monkeypatch.context() as m:
-        m.setattr(solving, "_single_pose", lambda *args: None)
+        m.setattr(solving, "_single_pose", lambda *args, **kwargs: None)
         m.setattr(solving, "settled", lambda *args: None)
         m.setattr(chunk, "settled", lambda *args: None)
         return sweepik.solve(robot, T, **kw)
@@ -60,3 +60,19 @@ def assert_reproduced(robot: sweepik.Robot, sol: Solutions, T: np.ndarray, qq: n
     d = np.abs(sol.q - qq)
     d[:, robot.is_revolute] = np.abs(np.angle(np.exp(1j * d[:, robot.is_revolute])))
     assert sol.families or (len(sol) and np.min(np.max(d, axis=1)) < 1e-6)
+
+
+def answered_as_the_general_path(
+    monkeypatch: pytest.MonkeyPatch, robot: sweepik.Robot, q: np.ndarray, locked: Any = None
+) -> int:
+    """For each configuration of ``q``, its pose solved with limits on and off: the general path's solutions bit
+    for bit, every solution reaching the pose and the configuration among them (``assert_reproduced``). Returns how
+    many of the ``2 len(q)`` solves the one call answered."""
+    answered = 0
+    for qq, T in zip(q, robot.fk(q), strict=True):
+        for limits in (True, False):
+            sol = sweepik.solve(robot, T, limits=limits, locked=locked)
+            assert_same(sol, general_path(monkeypatch, robot, T, limits=limits, locked=locked))
+            answered += answered_by_one_call(robot, T, limits, locked)
+        assert_reproduced(robot, sweepik.solve(robot, T, limits=False, locked=locked), T, qq)
+    return answered

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from one_call import answered_by_one_call, assert_reproduced, assert_same, configurations, general_path
+from one_call import answered_as_the_general_path, assert_reproduced, assert_same, configurations, general_path
 from rewrites import rewrite
 
 import sweepik
@@ -38,14 +38,7 @@ def test_an_arm_with_a_companion_joins_the_one_calls_as_the_general_path(
     if seed:
         robot = rewrite(robot, rng).robot
     q = configurations(robot, rng, 8)
-    answered = 0
-    for qq, T in zip(q, robot.fk(q), strict=True):
-        for limits in (True, False):
-            sol = sweepik.solve(robot, T, limits=limits)
-            assert_same(sol, general_path(monkeypatch, robot, T, limits=limits))
-            answered += answered_by_one_call(robot, T, limits)
-        assert_reproduced(robot, sweepik.solve(robot, T, limits=False), T, qq)
-    assert answered >= len(q)
+    assert answered_as_the_general_path(monkeypatch, robot, q) >= len(q)
 
 
 def test_a_held_arm_with_a_companion_joins_the_one_calls_as_the_general_path(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -60,14 +53,7 @@ def test_a_held_arm_with_a_companion_joins_the_one_calls_as_the_general_path(mon
     rng = np.random.default_rng(5)
     q = configurations(robot, rng, 8)
     q[:, 2] = 0.7
-    answered = 0
-    for qq, T in zip(q, robot.fk(q), strict=True):
-        for limits in (True, False):
-            sol = sweepik.solve(robot, T, limits=limits, locked=locked)
-            assert_same(sol, general_path(monkeypatch, robot, T, limits=limits, locked=locked))
-            answered += answered_by_one_call(robot, T, limits, locked)
-        assert_reproduced(robot, sweepik.solve(robot, T, limits=False, locked=locked), T, qq)
-    assert answered >= len(q)
+    assert answered_as_the_general_path(monkeypatch, robot, q, locked) >= len(q)
 
 
 def test_a_turned_lock_whose_reference_has_a_companion_joins_at_once(monkeypatch: pytest.MonkeyPatch) -> None:
