@@ -1,5 +1,6 @@
-"""Helpers of the tests of the one compiled call (``test_single_pose``, ``test_joined_pose``): configurations that
-probe singular sets, ``solve`` without the one call, the comparison bit for bit."""
+"""Helpers of the tests of the one compiled call (``test_single_pose``, ``test_joined_pose``, ``test_held_pose``,
+``test_held_joined``): configurations that probe singular sets, ``solve`` without the one call, the comparison bit for
+bit or to rounding."""
 
 from __future__ import annotations
 
@@ -76,3 +77,24 @@ def answered_as_the_general_path(
             answered += answered_by_one_call(robot, T, limits, locked)
         assert_reproduced(robot, sweepik.solve(robot, T, limits=False, locked=locked), T, qq)
     return answered
+
+
+def held_general(robot: sweepik.Robot, T: np.ndarray, k: int, value: float) -> Solutions:
+    """The held arm of ``robot`` with joint ``k`` at ``value`` solved the general way (its own plan, no one call)."""
+    return solving._solve_one(robot, T[None], None, "precise", True, solving.N_SAMPLES, None, {k: value}, False)
+
+
+def same_to_rounding(a: Solutions, b: Solutions, robot: sweepik.Robot) -> None:
+    """``a`` and ``b`` hold as many solutions, the same configurations to rounding, and the same reason."""
+    assert len(a) == len(b)
+    if len(a):
+        d = np.sort(a.q, axis=0) - np.sort(b.q, axis=0)
+        assert np.abs(d).max() < 1e-8 * max(1.0, robot.length_scale)
+    assert a.reason == b.reason
+
+
+def fk_ok(robot: sweepik.Robot, sol: Solutions, T: np.ndarray) -> None:
+    """Every solution of ``sol`` reaches ``T`` to 1e-9 (times the length scale)."""
+    F = robot.fk(sol.q)
+    assert np.abs(F[..., :3, 3] - T[:3, 3]).max(initial=0.0) < 1e-9 * robot.length_scale
+    assert np.abs(F[..., :3, :3] - T[:3, :3]).max(initial=0.0) < 1e-9

@@ -72,3 +72,18 @@ def test_a_companion_adds_no_member_of_the_first_answers_families() -> None:
     # the pose is reached: by the rows and by the families
     for s in sol.q:
         assert np.allclose(robot.fk(s), robot.fk(q), atol=1e-9)
+
+
+def test_without_the_solved_arm_two_near_solutions_are_handed_on() -> None:
+    """``meetings=False`` (blocks of another arm than the solved one, ``engine.held_joined``): a companion's solution
+    within ``MEET_REL`` of one of the first's but not its duplicate may be the same root, which only the solved arm
+    settles: None; a duplicate is left out as ever."""
+    robot = load_robot("puma560")
+    (block,) = solve_many(robot, robot.fk(np.array([[0.3, -0.4, 0.5, 0.6, 0.7, 0.8]])), limits=False).blocks
+    near, same = block.q.copy(), block.q.copy()
+    near[0, 0] += 1e-4  # (within MEET_REL, past the duplicate tolerance)
+    same[:, 0] += 1e-8
+    assert joined(block, dataclasses.replace(block, q=near), meetings=False) is None
+    assert joined(block, dataclasses.replace(block, q=near)) is not None
+    both = joined(block, dataclasses.replace(block, q=same), meetings=False)
+    assert both is not None and both.q.shape == block.q.shape

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from one_call import fk_ok, held_general, same_to_rounding
 from oracles import in_limit_configurations, recovers
 from rewrites import rewrite
 
@@ -22,7 +23,6 @@ from sweepik.engine.held_pose import HeldPose
 from sweepik.engine.lock_windows import in_windows
 from sweepik.engine.one_pose import OK
 from sweepik.reductions import first_held_reduction
-from sweepik.results import Solutions
 
 #: (arm, joint) of the bundled seven-joint arms whose held arm is one closed form at every value.
 TAKEN = [
@@ -40,25 +40,6 @@ TAKEN = [
 SWEPT = [("franka_panda", "joint1"), ("franka_panda", "joint3"), ("kinova_gen3", "joint_5"), ("kinova_gen3", "joint_7")]
 
 
-def _general(robot: sweepik.Robot, T: np.ndarray, k: int, value: float) -> Solutions:
-    """The held arm at ``value`` solved the general way (its own plan, no one call)."""
-    return solving._solve_one(robot, T[None], None, "precise", True, solving.N_SAMPLES, None, {k: value}, False)
-
-
-def _same(a: Solutions, b: Solutions, robot: sweepik.Robot) -> None:
-    assert len(a) == len(b)
-    if len(a):
-        d = np.sort(a.q, axis=0) - np.sort(b.q, axis=0)
-        assert np.abs(d).max() < 1e-8 * max(1.0, robot.length_scale)
-    assert a.reason == b.reason
-
-
-def _fk_ok(robot: sweepik.Robot, sol: Solutions, T: np.ndarray) -> None:
-    F = robot.fk(sol.q)
-    assert np.abs(F[..., :3, 3] - T[:3, 3]).max(initial=0.0) < 1e-9 * robot.length_scale
-    assert np.abs(F[..., :3, :3] - T[:3, :3]).max(initial=0.0) < 1e-9
-
-
 @pytest.mark.parametrize(("name", "joint"), TAKEN + SWEPT)
 def test_the_one_call_is_the_held_arm_at_each_value(name: str, joint: str) -> None:
     """Random values and poses: the one call answers (most poses) with the held arm's own solutions."""
@@ -73,8 +54,8 @@ def test_the_one_call_is_the_held_arm_at_each_value(name: str, joint: str) -> No
         if sol is None:
             continue
         answered += 1
-        _same(sol, _general(robot, T, k, float(qq[k])), robot)
-        _fk_ok(robot, sol, T)
+        same_to_rounding(sol, held_general(robot, T, k, float(qq[k])), robot)
+        fk_ok(robot, sol, T)
         assert np.all(sol.q[:, k] == qq[k]) and recovers(robot, sol, qq)
     assert answered >= 10
 
@@ -99,8 +80,8 @@ def test_arms_written_otherwise(name: str, joint: str, seed: int) -> None:
         q2 = rw.forward(qq)
         T = robot.fk(q2)
         sol = sweepik.solve(robot, T, locked={joint: float(q2[k])})
-        _same(sol, _general(robot, T, k, float(q2[k])), robot)
-        _fk_ok(robot, sol, T)
+        same_to_rounding(sol, held_general(robot, T, k, float(q2[k])), robot)
+        fk_ok(robot, sol, T)
         assert recovers(robot, sol, q2)
 
 
@@ -125,7 +106,7 @@ def test_values_where_axes_line_up_and_singular_wrists(name: str, joint: str) ->
                 q[rows, j] = 0.0
         for qq, T in zip(q, robot.fk(q), strict=True):
             sol = sweepik.solve(robot, T, locked={joint: float(v)})
-            _fk_ok(robot, sol, T)
+            fk_ok(robot, sol, T)
             assert np.all(sol.q[:, k] == v) and recovers(robot, sol, qq)
 
 
@@ -192,11 +173,11 @@ def test_arms_whose_plan_is_not_one_closed_form_at_every_value_are_not_taken() -
         held = sweepik.model.origin_axis.hold_joints(iiwa, {2: v})
         red = solving._default_reduction(held.arm, held)
         found.append((v, red, sweepik.engine.single_pose.SinglePose.of(held.arm, red, held)))
-    assert HeldPose._checked(iiwa, 2, found) is not None
+    assert HeldPose.from_references(iiwa, 2, found) is not None
     other = sweepik.model.origin_axis.hold_joints(iiwa, {4: 0.5})
     red = solving._default_reduction(other.arm, other)
     found[2] = (found[2][0], red, sweepik.engine.single_pose.SinglePose.of(other.arm, red, other))
-    assert HeldPose._checked(iiwa, 2, found) is None
+    assert HeldPose.from_references(iiwa, 2, found) is None
 
 
 @pytest.mark.parametrize(("name", "joint"), [("franka_panda", "joint6"), ("kuka_iiwa14", "A3")])
@@ -221,8 +202,8 @@ def test_values_just_outside_the_windows_are_the_held_arm(name: str, joint: str)
             status, sol = fast.solve(np.ascontiguousarray(T), float(v), True)
             if sol is not None:
                 answered += 1
-                _same(sol, _general(robot, T, k, float(v)), robot)
-                _fk_ok(robot, sol, T)
+                same_to_rounding(sol, held_general(robot, T, k, float(v)), robot)
+                fk_ok(robot, sol, T)
             assert recovers(robot, sweepik.solve(robot, T, locked={joint: float(v)}), qq)
     assert answered >= 1  # (the others, badly conditioned there, went the general way)
 
@@ -306,7 +287,7 @@ def test_the_general_way_builds_the_vouched_plan_as_it_would_find_it(name: str, 
     values = [v for v in rng.uniform(lo, hi, 25) if not fast.special(v)]
     for v in values:
         arm = sweepik.model.origin_axis.hold_joints(robot, {k: float(v)}).arm
-        assert _vouched(robot, (k,), arm, (float(v),)) == first_plan(arm)
+        assert _vouched(robot, (k,), arm, (float(v),)) == (first_plan(arm), None)
     for v in fast.windows[np.isfinite(fast.windows)]:
         if robot.lower[k] <= v <= robot.upper[k]:
             arm = sweepik.model.origin_axis.hold_joints(robot, {k: float(v)}).arm

@@ -42,12 +42,14 @@ def test_an_arm_with_a_companion_joins_the_one_calls_as_the_general_path(
 
 
 def test_a_held_arm_with_a_companion_joins_the_one_calls_as_the_general_path(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The Gen3 held at joint 3 (a fixed value): its held arm is solved with a companion, both one calls joined once
-    the value is asked for again (not at a value asked for once: building them costs more than the general way);
-    the general path's solutions bit for bit, full length."""
+    """The Gen3 held at joint 3 (a fixed value), where its two plans' calls do not take the value (``HeldJoined``,
+    left out here): its held arm is solved with a companion, both one calls joined once the value is asked for again
+    (not at a value asked for once: building them costs more than the general way); the general path's solutions
+    bit for bit, full length."""
     robot = load_robot("kinova_gen3")
     locked = {"joint_3": 0.7}
     monkeypatch.setattr(solving, "_HELD_ASKED", {})  # (whatever other tests asked before)
+    monkeypatch.setattr(solving, "_held_joined", lambda robot, k: None)
     assert solving._single_pose(robot, locked) is None
     assert isinstance(solving._single_pose(robot, locked), JoinedPose)
     rng = np.random.default_rng(5)

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from sweepik._jit import writable
 from sweepik.engine import parallel, search
 from sweepik.engine.chunk import chain_poses, settled, solve_chunk, theta_range
+from sweepik.engine.held_joined import HeldJoined
 from sweepik.engine.held_pose import SPECIAL, HeldPose
 from sweepik.engine.joined_pose import JoinedPose
 from sweepik.engine.one_pose import DUE
@@ -29,7 +30,14 @@ from sweepik.model.origin_axis import HeldJoints, held_values, hold_joints, lock
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit
 from sweepik.model.validate import as_float_array, check_bool, check_choice, check_int, check_poses, short_repr
-from sweepik.reductions import Reduction, automatic_for_held, first_held_reduction, get_reduction, is_default
+from sweepik.reductions import (
+    Reduction,
+    automatic_for_held,
+    first_held_reduction,
+    get_reduction,
+    held_pair,
+    is_default,
+)
 from sweepik.reductions.decompose import not_sweepable
 from sweepik.results import Block, SolutionBatch, Solutions, no_solution_reason
 
@@ -150,7 +158,7 @@ def _segments(runs: list[tuple[int, int, object]], fast: bool) -> list[tuple[int
 
 
 def _held_blocks(
-    robot: Robot, P: Array, fast: tuple[HeldPose, Array], options: dict[str, Any], s: int, e: int
+    robot: Robot, P: Array, fast: tuple[HeldPose | HeldJoined, Array], options: dict[str, Any], s: int, e: int
 ) -> list[Block]:
     """The blocks of poses ``s .. e - 1`` of ``P`` from ``fast``'s compiled call, each pose at its own lock value; a
     pose it does not settle by its held arm (``_held_run``)."""
@@ -213,9 +221,9 @@ def _turned_run(
 
 def _held_values(
     robot: Robot, P: Array, runs: list[tuple[int, int, object]], options: dict[str, Any], windings: bool
-) -> tuple[HeldPose, Array] | None:
-    """With the default options and one joint of a seven-joint arm held, the ``HeldPose`` that takes its value as an
-    argument and each pose's value; else None."""
+) -> tuple[HeldPose | HeldJoined, Array] | None:
+    """With the default options and one joint of a seven-joint arm held, the ``HeldPose`` (or ``HeldJoined``) that
+    takes its value as an argument and each pose's value; else None."""
     reduction = options["reduction"]
     if not (
         runs
@@ -465,7 +473,7 @@ def _iter_held(
     robot: Robot,
     P: Array,
     runs: list[tuple[int, int, object]],
-    fast: tuple[HeldPose, Array] | None,
+    fast: tuple[HeldPose | HeldJoined, Array] | None,
     first: Prepared | None,
     options: dict[str, Any],
     progress: Progress | None,
@@ -574,9 +582,10 @@ def _single_pose(
     """``robot``'s default reduction (``reduction``: None, or a name of it) ready for single poses with the default
     options and ``locked`` joints (None: it does not qualify, ``SinglePose.of``, or the arm, ``locked`` or
     ``reduction`` is refused: the general path then raises, after the pose's checks). One joint of a seven-joint arm
-    held: its lock value an argument of the compiled call where the plan allows (``HeldPose``). An arm solved with a
-    companion: both plans' one calls (``JoinedPose``; a held arm's at a value asked for before, ``_asked_before``, or
-    ``reused``: a value every pose asks for, a turned lock's reference)."""
+    held: its lock value an argument of the compiled call where the plan allows (``HeldPose``; the first or last
+    joint: ``TurnedAt``; both plans' calls of a held arm with a near-structure: ``HeldJoined``). An arm solved with
+    a companion: both plans' one calls (``JoinedPose``; a held arm's at a value asked for before, ``_asked_before``,
+    or ``reused``: a value every pose asks for, a turned lock's reference)."""
     held = None
     if locked is not None:
         try:
@@ -589,6 +598,9 @@ def _single_pose(
                 if turn is not None:  # (the held arm at the reference value, once for every value)
                     ref = _reference_pose(robot, turn.joint, turn.reference, reduction)
                     return None if ref is None else TurnedAt(ref, turn, robot)
+                joined = _held_joined(robot, k)
+                if joined is not None and (reduction is None or is_default(joined.arm, reduction)):
+                    return HeldAt(joined, v)
             held = held_joints(robot, locked)
         except (SweepikError, TypeError):  # (an unhashable value: the general path says what is wrong)
             return None
@@ -630,9 +642,9 @@ class TurnedAt(NamedTuple):
 
 
 class HeldAt(NamedTuple):
-    """A ``HeldPose`` at one lock value, solved as a ``SinglePose`` is."""
+    """A ``HeldPose`` (or ``HeldJoined``) at one lock value, solved as a ``SinglePose`` is."""
 
-    held: HeldPose
+    held: HeldPose | HeldJoined
     value: float
 
     def solve(self, pose: Array, limits: bool) -> tuple[int, Solutions | None]:
@@ -644,6 +656,15 @@ def _held_pose(robot: Robot, k: int) -> HeldPose | None:
     """``robot`` with joint ``k`` held, its lock value an argument (None: its plan changes with the value, or is not
     a closed form or sweep of ``SinglePose``: ``HeldPose.of``)."""
     return HeldPose.of(robot, k, first_held_reduction)
+
+
+@lru_cache(maxsize=16)
+def _held_joined(robot: Robot, k: int) -> HeldJoined | None:
+    """``robot`` with joint ``k`` held, both plans' calls taking the value (None: no companion, or its plans change
+    with the value: ``HeldJoined.of``). Built at the first value asked for (~0.2-0.4 s on the Kinova Gen3: every plan
+    checked at one value, as the first value's own choice would, and the pair at four more), so that every value
+    outside its windows is solved by the same pair, whatever was solved before."""
+    return HeldJoined.of(robot, k, held_pair)
 
 
 @lru_cache(maxsize=16)

@@ -143,7 +143,9 @@ def solve_chunk(
             return first
         if second is None:
             second = _solve_chunk_by(robot, comp, poses, strategy, limits, n_samples, use_fallback, False)
-        return joined(first, second)
+        both = joined(first, second)
+        assert both is not None  # (settled on the solved arm: every pair of near solutions)
+        return both
     finally:  # (what the reductions kept for these poses: dropped; most keep nothing, and pay nothing)
         keeping = [r for r in (red, comp) if r is not None and type(r).release is not Reduction.release]
         if keeping:

@@ -28,8 +28,11 @@ from sweepik.results import Block, joint_distance
 __all__ = ["joined"]
 
 
-def joined(first: Block, second: Block) -> Block:
-    """``first`` with the solutions of ``second`` (the same poses) that it lacks added, pose by pose."""
+def joined(first: Block, second: Block, meetings: bool = True) -> Block | None:
+    """``first`` with the solutions of ``second`` (the same poses) that it lacks added, pose by pose. ``meetings``
+    False: None where a solution of ``second`` lies within ``MEET_REL`` of one of ``first`` but not within the
+    duplicate tolerance (whether they are one root is settled on the solved arm, ``settle.one_root``: the caller's
+    blocks are of another arm, the full arm of a held one, ``engine.held_joined``)."""
     robot = first.robot
     tol = np.where(robot.is_revolute, DEDUPE_ANGLE, DEDUPE_LENGTH_REL * robot.length_scale)
     near = per_joint(robot, MEET_REL)
@@ -48,6 +51,8 @@ def joined(first: Block, second: Block) -> Block:
             new = ~np.any(np.all(d <= tol, axis=-1), axis=1)
             # (one within MEET_REL of the first's may be the same root, to the precision the pose fixes it)
             for k in np.flatnonzero(new & np.any(np.all(d <= near, axis=-1), axis=1)):
+                if not meetings:
+                    return None
                 row = b_rows[k]
                 for j in np.flatnonzero(np.all(d[k] <= near, axis=-1)):
                     at = first.bounds[i] + j

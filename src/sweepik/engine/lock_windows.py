@@ -10,7 +10,9 @@ none: two axes on one line). ``special_windows`` finds those values once per arm
    twice ``NEAR_TOL`` of parallel (the sine of their angle changes at most as fast as the value), or the neighbours
    of ``k`` within twice ``NEAR_TOL`` (times the length scale) of meeting, unless the relation holds at every value;
 2. at each flagged value the held arm's own checks (``structure.near_structure``, ``structure.structure_of``) decide:
-   a near-structure, or a structure other than at the other values, marks it;
+   a near-structure or a structure other than at the reference value marks it (a held arm with a near-structure at
+   every value, of joints on one side of ``k``, such as the Kinova Gen3's nearly spherical wrist: one that differs
+   from it, or from the size it has there, ``held_joined``);
 3. where an axis before ``k`` turns perpendicular to one after it (a blind spot of some plans), the plan the held
    arm chooses there (``plan_at``) must be the one of other values, else that value is marked;
 
@@ -83,12 +85,13 @@ def special_windows(
         if np.nanmax(d) >= INTERSECT_TOL_REL:
             flag |= d < 2.0 * NEAR_TOL
     near = np.convolve(flag, np.ones(5), mode="same") > 0  # (and the two values either side)
-    generic = _relations(structure_of(chain_at(reference), scale))
+    at_reference = chain_at(reference)
+    generic, nearly = _relations(structure_of(at_reference, scale)), near_structure(at_reference, scale)
     plan = plan_at(reference)
     marked = np.zeros(grid.size, dtype=bool)
     for g in np.nonzero(near)[0]:
         held = chain_at(float(grid[g]))
-        if near_structure(held, scale) or _relations(structure_of(held, scale)) != generic:
+        if near_structure(held, scale) != nearly or _relations(structure_of(held, scale)) != generic:
             marked[g] = True
     windows = _runs(grid, np.convolve(marked, np.ones(5), mode="same") > 0)
     for v in _perpendicular(H, hk, k, n):

@@ -26,7 +26,17 @@ from sweepik.reductions.plan import (
     plans,
 )
 
-__all__ = ["FEWER_POLISHED", "plans", "choose", "choice", "cheapest", "companion_plan", "explain", "set_plan_check"]
+__all__ = [
+    "FEWER_POLISHED",
+    "plans",
+    "choose",
+    "choice",
+    "cheapest",
+    "companion_plan",
+    "explain",
+    "passes_check",
+    "set_plan_check",
+]
 
 
 def continuum_everywhere(robot: Robot) -> str | None:
@@ -159,6 +169,12 @@ def set_plan_check(check: Callable[..., Any] | None) -> None:
     global _plan_check
     _plan_check = check
     choice.cache_clear()
+
+
+def passes_check(robot: Robot, plan: Plan) -> bool:
+    """Whether ``plan`` gives back every configuration of the registered check's short form on ``robot`` (the check
+    a hint of :func:`choice` passes; True where no check is registered)."""
+    return _plan_check is None or _plan_check(robot, (plan,), (plan,), hints_only=True) is not None
 
 
 def choose(robot: Robot, free_joint: int | None = None) -> Plan:
