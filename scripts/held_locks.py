@@ -1,16 +1,17 @@
-"""Which locks of the seven-joint arms take their value as an argument of one compiled call (``engine.held_pose``),
-and whether that call gives the held arm's own solutions (issue 39).
+"""Which locks of the seven-joint arms take their value as an argument of one compiled call (``engine.held_pose``;
+or of two, a plan's and its companion's, where the held arm has a near-structure: ``engine.held_joined``), and
+whether those calls give the held arm's own solutions (issue 39).
 
     python scripts/held_locks.py [--n 15] [--ssik] [--rewrite] [--only gen3 panda] [--turned]
 
 For every seven-joint arm (the bundled ones; ``--ssik``: ssik 8.2's catalogue too, ``tests/catalogue.py``) and each
-revolute joint: whether ``HeldPose`` takes it (a closed form or a sweep at every value), then ``--n`` random poses at
-random values: the one call's solutions (where it settles the pose) against the held arm built at the value and
-solved the general way (same count, configurations to 1e-8 of the arm's size), and the generating configuration
-recovered by ``solve``. ``--rewrite``: each arm rewritten at random too (axis signs, zeros, frames, units:
-``tests/rewrites.py``). Prints a line per taken lock and the totals. ``--turned``: instead, the first and last joints
-of every arm (``engine.turned_lock``: every value solved by the held arm at one reference value, the pose turned):
-``solve``'s solutions at random values against the held arm built at the value, and recovered.
+revolute joint: whether ``HeldPose`` takes it (a closed form or a sweep at every value; else ``HeldJoined``: "joined"),
+then ``--n`` random poses at random values: the calls' solutions (where they settle the pose) against the held arm
+built at the value and solved the general way (same count, configurations to 1e-8 of the arm's size), and the
+generating configuration recovered by ``solve``. ``--rewrite``: each arm rewritten at random too (axis signs, zeros,
+frames, units: ``tests/rewrites.py``). Prints a line per taken lock and the totals. ``--turned``: instead, the first
+and last joints of every arm (``engine.turned_lock``: every value solved by the held arm at one reference value, the
+pose turned): ``solve``'s solutions at random values against the held arm built at the value, and recovered.
 """
 
 from __future__ import annotations
@@ -42,13 +43,16 @@ def _differs(a: sweepik.Solutions, b: sweepik.Solutions, robot: sweepik.Robot) -
 
 
 def check_arm(robot: sweepik.Robot, n: int, rng: np.random.Generator) -> tuple[int, int, int, int, int]:
-    """``(locks, taken, poses answered by the one call, differing, not recovered)`` of one arm."""
+    """``(locks, taken or joined, poses answered by the one call, differing, not recovered)`` of one arm."""
     locks = taken = answered = differ = missed = 0
     for k in range(7):
         if not robot.is_revolute[k]:
             continue
         locks += 1
         fast = solving._held_pose(robot, k)
+        kind = "taken"
+        if fast is None and k not in (0, 6):  # (the first and last: ``--turned``)
+            fast, kind = solving._held_joined(robot, k), "joined"
         if fast is None:
             continue
         taken += 1
@@ -67,7 +71,7 @@ def check_arm(robot: sweepik.Robot, n: int, rng: np.random.Generator) -> tuple[i
                 missed += 1
                 print(f"    not recovered: joint {robot.joint_names[k]} at {v!r}, q = {qq.tolist()}")
         answered += mine
-        print(f"  {robot.name} {robot.joint_names[k]}: taken, {mine}/{n} answered by the one call", flush=True)
+        print(f"  {robot.name} {robot.joint_names[k]}: {kind}, {mine}/{n} answered by the one call", flush=True)
     return locks, taken, answered, differ, missed
 
 

@@ -8,7 +8,8 @@ none: two axes on one line). ``special_windows`` finds those values once per arm
 
 1. a grid of one turn, ``NEAR_TOL / 4`` apart, flags each value where an axis before ``k`` and one after it are within
    twice ``NEAR_TOL`` of parallel (the sine of their angle changes at most as fast as the value), or the neighbours
-   of ``k`` within twice ``NEAR_TOL`` (times the length scale) of meeting, unless the relation holds at every value;
+   of ``k`` within twice ``NEAR_TOL`` (times the length scale) of meeting, unless the relation holds at every value
+   (the neighbours: or nearly meet at every value, by the same distance, ``SAME_DISTANCE_REL``);
 2. at each flagged value the held arm's own checks (``structure.near_structure``, ``structure.structure_of``) decide:
    a near-structure or a structure other than at the reference value marks it (a held arm with a near-structure at
    every value, of joints on one side of ``k``, such as the Kinova Gen3's nearly spherical wrist: one that differs
@@ -45,6 +46,10 @@ Array = NDArray[np.float64]
 
 #: The grid's step (radians): a quarter of the near-structure tolerance.
 GRID_STEP = NEAR_TOL / 4.0
+#: Neighbours of the held joint that nearly meet at every value where they are not parallel, at distances within this
+#: fraction of one another, are one near-structure at every value and are not flagged (the Kinova Gen3 held at joint
+#: 6: its axes 5 and 7 3.1e-4 of its size apart at every value; every value of the grid was checked, ~10 s).
+SAME_DISTANCE_REL = 1e-3
 #: A value marked for its plan alone (step 3) is taken within this of it.
 EXACT_WINDOW = 1e-6
 
@@ -82,7 +87,9 @@ def special_windows(
         with np.errstate(all="ignore"):
             d = np.abs(np.einsum("ij,ij->i", pb - pts[a], nrm)) / sn / scale
         d = np.where(sn < NEAR_TOL, 0.0, d)  # (nearly parallel: flagged above)
-        if np.nanmax(d) >= INTERSECT_TOL_REL:
+        apart = d[sn >= NEAR_TOL]
+        same = apart.size > 0 and np.ptp(apart) <= SAME_DISTANCE_REL * np.max(apart) and np.max(apart) < NEAR_TOL
+        if np.nanmax(d) >= INTERSECT_TOL_REL and not same:
             flag |= d < 2.0 * NEAR_TOL
     near = np.convolve(flag, np.ones(5), mode="same") > 0  # (and the two values either side)
     at_reference = chain_at(reference)
