@@ -17,7 +17,7 @@ from oracles import recovers
 from rewrites import rotation
 
 import sweepik
-from sweepik import load_robot, solve
+from sweepik import SearchOverflowError, load_robot, plan_check, solve
 from sweepik.io.robot_file import bundled_robots
 from sweepik.model.origin_axis import origin_axis_form
 from sweepik.model.structure import NEAR_TOL, PARALLEL_TOL, near_structure
@@ -148,3 +148,36 @@ def test_a_near_structure_arm_takes_the_plan_that_needs_no_polish() -> None:
     companion = decompose.companion_plan(robot)
     assert companion is not None and companion.free_joint == 0
     assert "Newton steps on the fewest" in sweepik.analyze(robot)["why"]
+
+
+def test_a_plan_whose_search_overflows_fails_its_check(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A plan whose sweep crosses zero more often on a configuration of the check than the search holds
+    (``SearchOverflowError``: a Kinova Gen3 rewritten at random, held at joint 3 at -pi, raised ``RuntimeError``
+    from the automatic choice) gives back none of them: the choice takes another plan."""
+    robot = load_robot("puma560")
+    plan = next(p for p in decompose.plans(robot) if not p.closed_form)
+    check_plan.cache_clear()
+
+    def overflows(*args: object, **kwargs: object) -> None:
+        raise SearchOverflowError("the search of 'x' found more than 1 candidates")
+
+    monkeypatch.setattr(plan_check, "solve_many", overflows)
+    check = check_plan(robot, plan, 8)
+    check_plan.cache_clear()
+    assert (check.recovered, check.checked, check.passed) == (0, 8, False)
+
+
+def test_the_search_says_when_it_overflows(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Buffers too small for a pose even when grown: a ``SearchOverflowError`` (a ``SweepikError``) naming the
+    search (here its margins'), not a bare ``RuntimeError``."""
+    from sweepik.engine import chunk, search
+
+    robot = load_robot("fanuc_crx10ia")
+    red = sweepik.reductions.get_reduction(robot, None)
+    chain = chunk.chain_poses(robot, robot.fk(np.random.default_rng(2).uniform(robot.lower, robot.upper, (3, 6))))
+    lo, hi = chunk.theta_range(robot, red, chain)
+    monkeypatch.setattr(search, "MAX_CAND", 1)
+    monkeypatch.setattr(search, "REDO_MAX_CAND", 1)
+    with pytest.raises(SearchOverflowError, match="the search of 'margins' found more than 1 candidates"):
+        search.search(red, chain, lo, hi, 64)
+    assert issubclass(SearchOverflowError, sweepik.SweepikError)

@@ -20,6 +20,7 @@ from sweepik.errors import (
     PoseFileError,
     RobotDefinitionError,
     RobotFileError,
+    SearchOverflowError,
     ShapeError,
     StoreError,
     SweepikError,
@@ -169,5 +170,6 @@ __all__ = [
     "PoseFileError",
     "LockedJointError",
     "NoReductionError",
+    "SearchOverflowError",
     "StoreError",
 ]

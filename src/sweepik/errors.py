@@ -4,7 +4,7 @@ Grouped by area:
 
 - the model (robots, robot files, URDF, MJCF, catalogues): :class:`RobotDefinitionError`, :class:`RobotFileError`,
   :class:`UrdfError`, :class:`MjcfError`, :class:`UnknownRobotError`;
-- the decomposition: :class:`NoReductionError`;
+- the decomposition: :class:`NoReductionError`, :class:`SearchOverflowError`;
 - input to a call (arrays, poses, options, files of poses, locked joints): :class:`ShapeError`,
   :class:`NonFiniteError`, :class:`InvalidPoseError`, :class:`UnknownOptionError`, :class:`LockedJointError`,
   :class:`PoseFileError`;
@@ -26,6 +26,7 @@ __all__ = [
     "UnknownOptionError",
     "PoseFileError",
     "NoReductionError",
+    "SearchOverflowError",
     "LockedJointError",
     "StoreError",
 ]
@@ -100,6 +101,12 @@ class LockedJointError(UnknownOptionError):
 class NoReductionError(SweepikError):
     """No decomposition in sweepik's catalogue solves this arm (or not with the joint asked for as theta*); the
     message names the structure found and what a decomposition would need."""
+
+
+class SearchOverflowError(SweepikError, RuntimeError):
+    """A sweep's residual crosses zero more often along theta* on a pose than the search holds (millions of
+    candidates): the decomposition cannot answer that pose (a continuum its tests do not see); the message names it.
+    The automatic choice counts such a plan as failing its check."""
 
 
 # the solution store

@@ -28,6 +28,7 @@ from functools import lru_cache
 import numpy as np
 
 from sweepik.engine.chunk import counting_stepwise
+from sweepik.errors import SearchOverflowError
 from sweepik.model.robot import Robot
 from sweepik.reductions import Plan, reduction_for, set_plan_check
 from sweepik.reductions.decompose import cheapest
@@ -86,10 +87,14 @@ def check_configurations(robot: Robot, n: int = N_CHECK) -> np.ndarray:
 
 @lru_cache(maxsize=256)
 def check_plan(robot: Robot, plan: Plan, n: int = N_CHECK) -> PlanCheck:
-    """Solve ``FK(q)`` with ``plan`` (limits off) for ``n`` configurations of the check and count those given back."""
+    """Solve ``FK(q)`` with ``plan`` (limits off) for ``n`` configurations of the check and count those given back
+    (none where the plan's search overflows on one of them: ``SearchOverflowError``)."""
     Q = check_configurations(robot, n)
-    with counting_stepwise() as stepwise:
-        batch = solve_many(robot, robot.fk(Q), reduction=reduction_for(robot, plan), limits=False)
+    try:
+        with counting_stepwise() as stepwise:
+            batch = solve_many(robot, robot.fk(Q), reduction=reduction_for(robot, plan), limits=False)
+    except SearchOverflowError:  # (a pose it cannot answer: none counted as given back)
+        return PlanCheck(plan, 0, len(Q), 0, 0, len(Q))
     polished = len(Q) if plan.family == "general" else stepwise[0]
     found = 0
     n_solutions = sum(len(s) for s in batch)

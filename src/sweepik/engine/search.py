@@ -64,7 +64,7 @@ from sweepik.engine.settings import (
     U_UNIFORM,
     XTOL_REL,
 )
-from sweepik.errors import UnknownOptionError
+from sweepik.errors import SearchOverflowError, UnknownOptionError
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.base import overridden_below_kernel
 from sweepik.reductions.kernels import (
@@ -1517,7 +1517,7 @@ def _redone(
     while todo.size:
         K, F = MAX_CAND * grow, MAX_FAM * grow
         if K > REDO_MAX_CAND:
-            raise RuntimeError(
+            raise SearchOverflowError(
                 f"the search of {reduction.name!r} found more than {REDO_MAX_CAND} candidates or {F // REDO_GROW} "
                 "families on a pose: its residual crosses zero that often along theta*"
             )

@@ -185,9 +185,12 @@ def automatic_for_held(
     when a shorter check at these values finds it (or else its companion, :mod:`sweepik.engine.companion`) sound, the
     other of the two as the companion: a new lock value every pose (a redundant arm's self-motion swept, a path with a
     changing elbow angle) would otherwise check every plan again. ``values``: the held joints' values (a plan
-    ``vouch_held_plan`` vouched for at them is taken as ``first_plan`` would find it)."""
+    ``vouch_held_plan`` vouched for at them is taken as ``first_plan`` would find it; at its special values, the plans
+    vouched for are the hints, not those of the values solved before, so that the answer does not depend on them)."""
     key = (full, held)
-    sigs = _HELD_PLANS.get(key, ())
+    entry = _VOUCHED.get(key)
+    # (a joint whose plans are vouched for: they are the hints at its special values too, whatever was solved before)
+    sigs = _HELD_PLANS.get(key, ()) if entry is None else entry[:2]
     vouched = _vouched(full, held, arm, values)
     lazy = vouched if vouched is not None and vouched[1] is not None else None  # (a pair: ``engine.held_joined``)
     if lazy is None:
