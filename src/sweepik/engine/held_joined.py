@@ -133,10 +133,8 @@ class HeldJoined:
                 return both
         # (a sweep's pose due a polish, or two solutions that may be one root: on the held arm at this value)
         held = hold_joints(self.robot, {self.joint: value})
-        red = paired_reduction(held.arm, self.first.plan_at(value), self.second.plan_at(value))
-        comp = red.companion
-        assert comp is not None
-        a, b = (_held_block(held, r, poses, out, limits) for r, out in ((red, outs[0]), (comp, outs[1])))
+        parts = zip((self.first, self.second), outs, strict=True)
+        a, b = (_held_block(held, part, value, poses, out, limits) for part, out in parts)
         both = joined(a, b)
         assert both is not None
         return both.expanded(held)
@@ -168,11 +166,15 @@ def _sig(red: GeometricReduction) -> _Sig:
     return p.family, p.reversed, p.free, p.case
 
 
-def _held_block(held: HeldJoints, red: Reduction, poses: Array, out: tuple[Any, ...], limits: bool) -> Block:
-    """The held arm's block of ``poses (1, 4, 4)`` from a held call's answer ``out`` (full-length configurations):
-    settled, or resumed from a sweep's candidates (``DUE``: ``chunk.resumed``), as ``SinglePose.block``."""
+def _held_block(
+    held: HeldJoints, part: HeldPose, value: float, poses: Array, out: tuple[Any, ...], limits: bool
+) -> Block:  # fmt: skip
+    """The held arm's block of ``poses (1, 4, 4)`` from ``part``'s answer ``out`` at ``value`` (full-length
+    configurations): settled, or resumed from a sweep's candidates by its plan's reduction there (``DUE``:
+    ``chunk.resumed``), as ``SinglePose.block``."""
     status, _, reachable, q, ep, eg, ins, mu = out
     q = np.ascontiguousarray(np.delete(q, held.held[0][0], axis=1))
-    if status == DUE:
+    if status == DUE:  # (the plan alone: its companion is the other part's)
+        red = paired_reduction(held.arm, part.plan_at(value), None)
         return resumed(held.arm, red, poses, q, ep, eg, mu, limits)
     return one_block(held.arm, poses, q, ep, eg, ins, mu, reachable)
