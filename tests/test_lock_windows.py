@@ -88,3 +88,41 @@ def test_in_windows_takes_any_turn() -> None:
     for v in (0.01, 1.0, -2.0, 3.1, 2 * math.pi + 0.01):
         assert not in_windows(v, fast.windows)
     assert not in_windows(0.0, np.zeros((0, 2)))
+
+
+@pytest.mark.parametrize("k", [1, 3, 5])
+def test_a_near_structure_at_every_value_is_the_same_outside_the_windows(
+    k: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The Gen3 held at joint 2, 4 or 6: a nearly spherical wrist at every value (``engine.held_joined``). Outside
+    the windows the held arm has the near-structure of the reference value, of the same size, and its structure;
+    the windows are few and narrow. At joint 6 the held joint's neighbours nearly meet at every value by one
+    distance (``SAME_DISTANCE_REL``): the grid's values are not each checked in Python (25,000, ~10 s)."""
+    from sweepik.engine import lock_windows
+    from sweepik.engine.held_joined import HeldJoined
+    from sweepik.reductions import held_pair
+
+    robot = load_robot("kinova_gen3")
+    checked = []
+    real = lock_windows.near_structure
+
+    def counted(*args, **kwargs):  # type: ignore[no-untyped-def]
+        checked.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(lock_windows, "near_structure", counted)
+    fast = HeldJoined.of(robot, k, held_pair)
+    assert fast is not None and len(checked) < 2000
+    scale = robot.length_scale
+    reference = fast.first.chain_at(0.4321)
+    nearly, generic = near_structure(reference, scale), _relations(reference, scale)
+    assert nearly  # (a near-structure at every value)
+    assert np.sum(np.minimum(fast.windows[:, 1], math.pi) - np.maximum(fast.windows[:, 0], -math.pi)) < 0.01
+    rng = np.random.default_rng(k)
+    edges = np.concatenate([fast.windows[:, 0] - GRID_STEP, fast.windows[:, 1] + GRID_STEP])
+    for v in np.concatenate([rng.uniform(-math.pi, math.pi, 200), edges[np.isfinite(edges)]]):
+        if in_windows(float(v), fast.windows):
+            continue
+        chain = fast.first.chain_at(float(v))
+        assert near_structure(chain, scale) == nearly
+        assert _relations(chain, scale) == generic
