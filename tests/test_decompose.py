@@ -174,11 +174,11 @@ def test_a_held_arm_gets_the_plans_it_got_with_every_plan_checked() -> None:
     """``reductions._without_near_structure`` gives a held arm the plan and companion that ``automatic_for_held`` gives
     with every plan checked, for the signatures remembered from other lock values: none, the plan's own, its own and
     another plan's in either order, another's alone."""
-    from sweepik.reductions import _signature, _without_near_structure
+    from sweepik.reductions import _without_near_structure, plan_signature
 
     def full(arm: Robot, sigs: tuple) -> tuple[Plan, Plan | None]:
         options = plans(arm)
-        hints = tuple(p for sig in sigs for p in options if sig is not None and _signature(p) == sig)
+        hints = tuple(p for sig in sigs for p in options if sig is not None and plan_signature(p) == sig)
         plan, _ = decompose.choice(arm, None, hints)
         comp = next((p for p in hints if p != plan), None) if plan in hints else decompose.companion_plan(arm)
         return plan, comp
@@ -188,8 +188,10 @@ def test_a_held_arm_gets_the_plans_it_got_with_every_plan_checked() -> None:
         options = plans(arm)
         if not options:
             continue
-        mine = _signature(decompose.choice(arm, None)[0])
-        other = next((_signature(p) for p in options if _signature(p) != mine and p.family in ("wrist", "pair")), None)
+        mine = plan_signature(decompose.choice(arm, None)[0])
+        other = next(
+            (plan_signature(p) for p in options if plan_signature(p) != mine and p.family in ("wrist", "pair")), None
+        )
         for sigs in ((), (mine, None), (mine, other), (other, mine), (other, None)):
             lazy = _without_near_structure(arm, sigs)
             if lazy is not None:
@@ -205,14 +207,14 @@ def test_a_sound_hint_is_taken_without_the_general_methods_setup(monkeypatch: py
     the options."""
     from sweepik.model.origin_axis import hold_joints
     from sweepik.plan_check import checked_choice
-    from sweepik.reductions import _signature
+    from sweepik.reductions import plan_signature
 
     gen3 = load_robot("kinova_gen3")
     first = hold_joints(gen3, {3: 0.4}).arm
     plan0, _ = decompose.choice(first, None)
     arm = hold_joints(gen3, {3: -0.9}).arm
     options = tuple(p for p in plans(arm) if not p.conditional)
-    hints = tuple(p for p in options if _signature(p) == _signature(plan0))
+    hints = tuple(p for p in options if plan_signature(p) == plan_signature(plan0))
     assert hints and decompose.near_structures(arm) and decompose.general_refusal(arm) is None
     with_general = checked_choice(arm, (*options, decompose.GENERAL), hints)  # (as the choice was made before)
     assert with_general is not None

@@ -44,7 +44,7 @@ from sweepik.engine.one_pose import DUE, OK
 from sweepik.engine.single_pose import SinglePose, settles
 from sweepik.model.origin_axis import HeldJoints, hold_joints
 from sweepik.model.robot import Robot
-from sweepik.reductions import GeometricReduction, Reduction, paired_reduction, vouch_held_plan
+from sweepik.reductions import GeometricReduction, Reduction, paired_reduction, plan_signature, vouch_held_plan
 from sweepik.results import Block, Solutions
 
 __all__ = ["HeldJoined"]
@@ -93,7 +93,7 @@ class HeldJoined:
                 return None
             found[0].append((v, red, first))
             found[1].append((v, comp, second))
-            pair = pair or (_sig(red), _sig(comp))
+            pair = pair or (plan_signature(red.plan), plan_signature(comp.plan))
         assert pair is not None
         made = [HeldPose.from_references(robot, k, f) for f in found]
         if made[0] is None or made[1] is None:
@@ -159,11 +159,6 @@ class HeldJoined:
             else:
                 out.extend(general(i))
         return out
-
-
-def _sig(red: GeometricReduction) -> _Sig:
-    p = red.plan
-    return p.family, p.reversed, p.free, p.case
 
 
 def _held_block(

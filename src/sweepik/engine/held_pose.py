@@ -335,7 +335,7 @@ class HeldPose:
 
     def plan_at(self, value: float) -> Plan:
         """The held arm's plan at ``value`` (not in ``windows``): the references' with the wrist centre and meeting
-        point this call builds (``position_plan``'s to rounding, ~0.3 ms in Python)."""
+        point the compiled call builds, the plan ``position_plan`` finds there to rounding (which takes ~0.3 ms)."""
         row = held_args(value, *self._geometry)[3]
         return dataclasses.replace(self.plan, W=tuple(row[_W : _W + 3].tolist()), meet=tuple(row[_O : _O + 3].tolist()))
 

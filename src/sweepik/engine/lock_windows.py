@@ -9,7 +9,7 @@ none: two axes on one line). ``special_windows`` finds those values once per arm
 1. a grid of one turn, ``NEAR_TOL / 4`` apart, flags each value where an axis before ``k`` and one after it are within
    twice ``NEAR_TOL`` of parallel (the sine of their angle changes at most as fast as the value), or the neighbours
    of ``k`` within twice ``NEAR_TOL`` (times the length scale) of meeting, unless the relation holds at every value
-   (the neighbours: or nearly meet at every value, by the same distance, ``SAME_DISTANCE_REL``);
+   (or, for the neighbours, nearly holds at every value by the same distance: ``SAME_DISTANCE_REL``);
 2. at each flagged value the held arm's own checks (``structure.near_structure``, ``structure.structure_of``) decide:
    a near-structure or a structure other than at the reference value marks it (a held arm with a near-structure at
    every value, of joints on one side of ``k``, such as the Kinova Gen3's nearly spherical wrist: one that differs

@@ -33,6 +33,7 @@ __all__ = [
     "vouch_held_plan",
     "held_pair",
     "paired_reduction",
+    "plan_signature",
 ]
 
 #: Name of the reduction derived from the arm's geometry (``reductions.decompose``).
@@ -114,7 +115,8 @@ _Sig = tuple[str, bool, int, str]
 _HELD_PLANS: dict[tuple[Robot, tuple[int, ...]], tuple[_Sig | None, ...]] = {}
 
 
-def _signature(plan: Plan) -> _Sig:
+def plan_signature(plan: Plan) -> _Sig:
+    """What ``position_plan`` needs to build ``plan`` on a held arm at another value: family, chain, theta*, case."""
     return plan.family, plan.reversed, plan.free, plan.case
 
 
@@ -159,7 +161,7 @@ def held_pair(arm: Robot, pair: tuple[_Sig, _Sig] | None = None) -> Reduction | 
     """``arm`` (a held arm) solved by a plan and a companion as ``engine.held_joined`` takes them at each value:
     with ``pair`` None the automatic choice at a value seen first (every plan checked, ``get_reduction(arm,
     "auto")``) where it has a companion and both are ``wrist`` or ``pair`` plans; else the plans ``pair`` names
-    (``_signature``s: chosen plan, companion) where both apply and both pass the short check on ``arm``
+    (``plan_signature``s: chosen plan, companion) where both apply and both pass the short check on ``arm``
     (``decompose.passes_check``). None otherwise."""
     if pair is None:
         try:
@@ -199,7 +201,7 @@ def automatic_for_held(
         plan, comp = lazy
     else:
         options = decompose.plans(arm)
-        hints = tuple(p for sig in sigs for p in options if sig is not None and _signature(p) == sig)
+        hints = tuple(p for sig in sigs for p in options if sig is not None and plan_signature(p) == sig)
         plan, _ = decompose.choice(arm, None, hints)
         if plan in hints:  # (the other plan chosen with it, unchecked: a companion only adds solutions)
             comp = next((p for p in hints if p != plan), None)
@@ -210,7 +212,7 @@ def automatic_for_held(
     red = paired_reduction(arm, plan, comp)
     if len(_HELD_PLANS) > 256:  # (bounded, as the caches around it)
         _HELD_PLANS.clear()
-    _HELD_PLANS[key] = (_signature(plan), None if comp is None else _signature(comp))
+    _HELD_PLANS[key] = (plan_signature(plan), None if comp is None else plan_signature(comp))
     return red
 
 
@@ -251,7 +253,7 @@ def _without_near_structure(
         plan = first_plan(arm)
         if plan is None:
             return None
-    mine = _signature(plan)
+    mine = plan_signature(plan)
     if mine not in sigs:
         return plan, None
     for sig in sigs:  # (the hints, in their order: the first other one that applies)
