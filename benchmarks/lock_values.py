@@ -6,9 +6,10 @@ value for free"): ``solve`` per pose, and ``solve_many`` with one value per pose
 Prints the mean time a pose of each, in milliseconds, and their ratio. The same value is timed on poses reached with
 the joint at that value (configurations with it set there), as a user holding a lock solves them; and on the
 new-value poses too (most of which the arm does not reach at the fixed value: a quicker answer, the comparison the
-first rounds of issue 39 made). ``--parts``: where a new value's time goes,
-each step timed on its own in the order a solve takes them (the held arm, its plan, the reduction, its one call's
-fixed arguments, the solve itself), means over ``--n`` new values.
+first rounds of issue 39 made); and the first new-value poses solved again at their own values (each value asked for
+before: the same poses, ``AGAIN``). ``--parts``: where a new value's time goes, each step timed on its own in the
+order a solve takes them (the held arm, its plan, the reduction, its one call's fixed arguments, the solve itself),
+means over ``--n`` new values.
 """
 
 from __future__ import annotations
@@ -19,6 +20,11 @@ import time
 import numpy as np
 
 import sweepik
+
+#: How many of the new-value poses are solved again at their values (``--n`` at most; the held arms and reductions
+#: of the last 64 values are cached): the same poses and values, each value asked for before. The same value's poses
+#: are other poses, and how many of them need the general way's rarer steps depends on the value.
+AGAIN = 40
 
 
 def main() -> None:
@@ -59,14 +65,20 @@ def main() -> None:
     for i in range(n + 1, 2 * n + 1):
         sweepik.solve(arm, T[i], locked={args.joint: same_value})
     other = (time.perf_counter() - t0) / n
+    m = min(n, AGAIN)
+    t0 = time.perf_counter()
+    for i in range(1, m + 1):
+        sweepik.solve(arm, T[i], locked={args.joint: float(q[i, k])})
+    again = (time.perf_counter() - t0) / m
     rows = slice(2 * n + 1, 3 * n + 1)
     t0 = time.perf_counter()
     sweepik.solve_many(arm, T[rows], locked={args.joint: q[rows, k]})
     batch = (time.perf_counter() - t0) / n
     print(
         f"{args.arm}, {args.joint} held: a new value every pose {new * 1e3:.2f} ms, the same value {same * 1e3:.3f} ms "
-        f"(x{new / same:.2f}; on poses it mostly does not reach {other * 1e3:.3f} ms, x{new / other:.2f}); solve_many "
-        f"with a new value per pose {batch * 1e3:.2f} ms a pose"
+        f"(x{new / same:.2f}; on poses it mostly does not reach {other * 1e3:.3f} ms, x{new / other:.2f}); the first "
+        f"{m} new-value poses again, each value asked for before: {again * 1e3:.3f} ms (x{new / again:.2f}); "
+        f"solve_many with a new value per pose {batch * 1e3:.2f} ms a pose"
     )
 
 
