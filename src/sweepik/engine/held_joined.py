@@ -44,16 +44,21 @@ from sweepik.engine.one_pose import DUE, OK
 from sweepik.engine.single_pose import SinglePose, settles
 from sweepik.model.origin_axis import HeldJoints, hold_joints
 from sweepik.model.robot import Robot
-from sweepik.reductions import GeometricReduction, Reduction, paired_reduction, plan_signature, vouch_held_plan
+from sweepik.reductions import (
+    GeometricReduction,
+    PlanSignature,
+    Reduction,
+    paired_reduction,
+    plan_signature,
+    vouch_held_plan,
+)
 from sweepik.results import Block, Solutions
 
 __all__ = ["HeldJoined"]
 
 Array = NDArray[np.float64]
-#: A plan's family, chain, theta* and case (``reductions.position_plan``'s arguments).
-_Sig = tuple[str, bool, int, str]
 #: ``reductions.held_pair``: the pair at a held arm, chosen (None) or checked.
-PairOf = Callable[[Robot, "tuple[_Sig, _Sig] | None"], "Reduction | None"]
+PairOf = Callable[[Robot, "tuple[PlanSignature, PlanSignature] | None"], "Reduction | None"]
 
 
 class HeldJoined:
@@ -63,7 +68,9 @@ class HeldJoined:
 
     __slots__ = ("robot", "joint", "arm", "windows", "pair", "first", "second")
 
-    def __init__(self, pair: tuple[_Sig, _Sig], first: HeldPose, second: HeldPose, windows: Array) -> None:
+    def __init__(
+        self, pair: tuple[PlanSignature, PlanSignature], first: HeldPose, second: HeldPose, windows: Array
+    ) -> None:
         self.robot, self.joint, self.arm = first.robot, first.joint, first.arm
         #: the values the general way answers (``lock_windows.special_windows``)
         self.windows = windows
@@ -81,7 +88,7 @@ class HeldJoined:
         if values is None or k in (0, robot.n_joints - 1):  # (the first and last: ``turned_lock``, whatever the arm)
             return None
         found: tuple[list[tuple[float, Any, SinglePose]], list[tuple[float, Any, SinglePose]]] = ([], [])
-        pair: tuple[_Sig, _Sig] | None = None
+        pair: tuple[PlanSignature, PlanSignature] | None = None
         for v in values:
             held = hold_joints(robot, {k: v})
             red = pair_of(held.arm, pair)

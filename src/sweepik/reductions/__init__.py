@@ -34,6 +34,7 @@ __all__ = [
     "held_pair",
     "paired_reduction",
     "plan_signature",
+    "PlanSignature",
 ]
 
 #: Name of the reduction derived from the arm's geometry (``reductions.decompose``).
@@ -109,25 +110,30 @@ def set_plan_check(check: Callable[..., object] | None) -> None:
     _automatic.cache_clear()
 
 
-_Sig = tuple[str, bool, int, str]
+#: A plan as ``position_plan`` builds it on a held arm at another value: family, chain, theta*, case.
+PlanSignature = tuple[str, bool, int, str]
 #: The plan chosen for an arm with joints held, by (full arm, held joints): a new lock value reuses it (see
 #: ``automatic_for_held``).
-_HELD_PLANS: dict[tuple[Robot, tuple[int, ...]], tuple[_Sig | None, ...]] = {}
+_HELD_PLANS: dict[tuple[Robot, tuple[int, ...]], tuple[PlanSignature | None, ...]] = {}
 
 
-def plan_signature(plan: Plan) -> _Sig:
+def plan_signature(plan: Plan) -> PlanSignature:
     """What ``position_plan`` needs to build ``plan`` on a held arm at another value: family, chain, theta*, case."""
     return plan.family, plan.reversed, plan.free, plan.case
 
 
 #: Plans that hold at every value of a held joint but a few (``engine.held_pose``), by (full arm, held joints): the
 #: plan's signature, its companion's (or None) and the test of the values where they may not (``vouch_held_plan``).
-_VOUCHED: dict[tuple[Robot, tuple[int, ...]], tuple[_Sig, _Sig | None, Callable[[float], bool]]] = {}
+_VOUCHED: dict[tuple[Robot, tuple[int, ...]], tuple[PlanSignature, PlanSignature | None, Callable[[float], bool]]] = {}
 
 
 def vouch_held_plan(
-    full: Robot, held: tuple[int, ...], sig: _Sig, special: Callable[[float], bool], companion: _Sig | None = None
-) -> None:  # fmt: skip
+    full: Robot,
+    held: tuple[int, ...],
+    sig: PlanSignature,
+    special: Callable[[float], bool],
+    companion: PlanSignature | None = None,
+) -> None:
     """``full`` with the joints ``held`` locked is the plan ``sig`` (a ``wrist`` or ``pair`` plan's family, chain,
     theta* and case) at every value where ``special(value)`` is False, and that plan is the first without a blind
     spot there (``engine.held_pose`` checked it): ``automatic_for_held`` then builds that plan at a new value
@@ -157,7 +163,7 @@ def _vouched(
     return None if comp is None else (plan, comp)
 
 
-def held_pair(arm: Robot, pair: tuple[_Sig, _Sig] | None = None) -> Reduction | None:
+def held_pair(arm: Robot, pair: tuple[PlanSignature, PlanSignature] | None = None) -> Reduction | None:
     """``arm`` (a held arm) solved by a plan and a companion as ``engine.held_joined`` takes them at each value:
     with ``pair`` None the automatic choice at a value seen first (every plan checked, ``get_reduction(arm,
     "auto")``) where it has a companion and both are ``wrist`` or ``pair`` plans; else the plans ``pair`` names
@@ -238,7 +244,7 @@ def first_held_reduction(arm: Robot) -> Reduction | None:
 
 
 def _without_near_structure(
-    arm: Robot, sigs: tuple[_Sig | None, ...], vouched: Plan | None = None
+    arm: Robot, sigs: tuple[PlanSignature | None, ...], vouched: Plan | None = None
 ) -> tuple[Plan, Plan | None] | None:
     """``automatic_for_held``'s plan and companion for an arm without a near-structure (nor a continuum everywhere),
     the same ones, without every plan checked: ``decompose.choice`` takes the first plan without a blind spot
