@@ -48,8 +48,9 @@ def _brackets(f: Any, q: np.ndarray, joint: int, lo: float, hi: float, grid: int
     xs = np.linspace(lo, hi, grid)
     Q = np.repeat(q[None], grid, axis=0)
     Q[:, joint] = xs
-    vals = f(Q)
-    return xs, np.flatnonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)
+    s = np.sign(f(Q))
+    # (a zero on the grid itself, as a wrist straight at exactly 0: the bracket that starts at it)
+    return xs, np.flatnonzero((s[:-1] * s[1:] < 0) | ((s[:-1] == 0) & (s[1:] != 0)))
 
 
 def _zero(f: Any, q: np.ndarray, joint: int, a: float, b: float) -> float:
@@ -118,15 +119,16 @@ def folds_with_a_straight_wrist(
     return np.array(out)
 
 
-def recovered(robot: Any, sols: Any, q: np.ndarray, tol: float = 1e-6) -> bool:
-    """``q`` is among ``sols`` (a ``sweepik.Solutions``) as the module docstring says."""
+def recovered(robot: Any, sols: Any, q: np.ndarray, tol: float = 1e-6, reach: float = ARC_REACH) -> bool:
+    """``q`` is among ``sols`` (a ``sweepik.Solutions``) as the module docstring says (``reach``: the arc's)."""
     if not (len(sols) or sols.families):
         return False
-    return same_root(robot, q, sols.nearest(q), tol)
+    return same_root(robot, q, sols.nearest(q), tol, reach)
 
 
-def same_root(robot: Any, q: np.ndarray, s: np.ndarray, tol: float = 1e-6) -> bool:
-    """``q`` and the solution ``s`` are the same root of ``FK(q)`` as the module docstring says."""
+def same_root(robot: Any, q: np.ndarray, s: np.ndarray, tol: float = 1e-6, reach: float = ARC_REACH) -> bool:
+    """``q`` and the solution ``s`` are the same root of ``FK(q)`` as the module docstring says (an arc of solutions
+    joining them no longer than ``reach``)."""
     d = s - q
     d = np.where(robot.is_revolute, np.angle(np.exp(1j * d)), d / robot.length_scale)
     if np.max(np.abs(d)) < tol:
@@ -136,7 +138,7 @@ def same_root(robot: Any, q: np.ndarray, s: np.ndarray, tol: float = 1e-6) -> bo
     between = q[None] + np.array([0.25, 0.5, 0.75])[:, None] * (s - q)[None]
     if np.all(_geodesic(robot, between, T) <= SAME_ROOT_REL * robot.length_scale):
         return True
-    return bool(np.max(np.abs(d)) <= ARC_REACH and _on_one_arc(robot, q, s, T))
+    return bool(np.max(np.abs(d)) <= reach and _on_one_arc(robot, q, s, T))
 
 
 def one_root(robot: Any, q: np.ndarray, s: np.ndarray) -> bool:

@@ -645,6 +645,26 @@ def _jacobian(H, P, rev, qk, Tk, J, z, o):
 
 
 @inlined
+def nearly_singular_row(H, P, rev, R_end, qk, scale, ratio):
+    """Whether the Jacobian at ``qk`` (lengths over ``scale``, a slide's column times it: as
+    ``continuation.scaled_jacobians``) has its least singular value at most ``ratio`` of its largest: one row of
+    ``partners.nearly_singular``, compiled (a few microseconds; its callers ask for the rare rows above rounding)."""
+    n = H.shape[0]
+    J, z, o = np.empty((6, n)), np.empty((n, 3)), np.empty((n, 3))
+    _jacobian(H, P, rev, qk, _poe_fk(H, P, rev, R_end, qk), J, z, o)
+    for j in range(n):
+        for i in range(6):
+            if i < 3:
+                J[i, j] /= scale
+            if not rev[j]:
+                J[i, j] *= scale
+    r = min(6, n)
+    B, V, s = np.empty((6, n)), np.empty((n, n)), np.empty(r)
+    jacobi.singular_values(J, B, V, s, False)
+    return s[r - 1] <= ratio * s[0]
+
+
+@inlined
 def polish_row(H, P, rev, R_end, qk, Td, weight, held, iterations, backtrack, rcond, floor, work, settled=0.0):
     """``polish.polish`` of one configuration ``qk (n,)`` in place towards the pose ``Td (4, 4)``: its geodesic
     error after. Damped Newton steps on the full pose (pseudo-inverse of the Jacobian, singular values below

@@ -393,6 +393,13 @@ def _settled_rows(
         )
     assert err_geo is not None and err_paper is not None
     due, rows, w, inside, keep = settled
+    slope = rows[err_geo[rows] > bounds[5]]  # (a certified one on a valley's slope: ``settings.VALLEY_ABOVE_REL``)
+    if slope.size:
+        slope = slope[nearly_singular(robot, q[slope])]
+    if slope.size:
+        due[pose_idx[slope]] = True
+        kept = np.flatnonzero(~due[pose_idx[rows]])
+        rows, w, inside, keep = rows[kept], w[kept], inside[kept], keep[kept]
     parts = [(pose_idx[rows], w, err_paper[rows], err_geo[rows], mult[rows], inside, keep)]
     if due.any():  # (these poses' rows, by the steps; the rows of a pose stay in order, and together)
         sub = np.nonzero(due[pose_idx])[0]
@@ -600,7 +607,7 @@ def _settle_stepwise(
             err_geo, err_paper = err_geo[finite], err_paper[finite]
     if err_geo is None or err_paper is None:
         err_geo, err_paper = errors_of(robot, q, poses[pose_idx], weight)
-    below, above, paper_above, accept, multiple = settle_bounds(robot)
+    below, above, paper_above, accept, multiple, valley_above = settle_bounds(robot)
     if strategy == "precise":
         # (a multiple root's candidate: further, POLISH_MULTIPLE_REL; a nearly singular one's: POLISH_SINGULAR_REL)
         reach = np.where(mult >= 2, multiple, below)
@@ -608,6 +615,7 @@ def _settle_stepwise(
         if band.size:
             reach[band[nearly_singular(robot, q[band])]] = multiple
         near = np.nonzero((err_geo <= reach) & ((err_geo > above) | (err_paper > paper_above)))[0]
+        probed = np.zeros(0, dtype=np.intp)
         if near.size:
             target = poses[pose_idx[near]]
             polished = polish(robot, q[near], target, weight, floor=above)
@@ -617,13 +625,15 @@ def _settle_stepwise(
             drift = (err_geo[near] <= accept) & inside_limits(robot, q[near]) & ~inside_limits(robot, polished)
             take = np.nonzero(~drift)[0]
             q[near[take]], err_geo[near[take]], err_paper[near[take]] = polished[take], eg[take], ep[take]
-            # a sweep's solution next to a fold of the solution set: a valley's bottom, a close partner (a closed form
-            # gives every branch's root, a pair split by rounding included: ``MEET_REL``)
-            if not red.closed_form:
-                polished_ok = near[take][eg[take] <= accept]
-                pose_idx, q, mult, err_geo, err_paper = next_to_folds(
-                    robot, poses, pose_idx, q, mult, err_geo, err_paper, polished_ok
-                )
+            if not red.closed_form:  # (a closed form gives every branch's root, a pair split by rounding too: MEET_REL)
+                probed = near[take][eg[take] <= accept]
+        # next to a fold of the solution set: a certified solution above rounding on a valley's slope moved to its
+        # bottom (a closed form's root just off a fold, imprecise; a sweep's polish stopping in a valley); a sweep's
+        # polished solution's close partner across the fold
+        valley = np.union1d(probed, np.flatnonzero((err_geo > valley_above) & (err_geo <= accept)))
+        pose_idx, q, mult, err_geo, err_paper = next_to_folds(
+            robot, poses, pose_idx, q, mult, err_geo, err_paper, valley, probed
+        )
     if strategy == "precise":
         certified = err_geo <= accept
     else:

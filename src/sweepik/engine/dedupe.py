@@ -115,7 +115,7 @@ def settle(
     pose_idx: NDArray[np.intp],
     mult: NDArray[np.intp],
     n_poses: int,
-    thresholds: tuple[float, float, float, float, float],
+    thresholds: tuple[float, ...],
     reach: Array,
 ) -> tuple[NDArray[np.bool_], NDArray[np.intp], Array, NDArray[np.bool_], NDArray[np.bool_]] | None:
     """The solver's steps from candidates to final ones in one compiled pass, for the poses (of ``n_poses``) where

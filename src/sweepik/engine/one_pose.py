@@ -25,9 +25,17 @@ from numpy.typing import NDArray
 from sweepik._jit import function_at, inlined, internal, writable
 from sweepik.engine import search
 from sweepik.engine.candidates import unit_grid
-from sweepik.engine.certify import _CERTIFY_EVERY_SIG, _CERTIFY_SIG, _certify, _certify_every_branch, chain_args
+from sweepik.engine.certify import (
+    _CERTIFY_EVERY_SIG,
+    _CERTIFY_SIG,
+    _certify,
+    _certify_every_branch,
+    chain_args,
+    nearly_singular_row,
+)
 from sweepik.engine.dedupe import _SETTLE_SIG, _rows_within, _settle, duplicate_tolerance, limit_args
 from sweepik.engine.search import _ONE_PASS_SIG, _plan
+from sweepik.engine.settings import PARTNER_SINGULAR
 from sweepik.model.units import orientation_weight
 from sweepik.reductions.geometric import _CONTINUUM_SIG, _continuum_rows
 from sweepik.reductions.kernels import (
@@ -111,9 +119,10 @@ _A_SEARCH, _A_CERTIFY, _A_SETTLE, _A_CFG, _A_ROWS, _A_AMP, _A_DIV, _A_SING, _A_S
 
 
 @internal
-def _settled(settle, q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale):
+def _settled(settle, q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, H, P, rev, R_end):
     """One pose's certified candidates settled (``dedupe._settle`` at the address ``settle``): whether one is
-    due the solver's rarer steps, and the count, rows, wrapped configurations, limit check and duplicate mask
+    due the solver's rarer steps (a certified one on a valley's slope too: above ``thr[5]``, nearly singular,
+    ``settings.VALLEY_ABOVE_REL``), and the count, rows, wrapped configurations, limit check and duplicate mask
     of the certified ones (buffers as long as the candidates)."""
     K, n = q.shape
     rows = np.empty(K, dtype=np.int64)
@@ -129,6 +138,12 @@ def _settled(settle, q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyon
         q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, due, rows, w, score,
         inside, keep, ints[0:2], ints[2:3], 0, 1,
     )  # fmt: skip
+    for a in range(ints[2]):  # (the others are above the polish's floor, thr[1], and due already)
+        if due[0]:
+            break
+        k = rows[a]
+        if eg[k] > thr[5] and nearly_singular_row(H, P, rev, R_end, q[k], scale, PARTNER_SINGULAR):
+            due[0] = True
     return due[0], ints[2], rows, w, inside, keep
 
 
@@ -263,8 +278,9 @@ def searched_settled(
         addr[_A_CFG], params, world, pose, theta, branch, True, H, P, rev, R_end, weight, q, eg, ep, 0, K
     )
     due, c, rows, w, inside, keep = _settled(
-        addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
-    )
+        addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, H, P, rev,
+        R_end,
+    )  # fmt: skip
     if due and status == OK:
         status, c = DUE, 0
     if (status == OK or status == DUE) and addr[_A_ROWS] != 0 and K > 0:
@@ -314,8 +330,9 @@ def every_branch_settled(
     for k in range(nb):
         pose[k], mult[k] = 0, 1
     due, c, rows, w, inside, keep = _settled(
-        addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale
-    )
+        addr[_A_SETTLE], q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, H, P, rev,
+        R_end,
+    )  # fmt: skip
     status = DUE if due else OK
     if status == OK and _branches_meet(c, w, keep, lrev, meet):
         status = MEET
@@ -429,7 +446,7 @@ def settle_one(
     hi: Array,
     n_samples: int,
     params: Array,
-    thresholds: tuple[float, float, float, float, float],
+    thresholds: tuple[float, ...],
     reach: Array,
     clip_rel: float,
     seed_tol: float,
@@ -463,7 +480,7 @@ def settle_closed(
     red: Any,
     world: Array,
     params: Array,
-    thresholds: tuple[float, float, float, float, float],
+    thresholds: tuple[float, ...],
     reach: Array,
     meet: Array,
     only_inside: bool,
@@ -482,9 +499,7 @@ def settle_closed(
     return Settled(status, c, reachable, q, ep, eg, inside, mu, theta, branch, err_all, bool(addr[_A_SING] != 0))
 
 
-def closed_fixed(
-    robot: Any, red: Any, thresholds: tuple[float, float, float, float, float], reach: Array
-) -> tuple[Any, ...] | None:
+def closed_fixed(robot: Any, red: Any, thresholds: tuple[float, ...], reach: Array) -> tuple[Any, ...] | None:
     """What ``every_branch_settled`` takes for the closed form ``red`` besides the pose's rows, the target, the
     meeting reach and ``only_inside``, kept per reduction: ``(addr, nb, theta, branch, tail, s_thr)``; None where
     ``red`` has no all-branch configuration kernel."""

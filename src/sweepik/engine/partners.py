@@ -35,6 +35,7 @@ from sweepik.engine.settings import (
     PARTNER_STAY,
     PARTNER_STEPS,
     VALLEY_REACH,
+    VALLEY_RISE,
     VALLEY_SAMPLES,
     VALLEY_STEPS,
 )
@@ -123,9 +124,11 @@ def valley_bottoms(robot: Robot, q: Array, world: Array, tol: float) -> tuple[Ar
 
     grid = np.broadcast_to(np.linspace(-VALLEY_REACH, VALLEY_REACH, VALLEY_SAMPLES), (rows.size, VALLEY_SAMPLES))
     _, e = corrected(grid)
-    # a valley ends within the reach both ways (its ends do not solve the pose); along a continuum, which holds
-    # solutions all the way, a point is where it is (the continuum is reported by its family)
-    bounded = (e[:, 0] > tol) & (e[:, -1] > tol)
+    # a valley ends within the reach both ways: its ends do not solve the pose, or rise well above its lowest point
+    # (a closed form's imprecise root just off a fold: a V at rounding level, ``VALLEY_ABOVE_REL``); along a
+    # continuum, which holds solutions all the way, a point is where it is (the continuum is reported by its family)
+    high = np.minimum(tol, VALLEY_RISE * np.maximum(e.min(axis=1), floor))
+    bounded = (e[:, 0] > high) & (e[:, -1] > high)
     rows, grid, e, v, held = rows[bounded], grid[bounded], e[bounded], v[bounded], held[bounded]
     if rows.size == 0:
         return out, moved

@@ -418,6 +418,19 @@ VALLEY_REACH = 1e-2
 #: ends at the reach still solve the pose is a continuum's stretch: no point of it is moved.
 VALLEY_SAMPLES = 41
 VALLEY_STEPS = 30
+#: A valley is one where its ends at the reach miss the pose by more than the tolerance, or by more than this times
+#: its lowest point's error (at least ``PARTNER_ROUNDING``): the GP8's below rises to 4e-14 of its size at the reach
+#: from 1e-16 at its bottom; a continuum's points solve the pose to rounding all along.
+VALLEY_RISE = 4.0
+#: A certified solution whose pose error is above this times the arm's size, though below ``POLISH_ABOVE_REL``, may
+#: lie on a valley's slope too, nearly singular: a closed form's root just off a fold with the wrist nearly straight
+#: (ssik's Yaskawa GP8, the elbow 1e-7 rad off its fold and q5 = 6.5e-5: subproblem 3 loses eps over the distance to
+#: the fold, the wrist's step multiplies it by 1/sin q5) comes out 2.2e-3 rad from the root along the nearly null
+#: direction at 9.7e-15 of the size, a polish not helping (``PINV_RCOND`` drops that direction). Such solutions, nearly
+#: singular (``PARTNER_SINGULAR``: checked in compiled code for the one-pose kernels, ``certify.nearly_singular_row``),
+#: are settled step by step and moved to their valley's bottom (``partners.valley_bottoms``). A solution above it is
+#: rare (0.2 % of a UR5's random poses have one, 2-7 % of a swept arm's), a nearly singular one rarer.
+VALLEY_ABOVE_REL = 4e-15
 
 
 # The paper's strategy (paper_sweep.py)

@@ -38,6 +38,7 @@ from sweepik.engine.settings import (
     POLISH_PAPER_ABOVE_REL,
     SNAP_ITERATIONS,
     SNAP_REACH,
+    VALLEY_ABOVE_REL,
 )
 from sweepik.model.robot import Robot
 from sweepik.model.units import orientation_weight
@@ -46,10 +47,11 @@ from sweepik.results import joint_distance
 Array = NDArray[np.float64]
 
 
-def settle_bounds(robot: Robot) -> tuple[float, float, float, float, float]:
+def settle_bounds(robot: Robot) -> tuple[float, float, float, float, float, float]:
     """The precise strategy's thresholds, absolute (times the arm's length scale): polish below, polish above, polish
-    above on the paper's J, acceptance, polish below for a multiple root's candidate (``POLISH_BELOW_REL`` ...
-    ``ACCEPT_TOL_REL``, ``POLISH_MULTIPLE_REL``); the stepwise path and ``dedupe.settle`` take the same values."""
+    above on the paper's J, acceptance, polish below for a multiple root's candidate, a valley's slope above
+    (``POLISH_BELOW_REL`` ... ``ACCEPT_TOL_REL``, ``POLISH_MULTIPLE_REL``, ``VALLEY_ABOVE_REL``); the stepwise path
+    and ``dedupe.settle`` take the same values."""
     ls = robot.length_scale
     return (
         POLISH_BELOW_REL * ls,
@@ -57,6 +59,7 @@ def settle_bounds(robot: Robot) -> tuple[float, float, float, float, float]:
         POLISH_PAPER_ABOVE_REL * ls,
         ACCEPT_TOL_REL * ls,
         POLISH_MULTIPLE_REL * ls,
+        VALLEY_ABOVE_REL * ls,
     )
 
 
@@ -244,12 +247,13 @@ def next_to_folds(
     err_geo: Array,
     err_paper: Array,
     rows: NDArray[np.intp],
+    probed: NDArray[np.intp],
 ) -> tuple[NDArray[np.intp], Array, NDArray[np.intp], Array, Array]:
-    """The certified solutions ``rows`` the polish gave, next to a fold of the solution set (:mod:`.partners`): one in
-    a flat valley moved to its bottom (in place; never out of the limits, as the polish's drift), and a close partner
-    on the far side of the fold added after the solution it was found from (a pose's rows stay together): the
-    candidates ``(pose_idx, q, mult, err_geo, err_paper)``."""
-    if rows.size:  # (only nearly singular ones: most polished solutions are not)
+    """Certified solutions next to a fold of the solution set (:mod:`.partners`): those of ``rows`` in a flat valley
+    moved to its bottom (in place; never out of the limits, as the polish's drift), and a close partner on the far
+    side of the fold of those of ``probed`` (the polish gave them) added after the solution it was found from (a
+    pose's rows stay together): the candidates ``(pose_idx, q, mult, err_geo, err_paper)``."""
+    if rows.size:  # (only nearly singular ones: most are not)
         rows = rows[nearly_singular(robot, q[rows])]
     if rows.size == 0:
         return pose_idx, q, mult, err_geo, err_paper
@@ -261,6 +265,7 @@ def next_to_folds(
         m = rows[moved]
         q[m] = q_v[moved]
         err_geo[m], err_paper[m] = errors_of(robot, q[m], poses[pose_idx[m]], weight)
+    rows = rows[np.isin(rows, probed)]
     # each distinct one once, and none of a pose with more of them than an arm has solutions (a numerical continuum,
     # along which no partner is taken)
     distinct = rows[finish(robot, pose_idx[rows], q[rows], err_geo[rows])[2]]
