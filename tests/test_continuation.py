@@ -311,6 +311,31 @@ def test_numerical_continuum_next_to_a_self_motion(q: list[float]) -> None:
         assert np.all(err <= 1.01 * ACCEPT_TOL_REL * arm.length_scale), (err / (ACCEPT_TOL_REL * arm.length_scale), f)
 
 
+@pytest.mark.parametrize(
+    "q",
+    [
+        [0.8368222606646678, 2.9369867087557644, 3.165758277459611e-11 - 1e-7, -0.6809412564547146,
+         4.7165911145115574e-05, -0.9678576828074092],
+        [-0.7814705648545721, -0.37248370770586936, 2.8268058841444838e-09 + 1e-7, 0.6973900543544262,
+         3.341919253568343e-05, 0.9988520203934721],
+    ],
+)  # fmt: skip
+def test_trace_past_a_first_step_that_jumps_where_a_nearly_straight_wrist_swings(q: list[float]) -> None:
+    """The Stanford arm with its slide 1e-7 off d3 = 0 and the wrist 3e-5 ... 5e-5 rad from straight: no isolated
+    solution, a numerical continuum along theta2 through the configuration (every member solves the pose to
+    rounding). The trace's first step from the seed (``PROBE_STEP`` of a step, 3.8e-4 rad) reached the pose but jumped
+    0.47 (the wrist's joints 4 and 6 swing fast there: ``TRACE_JUMP`` is 0.25), and steps were not halved below the
+    probe's, so the family stopped at its seed, 4.4e-4 rad short of the configuration. A first step that reaches the
+    pose now lets the steps halve."""
+    from singular import recovered
+
+    arm = load_robot("stanford")
+    q_ = np.array(q)
+    T = arm.fk(q_)
+    s = solve(arm, T, limits=False)
+    assert s.families and recovered(arm, s, q_)
+
+
 def test_compiled_trace_follows_the_reference() -> None:
     """The compiled side of a trace (``continuation._side``) and its NumPy reference follow the same continuum
     to the same ends (the trace's resolution), their members solving the pose; a small buffer hands the compiled

@@ -188,11 +188,11 @@ def trace_side(
     most, from the seed on: ``(joint values (M,), members (M, n), distance gone)``. Each step predicts the next member
     by the secant through the last two, corrects it with the joint held, and keeps it when it solves the pose, lies
     near its prediction (``TRACE_JUMP``) and the member halfway solves the pose too (``_bridged``); a failed step
-    is halved. The reference of the compiled
-    ``continuation._side``."""
+    is halved (below the first step's ``PROBE_STEP`` only once the trace has gone ``TRACE_MIN`` or that first step
+    reached the pose). The reference of the compiled ``continuation._side``."""
     nodes: list[tuple[float, Array]] = [(x0, q0)]
-    h, done = h0 * PROBE_STEP, 0.0
-    while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if done >= TRACE_MIN * h0 else PROBE_STEP):
+    h, done, on = h0 * PROBE_STEP, 0.0, False  # (on: the first step reached the pose, so steps halve below it)
+    while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if on or done >= TRACE_MIN * h0 else PROBE_STEP):
         step = min(h, reach - done)
         x, q = nodes[-1]
         pred = q.copy()
@@ -203,6 +203,7 @@ def trace_side(
         corr, err = correct(robot, pred[None], world[None], joint, tol)
         if len(nodes) == 1 and not err[0] <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
             break
+        on = True
         if (
             err[0] <= tol
             and weighted_joint_distance(robot, corr[0], pred) <= TRACE_JUMP

@@ -247,7 +247,10 @@ def _trace_side(H, P, rev, R_end, world, joint, sign, reach, h0, tol, scale, wei
     held = np.zeros(n, dtype=np.bool_)
     held[joint] = True
     pred, mid = np.empty(n), np.empty(n)
-    while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if done >= TRACE_MIN * h0 else PROBE_STEP):
+    # (its steps halved below the probe's once the trace has gone far enough, or once the first step reached the pose:
+    # a continuum's, where only the jump failed, as next to a nearly straight wrist that swings fast)
+    on = False
+    while done < reach and h >= h0 * (2.0**-TRACE_HALVINGS if on or done >= TRACE_MIN * h0 else PROBE_STEP):
         if count == xs.shape[0]:
             return count, h, done, True
         step = min(h, reach - done)
@@ -265,6 +268,7 @@ def _trace_side(H, P, rev, R_end, world, joint, sign, reach, h0, tol, scale, wei
         err = _correct_row(H, P, rev, R_end, corr, world, weight, held, tol, work)
         if count == 1 and not err <= PROBE_ERROR * tol:  # (see PROBE_ERROR)
             break
+        on = on or count == 1
         ok = err <= tol and _distance(corr, pred, rev, scale) <= TRACE_JUMP
         if ok:  # the member halfway solves the pose too (``_bridged``)
             for i in range(n):
