@@ -3,6 +3,8 @@ elimination's full path (the 24x24 companion, ``GeneralIK.solve``), and its LAPA
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from general_arms import poses_of, random_arm
@@ -49,3 +51,66 @@ def test_the_spurious_roots_null_space_is_the_arms() -> None:
     assert np.allclose(U.conj().T @ U, np.eye(4), atol=1e-12)  # (orthonormal singular vectors)
     assert np.allclose(V.T @ V, np.eye(4), atol=1e-12)
     assert np.allclose(V.T @ np.concatenate([Ur, Ui], axis=1), 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize(("kind", "seed"), [("6r", 1), ("5r1p", 3)])
+def test_a_ranking_taken_over_gives_the_full_rankings_answers(kind: str, seed: int) -> None:
+    """The elimination built with another build's ranking (``GeneralIK(..., prefer=)``, as an arm held at a new lock
+    value takes the one found at a reference value) builds its first three arrangements alone, and gives the full
+    build's solution set; a ranking whose first arrangement is unusable on the arm falls back to the full build."""
+    from sweepik.reductions.elimination import ARRANGEMENTS, GeneralIK
+
+    robot = random_arm(kind, seed)
+    c = robot.chain
+    full = GeneralIK(c.H, c.P, c.revolute, c.R_end)
+    hinted = GeneralIK(c.H, c.P, c.revolute, c.R_end, prefer=full.ranking)
+    assert hinted.hinted and not full.hinted
+    assert hinted.ranking == full.ranking[:3]
+    T = robot.fk(poses_of(robot, 20, 0, seed=seed))  # (next to the singular set a double root is fixed to ~1e-6)
+    for k in range(len(T)):
+        a, b = hinted.solve(T[k]).q, full.solve(T[k]).q
+        assert same_solution_set(a, b, robot.is_revolute, robot.length_scale), k
+    fell = 0
+    for k in (k for k in range(len(ARRANGEMENTS)) if k not in full.ranking):  # (unusable in the full build)
+        other = GeneralIK(c.H, c.P, c.revolute, c.R_end, prefer=(k,))
+        assert other.ranking == ((k,) if other.hinted else full.ranking)
+        fell += not other.hinted
+    assert fell or kind == "6r"  # (a prismatic joint makes some arrangements unusable whatever their numbers)
+
+
+def test_a_held_arm_at_new_values_takes_the_reference_ranking() -> None:
+    """A seven-joint arm without structure held at one joint: every value's held arm takes the general method, its
+    setup the ranking found at the joint's reference value (``general.held_ranking``) where it passes the trial
+    solves. Each value's solutions are those of the held arm solved on its own (a full build), the generating
+    configuration among them."""
+    from oracles import contains
+
+    import sweepik
+    from sweepik.io.robot_file import robot_from_dict
+    from sweepik.model.origin_axis import hold_joints
+    from sweepik.reductions import general
+
+    rng = np.random.default_rng(39)
+    joints = [
+        {"name": f"j{i + 1}", "type": "revolute", "a": float(rng.uniform(0.05, 0.4)),
+         "alpha": float(rng.uniform(-180, 180)), "d": float(rng.uniform(0.05, 0.3)),
+         "theta": float(rng.uniform(-180, 180)), "limits": [-180.0, 180.0]}
+        for i in range(7)
+    ]  # fmt: skip
+    arm = robot_from_dict({"name": "general_7r", "dh_convention": "standard", "length_unit": "m", "joints": joints})
+    k = 3
+    assert general.held_ranking(arm, k) is not None
+    q = rng.uniform(-np.pi, np.pi, (6, 7))
+    hinted = 0
+    for qq in q:
+        T = arm.fk(qq)
+        s = sweepik.solve(arm, T, locked={"j4": float(qq[k])}, limits=False)
+        assert contains(s.q, qq, arm.is_revolute, arm.length_scale, 1e-6)
+        held = hold_joints(arm, {k: float(qq[k])}).arm
+        setup = general._setup(held)
+        assert not isinstance(setup, str)
+        hinted += setup.hinted
+        alone = dataclasses.replace(held, name="alone")  # (no hint: the full build)
+        a = sweepik.solve(alone, T, limits=False)
+        assert same_solution_set(np.delete(s.q, k, axis=1), a.q, alone.is_revolute, alone.length_scale)
+    assert hinted >= 5

@@ -7,13 +7,13 @@ from functools import lru_cache
 
 from sweepik.errors import NoReductionError, SweepikError, UnknownOptionError
 from sweepik.model.robot import Robot
-from sweepik.reductions import decompose
+from sweepik.reductions import decompose, general
 from sweepik.reductions.base import Reduction
 from sweepik.reductions.carm import CArmD1, CArmTheta2
 from sweepik.reductions.decompose import choose
-from sweepik.reductions.general import GeneralReduction
+from sweepik.reductions.general import GeneralReduction, general_refusal
 from sweepik.reductions.generic import GeometricReduction, Plan
-from sweepik.reductions.plan import first_plan, position_plan
+from sweepik.reductions.plan import GENERAL, first_plan, position_plan
 
 __all__ = [
     "Reduction",
@@ -196,6 +196,8 @@ def automatic_for_held(
     ``vouch_held_plan`` vouched for at them is taken as ``first_plan`` would find it; at its special values, the plans
     vouched for are the hints, not those of the values solved before, so that the answer does not depend on them)."""
     key = (full, held)
+    if full.n_joints == 7 and len(held) == 1:
+        general.held_arm(arm, full, held[0])  # (its elimination's setup, if it needs one, takes a hint)
     entry = _VOUCHED.get(key)
     # (a joint whose plans are vouched for: they are the hints at its special values too, whatever was solved before)
     sigs = _HELD_PLANS.get(key, ()) if entry is None else entry[:2]
@@ -211,6 +213,8 @@ def automatic_for_held(
         plan, _ = decompose.choice(arm, None, hints)
         if plan in hints:  # (the other plan chosen with it, unchecked: a companion only adds solutions)
             comp = next((p for p in hints if p != plan), None)
+            if comp is None and plan_signature(GENERAL) in sigs and general_refusal(arm) is None:
+                comp = GENERAL  # (its setup takes the ranking found at the other values: ``general._setup``)
             if comp is None:  # (none remembered: this value's own choice, or its companion, as a second opinion)
                 comp = _own_second(arm, plan)
         else:

@@ -126,19 +126,24 @@ def fast_path(ik: GeneralIK) -> FastPath | None:
     return path if _agrees(ik, path, np.random.default_rng(11)) else None
 
 
-#: Random configurations on which the compiled path must give the full elimination's answer (``_agrees``).
+#: Random configurations on which the compiled path must give the full elimination's answer (``_agrees``) ...
 CHECK_POSES = 12
+#: ... or this many, where the arrangements' ranking was taken over from the same arm held at another value
+#: (``GeneralIK.hinted``: its compiled path passed the full check there).
+HINTED_CHECK_POSES = 4
 
 
 def _agrees(ik: GeneralIK, path: FastPath, rng: np.random.Generator) -> bool:
-    """The compiled path answers ``CHECK_POSES`` random poses of the arm with as many solutions as the full
-    elimination (``GeneralIK.solve``) where it answers at all. An arm whose three axes are parallel to a few
-    micrometres (the I2RT big YAM: joints 2-4 to 2.7e-6 rad) has pairs of roots 1e-4 apart in the eigen-joint that
-    the deflated pencil merged into one: 4 of 8 solutions at one random pose in 13, the full elimination all 8."""
-    q = rng.uniform(-np.pi, np.pi, (CHECK_POSES, 6))
-    q[:, ~ik.rev] = rng.uniform(-1.0, 1.0, (CHECK_POSES, int(np.sum(~ik.rev))))
-    world = np.empty((CHECK_POSES, 4, 4))
-    for k in range(CHECK_POSES):
+    """The compiled path answers ``CHECK_POSES`` (``HINTED_CHECK_POSES``) random poses of the arm with as many
+    solutions as the full elimination (``GeneralIK.solve``) where it answers at all. An arm whose three axes are
+    parallel to a few micrometres (the I2RT big YAM: joints 2-4 to 2.7e-6 rad) has pairs of roots 1e-4 apart in the
+    eigen-joint that the deflated pencil merged into one: 4 of 8 solutions at one random pose in 13, the full
+    elimination all 8."""
+    n = HINTED_CHECK_POSES if ik.hinted else CHECK_POSES
+    q = rng.uniform(-np.pi, np.pi, (n, 6))
+    q[:, ~ik.rev] = rng.uniform(-1.0, 1.0, (n, int(np.sum(~ik.rev))))
+    world = np.empty((n, 4, 4))
+    for k in range(n):
         R, p = _chain_fk(ik.H, ik.P, ik.rev, ik.R_end, q[k])
         world[k] = np.eye(4)
         world[k, :3, :3], world[k, :3, 3] = R, p * ik.scale

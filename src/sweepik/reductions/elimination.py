@@ -7,7 +7,8 @@ method, its arrangements and its failure modes: docs/decomposition.md, "The gene
 Input: a chain in product-of-exponentials form at q = 0 (``H (6, 3)`` joint axes, ``P (7, 3)`` link vectors,
 ``revolute (6,)``, ``R_end (3, 3)``: :class:`sweepik.model.chain.Chain`) and a target pose ``T (4, 4)`` in the same
 frame. ``GeneralIK(H, P, revolute, R_end)`` is the per-arm setup (every arrangement built, the unusable dropped, the
-rest ranked by trial solves); ``.solve(T) -> IKResult(q, continuum, info)``: the solutions, revolute angles wrapped
+rest ranked by trial solves; with ``prefer=``, another build's ``ranking``, its first three alone where the first
+passes the trial solves); ``.solve(T) -> IKResult(q, continuum, info)``: the solutions, revolute angles wrapped
 to (-pi, pi], each Newton-polished and checked by FK, and whether the pose is a continuum (then ``q`` holds the
 members found). :class:`ArmNotSupportedError` at setup when no arrangement is well posed for the arm.
 :mod:`sweepik.reductions.general` makes it a reduction.
@@ -946,6 +947,13 @@ def _reverse_chain(H, P, rev, R_end):
     return -(H[::-1] @ Rt.T), -(P[::-1] @ Rt.T), rev[::-1].copy(), Rt.copy()
 
 
+#: Every arrangement tried, ``(reversed, L, swapped)``: the chain or its reverse, the joint whose line is used, the
+#: family of splits (``_make_arrangement``, ``_make_swapped``).
+ARRANGEMENTS = tuple((r, L, sw) for r in (False, True) for L in (5, 4, 3) for sw in (False, True))
+#: Arrangements after the first that ``GeneralIK.solve`` asks for a second opinion on a suspicious pose.
+SECOND_OPINIONS = 2
+
+
 @dataclass
 class _Arrangement:
     """One way of splitting the loop (docs/decomposition.md): chain (maybe reversed), L = joint whose line is used,
@@ -990,6 +998,8 @@ class _Arrangement:
     b_inv: np.ndarray | None = None
     score: float = 0.0
     G: np.ndarray | None = None  # (3, 3, 3): per slot, node values -> monomial coefficients
+    key: int = -1  # (its index in ARRANGEMENTS)
+    trial_rcond: float = math.inf  # (the worst leading matrix's conditioning on the trial poses)
 
     def __post_init__(self):
         assert self.ops_slot[-1] == 0, "the eigen-joint's motion must be the V side's last (_pencil)"
@@ -1211,7 +1221,7 @@ FK_TOL = 1e-9
 class GeneralIK:
     """Per-arm setup (arrangements of the elimination, cached matrices) and the per-pose solve."""
 
-    def __init__(self, H, P, revolute, R_end, *, seed=12345, n_trial=6):
+    def __init__(self, H, P, revolute, R_end, *, seed=12345, n_trial=6, prefer=None):
         H = np.asarray(H, dtype=np.float64).reshape(6, 3)
         P = np.asarray(P, dtype=np.float64).reshape(7, 3)
         rev = np.asarray(revolute, dtype=bool).reshape(6)
@@ -1223,32 +1233,26 @@ class GeneralIK:
         rng = np.random.default_rng(seed)
         self._rng_b0 = rng.normal(size=12)
         self._phis = rng.uniform(-np.pi, np.pi, 8)
+        chains = {False: (self.H, self.P, rev, R_end), True: _reverse_chain(self.H, self.P, rev, R_end)}
+        self.hinted = False
+        if prefer:
+            # the ranking found for the same arm held at a reference value: its first arrangements alone (each from
+            # its own random stream), taken when the first of them answers every trial pose, as the best of the full
+            # ranking must
+            trial = np.random.default_rng((seed, len(ARRANGEMENTS)))
+            qs = trial.uniform(-np.pi, np.pi, (n_trial, 6))
+            qs[:, ~rev] = trial.uniform(-0.5, 0.5, (n_trial, int((~rev).sum())))
+            arrs = [a for a in (self._keyed(k, chains, seed) for k in prefer[: 1 + SECOND_OPINIONS]) if a is not None]
+            if arrs and self._misses(arrs[0], qs) == 0:
+                self.arrangements, self.hinted = arrs, True
+                return
         arrs = []
-        chains = [(False, (self.H, self.P, rev, R_end)), (True, _reverse_chain(self.H, self.P, rev, R_end))]
-        for reversed_, (h, p, r, re) in chains:
-            for L in (5, 4, 3):
-                a = _make_arrangement(
-                    np.ascontiguousarray(h),
-                    np.ascontiguousarray(p),
-                    r.copy(),
-                    np.ascontiguousarray(re),
-                    reversed_,
-                    L,
-                    rng,
-                )
-                if a is not None and a.q_cond > 1e-9:
-                    arrs.append(a)
-                a = _make_swapped(
-                    np.ascontiguousarray(h),
-                    np.ascontiguousarray(p),
-                    r.copy(),
-                    np.ascontiguousarray(re),
-                    reversed_,
-                    L,
-                    rng,
-                )
-                if a is not None:
-                    arrs.append(a)
+        for k, (reversed_, L, swapped) in enumerate(ARRANGEMENTS):
+            h, p, r, re = (np.ascontiguousarray(x) for x in chains[reversed_])
+            a = (_make_swapped if swapped else _make_arrangement)(h, p, r.copy(), re, reversed_, L, rng)
+            if a is not None and (swapped or a.q_cond > 1e-9):
+                a.key = k
+                arrs.append(a)
         arrs = [a for a in arrs if self._choose_kind(a, rng)]
         if not arrs:
             raise ArmNotSupportedError("no arrangement of the elimination is usable for this arm")
@@ -1256,19 +1260,42 @@ class GeneralIK:
         qs = rng.uniform(-np.pi, np.pi, (n_trial, 6))
         qs[:, ~rev] = rng.uniform(-0.5, 0.5, (n_trial, int((~rev).sum())))
         for a in arrs:
-            worst = a.q_cond
-            misses = 0
-            for q in qs:
-                RT, pT = _chain_fk(self.H, self.P, rev, R_end, q)
-                sols, info = self._solve_with(a, RT, pT)
-                worst = min(worst, info.get("a_rcond", 0.0))
-                if len(sols) == 0 or np.min(_dist(sols, q, rev)) > 1e-6:
-                    misses += 1
+            misses = self._misses(a, qs)
+            worst = min(a.q_cond, a.trial_rcond)
             # fewest misses first, then the best-conditioned leading matrix; the swapped family (per-pose SVD
             # of Q) is slightly slower, so it gives way to a pose-free one conditioned within a factor of 10
             a.score = -misses + 1e-3 * math.log10(max(worst, 1e-300)) - (1e-3 if a.swapped else 0.0)
         arrs.sort(key=lambda a: -a.score)
         self.arrangements = arrs
+
+    @property
+    def ranking(self) -> tuple[int, ...]:
+        """The arrangements in the order they are tried, as indices of ``ARRANGEMENTS`` (``prefer``'s form)."""
+        return tuple(a.key for a in self.arrangements)
+
+    def _keyed(self, k, chains, seed):
+        """Arrangement ``ARRANGEMENTS[k]`` of this arm with its matrix-polynomial construction chosen, from a random
+        stream of its own (the same whatever else is built), or None where it is unusable."""
+        reversed_, L, swapped = ARRANGEMENTS[k]
+        rng = np.random.default_rng((seed, k))
+        h, p, r, re = (np.ascontiguousarray(x) for x in chains[reversed_])
+        a = (_make_swapped if swapped else _make_arrangement)(h, p, r.copy(), re, reversed_, L, rng)
+        if a is None or (not swapped and a.q_cond <= 1e-9) or not self._choose_kind(a, rng):
+            return None
+        a.key = k
+        return a
+
+    def _misses(self, a, qs):
+        """Of the configurations ``qs``, how many arrangement ``a`` does not recover (the worst leading matrix's
+        conditioning seen: ``a.trial_rcond``)."""
+        misses, a.trial_rcond = 0, math.inf
+        for q in qs:
+            RT, pT = _chain_fk(self.H, self.P, self.rev, self.R_end, q)
+            sols, info = self._solve_with(a, RT, pT)
+            a.trial_rcond = min(a.trial_rcond, info.get("a_rcond", 0.0))
+            if len(sols) == 0 or np.min(_dist(sols, q, self.rev)) > 1e-6:
+                misses += 1
+        return misses
 
     def _choose_kind(self, a, rng):
         """Pick the matrix-polynomial construction for arrangement a (checked on a random pose: the polynomial
@@ -1575,8 +1602,7 @@ class GeneralIK:
             allsing = sing
             # up to two: a solution with a singular Jacobian (a double root) may have lost a near-double pair that
             # rounding made complex (an even count, every root polished: the I2RT big YAM's singular set)
-            n_more = 2
-            for a in self.arrangements[1 : 1 + n_more]:
+            for a in self.arrangements[1 : 1 + SECOND_OPINIONS]:
                 s2, i2 = self._solve_with(a, RT, pT)
                 infos.append(i2)
                 n_singular += i2.get("n_singular", 0)
