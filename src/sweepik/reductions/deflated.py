@@ -105,10 +105,11 @@ def deflation(ik: GeneralIK, a: _Arrangement, rng: np.random.Generator) -> tuple
 
 
 def fast_path(ik: GeneralIK) -> FastPath | None:
-    """The compiled path of ``ik``'s first arrangement, or None where it has none (not the standard construction
-    with a revolute eigen-joint, a swapped arrangement, or no deflation) or LAPACK is not at hand."""
-    a = ik.arrangements[0]
-    if not lapack.AVAILABLE or a.kind != "std" or a.swapped or a.slot_kind[0] != 1:
+    """The compiled path of ``ik``'s arrangement for it (``GeneralIK.fast``), or None where it has none (no
+    arrangement of the standard construction with a revolute eigen-joint, not swapped, recovers every trial pose, or
+    no deflation) or LAPACK is not at hand."""
+    a = ik.fast
+    if not lapack.AVAILABLE or a is None:
         return None
     defl = deflation(ik, a, np.random.default_rng(7))
     if defl is None:
@@ -135,10 +136,10 @@ HINTED_CHECK_POSES = 4
 
 def _agrees(ik: GeneralIK, path: FastPath, rng: np.random.Generator) -> bool:
     """The compiled path answers ``CHECK_POSES`` (``HINTED_CHECK_POSES``) random poses of the arm with as many
-    solutions as the full elimination (``GeneralIK.solve``) where it answers at all. An arm whose three axes are
-    parallel to a few micrometres (the I2RT big YAM: joints 2-4 to 2.7e-6 rad) has pairs of roots 1e-4 apart in the
-    eigen-joint that the deflated pencil merged into one: 4 of 8 solutions at one random pose in 13, the full
-    elimination all 8."""
+    solutions as the full elimination of its arrangement (``GeneralIK.count``) where it answers at all. An arm whose
+    three axes are parallel to a few micrometres (the I2RT big YAM: joints 2-4 to 2.7e-6 rad) has pairs of roots 1e-4
+    apart in the eigen-joint that the deflated pencil merged into one: 4 of 8 solutions at one random pose in 13, the
+    full elimination all 8."""
     n = HINTED_CHECK_POSES if ik.hinted else CHECK_POSES
     q = rng.uniform(-np.pi, np.pi, (n, 6))
     q[:, ~ik.rev] = rng.uniform(-1.0, 1.0, (n, int(np.sum(~ik.rev))))
@@ -149,7 +150,7 @@ def _agrees(ik: GeneralIK, path: FastPath, rng: np.random.Generator) -> bool:
         world[k, :3, :3], world[k, :3, 3] = R, p * ik.scale
     _, count = solve_poses(path, world, 16)
     for k in np.flatnonzero(count >= 0).tolist():
-        if ik.solve(world[k]).q.shape[0] != count[k]:
+        if ik.count(ik.fast, world[k]) != count[k]:
             return False
     return True
 

@@ -6,12 +6,12 @@ method, its arrangements and its failure modes: docs/decomposition.md, "The gene
 
 Input: a chain in product-of-exponentials form at q = 0 (``H (6, 3)`` joint axes, ``P (7, 3)`` link vectors,
 ``revolute (6,)``, ``R_end (3, 3)``: :class:`sweepik.model.chain.Chain`) and a target pose ``T (4, 4)`` in the same
-frame. ``GeneralIK(H, P, revolute, R_end)`` is the per-arm setup (every arrangement built, the unusable dropped, the
-rest ranked by trial solves; with ``prefer=``, another build's ``ranking``, its first three alone where the first
-passes the trial solves); ``.solve(T) -> IKResult(q, continuum, info)``: the solutions, revolute angles wrapped
-to (-pi, pi], each Newton-polished and checked by FK, and whether the pose is a continuum (then ``q`` holds the
-members found). :class:`ArmNotSupportedError` at setup when no arrangement is well posed for the arm.
-:mod:`sweepik.reductions.general` makes it a reduction.
+frame. ``GeneralIK(H, P, revolute, R_end)`` is the per-arm setup: every arrangement built, the unusable dropped, the
+rest ranked by trial solves, the compiled path's chosen (with ``prefer=``, another build's ``ranking``: its first
+three alone where the first passes the trial solves). ``.solve(T) -> IKResult(q, continuum, info)``: the solutions,
+revolute angles wrapped to (-pi, pi], each Newton-polished and checked by FK, and whether the pose is a continuum
+(then ``q`` holds the members found). :class:`ArmNotSupportedError` at setup when no arrangement is well posed for the
+arm. :mod:`sweepik.reductions.general` makes it a reduction.
 """
 
 from __future__ import annotations
@@ -1000,6 +1000,8 @@ class _Arrangement:
     G: np.ndarray | None = None  # (3, 3, 3): per slot, node values -> monomial coefficients
     key: int = -1  # (its index in ARRANGEMENTS)
     trial_rcond: float = math.inf  # (the worst leading matrix's conditioning on the trial poses)
+    trial_suspicious: int = 0  # (trial poses ``GeneralIK.solve`` would ask another arrangement about)
+    trial_misses: int = 0  # (trial configurations it did not recover)
 
     def __post_init__(self):
         assert self.ops_slot[-1] == 0, "the eigen-joint's motion must be the V side's last (_pencil)"
@@ -1242,9 +1244,16 @@ class GeneralIK:
             trial = np.random.default_rng((seed, len(ARRANGEMENTS)))
             qs = trial.uniform(-np.pi, np.pi, (n_trial, 6))
             qs[:, ~rev] = trial.uniform(-0.5, 0.5, (n_trial, int((~rev).sum())))
-            arrs = [a for a in (self._keyed(k, chains, seed) for k in prefer[: 1 + SECOND_OPINIONS]) if a is not None]
+            ranking, fast = prefer
+            arrs = [a for a in (self._keyed(k, chains, seed) for k in ranking[: 1 + SECOND_OPINIONS]) if a is not None]
             if arrs and self._misses(arrs[0], qs) == 0:
                 self.arrangements, self.hinted = arrs, True
+                mine = next((a for a in arrs if a.key == fast), None)
+                if mine is None and fast is not None:
+                    mine = self._keyed(fast, chains, seed)
+                    if mine is not None and mine is not arrs[0] and self._misses(mine, qs) != 0:
+                        mine = None
+                self.fast = mine if mine is not None and _compiled(mine) else None
                 return
         arrs = []
         for k, (reversed_, L, swapped) in enumerate(ARRANGEMENTS):
@@ -1265,13 +1274,26 @@ class GeneralIK:
             # fewest misses first, then the best-conditioned leading matrix; the swapped family (per-pose SVD
             # of Q) is slightly slower, so it gives way to a pose-free one conditioned within a factor of 10
             a.score = -misses + 1e-3 * math.log10(max(worst, 1e-300)) - (1e-3 if a.swapped else 0.0)
+            a.trial_misses = misses
         arrs.sort(key=lambda a: -a.score)
         self.arrangements = arrs
+        # the compiled path's (``deflated.fast_path``): the first, or where it finds most trial poses suspicious, of
+        # those that recover every one the one found suspicious at the fewest (the first of equals). ssik's xArm7
+        # held at joint 2 ranks first an arrangement suspicious at 5 of 6 trial poses, 3e-4 better conditioned than
+        # one at none: the compiled path handed nearly every pose to the full solve, which asked two more
+        # arrangements (1.2 ms a pose, 0.2 with the other). (The big YAM's first, suspicious at 2 of 6, stays: its
+        # compiled path elsewhere lost 2 of 50 configurations next to the singular set.)
+        first = arrs[0]
+        self.fast = first if _compiled(first) else None
+        if self.fast is not None and 2 * first.trial_suspicious > len(qs):
+            sound = [a for a in arrs if a.trial_misses == 0 and _compiled(a)]
+            self.fast = min(sound, key=lambda a: a.trial_suspicious) if sound else first
 
     @property
-    def ranking(self) -> tuple[int, ...]:
-        """The arrangements in the order they are tried, as indices of ``ARRANGEMENTS`` (``prefer``'s form)."""
-        return tuple(a.key for a in self.arrangements)
+    def ranking(self) -> tuple[tuple[int, ...], int | None]:
+        """``prefer``'s form: the arrangements in the order they are tried, and the compiled path's (``fast``), as
+        indices of ``ARRANGEMENTS``."""
+        return tuple(a.key for a in self.arrangements), None if self.fast is None else self.fast.key
 
     def _keyed(self, k, chains, seed):
         """Arrangement ``ARRANGEMENTS[k]`` of this arm with its matrix-polynomial construction chosen, from a random
@@ -1287,12 +1309,13 @@ class GeneralIK:
 
     def _misses(self, a, qs):
         """Of the configurations ``qs``, how many arrangement ``a`` does not recover (the worst leading matrix's
-        conditioning seen: ``a.trial_rcond``)."""
-        misses, a.trial_rcond = 0, math.inf
+        conditioning seen: ``a.trial_rcond``; the poses ``solve`` would find suspicious: ``a.trial_suspicious``)."""
+        misses, a.trial_rcond, a.trial_suspicious = 0, math.inf, 0
         for q in qs:
             RT, pT = _chain_fk(self.H, self.P, self.rev, self.R_end, q)
             sols, info = self._solve_with(a, RT, pT)
             a.trial_rcond = min(a.trial_rcond, info.get("a_rcond", 0.0))
+            a.trial_suspicious += _suspicious(sols, info)
             if len(sols) == 0 or np.min(_dist(sols, q, self.rev)) > 1e-6:
                 misses += 1
         return misses
@@ -1584,21 +1607,26 @@ class GeneralIK:
                 out.append(q)
         return out
 
+    def count(self, a, T) -> int:
+        """How many solutions of the pose ``T`` arrangement ``a`` finds where it finds nothing suspicious
+        (``_suspicious``), else how many ``solve`` gives: ``solve``'s count where ``a`` is the first."""
+        T = np.asarray(T, dtype=np.float64)
+        sols, info = self._solve_with(a, np.ascontiguousarray(T[:3, :3]), np.ascontiguousarray(T[:3, 3] / self.scale))
+        return self.solve(T).q.shape[0] if _suspicious(sols, info) else len(sols)
+
     def solve(self, T) -> IKResult:
         T = np.asarray(T, dtype=np.float64)
         RT = np.ascontiguousarray(T[:3, :3])
         pT = np.ascontiguousarray(T[:3, 3] / self.scale)
         sols, info = self._solve_with(self.arrangements[0], RT, pT)
         infos = [info]
-        # triggers for a second opinion from another arrangement: singular pencil, a real root that did not
-        # polish, an odd number of solutions (the real roots of a real polynomial come in an even number:
-        # odd means a double root or a lost one), or none (a pose whose only roots are a double one, on the singular
-        # set, can lose it as a complex pair: the big YAM exactly on its singular set was answered unreachable)
+        # a suspicious answer asks another arrangement (``_suspicious``; none among them: a pose whose only roots are
+        # a double one, on the singular set, can lose it as a complex pair: the big YAM exactly on its singular set
+        # was answered unreachable)
         sing = info.get("singular_pencil", False)
         n_singular = info.get("n_singular", 0)
-        suspicious = sing or info["n_real_fail"] > 0 or len(sols) % 2 == 1 or n_singular > 0 or len(sols) == 0
         continuum = False
-        if suspicious:
+        if _suspicious(sols, info):
             allsing = sing
             # up to two: a solution with a singular Jacobian (a double root) may have lost a near-double pair that
             # rounding made complex (an even count, every root polished: the I2RT big YAM's singular set)
@@ -1626,6 +1654,25 @@ class GeneralIK:
         out = np.array(sols, dtype=np.float64).reshape(-1, 6)
         out[:, ~self.rev] *= self.scale
         return IKResult(out, continuum, {"tries": infos})
+
+
+def _compiled(a):
+    """Whether arrangement ``a`` has a compiled path (:mod:`.deflated`): the standard construction, not swapped,
+    a revolute eigen-joint."""
+    return a.kind == "std" and not a.swapped and a.slot_kind[0] == 1
+
+
+def _suspicious(sols, info):
+    """Whether an arrangement's answer ``sols`` (its ``info``) asks another arrangement (``GeneralIK.solve``): a
+    singular pencil, a real root that did not polish, an odd number of solutions (the real roots of a real
+    polynomial come in an even number: odd means a double root or a lost one), a singular solution, or none."""
+    return bool(
+        info.get("singular_pencil", False)
+        or info["n_real_fail"] > 0
+        or len(sols) % 2 == 1
+        or info.get("n_singular", 0) > 0
+        or len(sols) == 0
+    )
 
 
 #: A root at a singular configuration (LU pivot ratio under ``SPLIT_PIVOT``) that the polish leaves missing the pose

@@ -56,7 +56,7 @@ def held_arm(arm: Robot, full: Robot, joint: int) -> None:
 
 
 @lru_cache(maxsize=64)
-def held_ranking(full: Robot, joint: int) -> tuple[int, ...] | None:
+def held_ranking(full: Robot, joint: int) -> tuple[tuple[int, ...], int | None] | None:
     """The ranking of the elimination's arrangements (``GeneralIK.ranking``) of ``full`` held at the reference value
     of revolute ``joint`` (``REFERENCE`` of its range cut to one turn), or None (a prismatic joint, no range, or the
     general method not well posed there). Every value of the joint tries it first: the same hint whatever was solved
