@@ -630,10 +630,14 @@ def _settle_stepwise(
         # next to a fold of the solution set: a certified solution above rounding on a valley's slope moved to its
         # bottom (a closed form's root just off a fold, imprecise; a sweep's polish stopping in a valley); a sweep's
         # polished solution's close partner across the fold
-        valley = np.union1d(probed, np.flatnonzero((err_geo > valley_above) & (err_geo <= accept)))
-        pose_idx, q, mult, err_geo, err_paper = next_to_folds(
-            robot, poses, pose_idx, q, mult, err_geo, err_paper, valley, probed
-        )
+        valley = (err_geo > valley_above) & (err_geo <= accept)
+        valley[probed] = True
+        if valley.any():
+            probed_mask = np.zeros(q.shape[0], dtype=bool)
+            probed_mask[probed] = True
+            pose_idx, q, mult, err_geo, err_paper = next_to_folds(
+                robot, poses, pose_idx, q, mult, err_geo, err_paper, np.flatnonzero(valley), probed_mask
+            )
     if strategy == "precise":
         certified = err_geo <= accept
     else:

@@ -247,12 +247,12 @@ def next_to_folds(
     err_geo: Array,
     err_paper: Array,
     rows: NDArray[np.intp],
-    probed: NDArray[np.intp],
+    probed: NDArray[np.bool_],
 ) -> tuple[NDArray[np.intp], Array, NDArray[np.intp], Array, Array]:
     """Certified solutions next to a fold of the solution set (:mod:`.partners`): those of ``rows`` in a flat valley
     moved to its bottom (in place; never out of the limits, as the polish's drift), and a close partner on the far
-    side of the fold of those of ``probed`` (the polish gave them) added after the solution it was found from (a
-    pose's rows stay together): the candidates ``(pose_idx, q, mult, err_geo, err_paper)``."""
+    side of the fold of those ``probed`` marks (one entry a candidate: the polish gave them) added after the solution
+    it was found from (a pose's rows stay together): the candidates ``(pose_idx, q, mult, err_geo, err_paper)``."""
     if rows.size:  # (only nearly singular ones: most are not)
         rows = rows[nearly_singular(robot, q[rows])]
     if rows.size == 0:
@@ -265,7 +265,7 @@ def next_to_folds(
         m = rows[moved]
         q[m] = q_v[moved]
         err_geo[m], err_paper[m] = errors_of(robot, q[m], poses[pose_idx[m]], weight)
-    rows = rows[np.isin(rows, probed)]
+    rows = rows[probed[rows]]
     # each distinct one once, and none of a pose with more of them than an arm has solutions (a numerical continuum,
     # along which no partner is taken)
     distinct = rows[finish(robot, pose_idx[rows], q[rows], err_geo[rows])[2]]
