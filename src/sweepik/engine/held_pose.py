@@ -46,7 +46,7 @@ from sweepik.engine.single_pose import SinglePose, answer, not_rigid, pose_row, 
 from sweepik.model.chain import Chain, rotation_about
 from sweepik.model.origin_axis import hold_joints
 from sweepik.model.robot import Robot
-from sweepik.reductions import GeometricReduction, Plan, Reduction, vouch_held_plan
+from sweepik.reductions import GeometricReduction, Plan, Reduction, general, vouch_held_plan
 from sweepik.reductions.geometric import LAYOUT
 from sweepik.reductions.kernels import lazy_njit
 from sweepik.results import Block, Solutions
@@ -57,8 +57,9 @@ __all__ = ["HeldPose", "REFERENCES", "SPECIAL", "at_turn", "references"]
 Array = NDArray[np.float64]
 
 #: Where in the held joint's range (a revolute one's cut to one turn) the plan is checked: five values, none at the
-#: middle or an end (a symmetric range's 0 and +-pi/2 are where axes of many arms line up).
-REFERENCES = (0.0731, 0.2689, 0.4623, 0.6571, 0.8817)
+#: middle or an end (a symmetric range's 0 and +-pi/2 are where axes of many arms line up); the first is where a held
+#: arm that takes the general method ranks its elimination's arrangements (``reductions.general.REFERENCE``).
+REFERENCES = (general.REFERENCE, 0.2689, 0.4623, 0.6571, 0.8817)
 #: The parameter row, chain and tool vectors built here equal the held arm's to this, times the length scale.
 MATCH_REL = 1e-12
 #: ``HeldPose.solve``'s status for a value in its ``windows`` (the general way answers).

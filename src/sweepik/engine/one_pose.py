@@ -138,7 +138,7 @@ def _settled(settle, q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyon
         q, eg, ep, pose, mult, thr, lrev, lower, upper, ltol, beyond, reach, tol, scale, due, rows, w, score,
         inside, keep, ints[0:2], ints[2:3], 0, 1,
     )  # fmt: skip
-    for a in range(ints[2]):  # (the others are above the polish's floor, thr[1], and due already)
+    for a in range(ints[2]):  # (certified, not due: at most thr[1], the polish's floor, or on the paper's J)
         if due[0]:
             break
         k = rows[a]

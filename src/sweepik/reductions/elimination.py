@@ -1277,8 +1277,9 @@ class GeneralIK:
             a.trial_misses = misses
         arrs.sort(key=lambda a: -a.score)
         self.arrangements = arrs
-        # the compiled path's (``deflated.fast_path``): the first, or where it finds most trial poses suspicious, of
-        # those that recover every one the one found suspicious at the fewest (the first of equals). ssik's xArm7
+        # the compiled path's arrangement (``deflated.fast_path``): the first; where that one finds most trial poses
+        # suspicious, the one found suspicious at the fewest of those that recover every trial configuration (the
+        # first of equals). ssik's xArm7
         # held at joint 2 ranks first an arrangement suspicious at 5 of 6 trial poses, 3e-4 better conditioned than
         # one at none: the compiled path handed nearly every pose to the full solve, which asked two more
         # arrangements (1.2 ms a pose, 0.2 with the other). (The big YAM's first, suspicious at 2 of 6, stays: its

@@ -43,7 +43,8 @@ __all__ = ["GeneralReduction", "MAX_SOLUTIONS", "general_refusal"]
 #: tries the ranking found at a reference value of that joint first (``held_ranking``). Bounded, as the caches.
 _HELD_FROM: OrderedDict[Robot, tuple[Robot, int]] = OrderedDict()
 _HELD_KEPT = 256
-#: Where in the held joint's range (cut to one turn) its reference value lies (``engine.held_pose.REFERENCES[0]``).
+#: Where in the held joint's range (cut to one turn) its reference value lies (the first of
+#: ``engine.held_pose.REFERENCES``, where a held arm's plan is checked first).
 REFERENCE = 0.0731
 
 
