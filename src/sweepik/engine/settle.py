@@ -51,7 +51,7 @@ def settle_bounds(robot: Robot) -> tuple[float, float, float, float, float, floa
     """The precise strategy's thresholds, absolute (times the arm's length scale): polish below, polish above, polish
     above on the paper's J, acceptance, polish below for a multiple root's candidate, a valley's slope above
     (``POLISH_BELOW_REL`` ... ``ACCEPT_TOL_REL``, ``POLISH_MULTIPLE_REL``, ``VALLEY_ABOVE_REL``); the stepwise path
-    and ``dedupe.settle`` take the same values."""
+    and ``dedupe.settle`` take the same values (the last: the one-pose kernels and ``chunk._settled_rows``)."""
     ls = robot.length_scale
     return (
         POLISH_BELOW_REL * ls,

@@ -1249,9 +1249,9 @@ class GeneralIK:
             if arrs and self._misses(arrs[0], qs) == 0:
                 self.arrangements, self.hinted = arrs, True
                 mine = next((a for a in arrs if a.key == fast), None)
-                if mine is None and fast is not None:
+                if mine is None and fast is not None:  # (built alone, it must recover the trial configurations too)
                     mine = self._keyed(fast, chains, seed)
-                    if mine is not None and mine is not arrs[0] and self._misses(mine, qs) != 0:
+                    if mine is not None and self._misses(mine, qs) != 0:
                         mine = None
                 self.fast = mine if mine is not None and _compiled(mine) else None
                 return
