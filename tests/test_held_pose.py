@@ -208,6 +208,41 @@ def test_values_just_outside_the_windows_are_the_held_arm(name: str, joint: str)
     assert answered >= 1  # (the others, badly conditioned there, went the general way)
 
 
+def test_a_window_chooses_the_companion_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Values in one window of the Panda held at joint 6 (a nearly parallel pair of axes round 0, where the general
+    way joins a second plan to the one vouched for): every plan is checked once for the window, at its reference
+    value, not at each value (0.2-0.6 s a value before); the solutions reach the pose and recover the configuration
+    they were made from, and do not depend on the value of the window solved first."""
+    from sweepik import reductions
+    from sweepik.reductions import decompose
+
+    robot = load_robot("franka_panda")
+    k = 5
+    fast = solving._held_pose(robot, k)
+    assert fast is not None
+    lo, hi = next((a, b) for a, b in fast.windows if a < 0.0 < b)
+    values = [lo + f * (hi - lo) for f in (0.15, 0.45, 0.8, 0.6)]
+    rng = np.random.default_rng(5)
+    q = in_limit_configurations(robot, len(values), rng)
+    q[:, k] = values
+    full = []
+    real = decompose.choice
+    monkeypatch.setattr(decompose, "choice", lambda arm, *a, **kw: full.append((arm, a[1:])) or real(arm, *a, **kw))
+    answers = {}
+    for order in (slice(None), slice(None, None, -1)):
+        reductions._WINDOW_CHOICES.clear()
+        solving._default_reduction.cache_clear()
+        full.clear()
+        for qq, T in list(zip(q, robot.fk(q), strict=True))[order]:
+            sol = sweepik.solve(robot, T, locked={k: float(qq[k])})
+            fk_ok(robot, sol, T)
+            assert recovers(robot, sol, qq)
+            answers.setdefault(float(qq[k]), []).append(sol)
+        assert len({id(arm) for arm, hints in full if not hints or not hints[0]}) == 1  # (the window's, once)
+    for first, second in answers.values():
+        np.testing.assert_array_equal(first.q, second.q)
+
+
 def test_values_are_checked_as_before() -> None:
     """A value outside the limits or not finite: the same LockedJointError as the held arm's."""
     robot = load_robot("kuka_iiwa14")

@@ -3,7 +3,8 @@
 Properties: outside the windows (random values, and values a grid step past each window's edges) the held arm has
 no near-structure and the structure of every other value; inside, at its centre, it has one or the other; the
 windows of an arm rewritten (zeros moved, axes reversed, frames) are the original's mapped; the held chain built
-from the value is the held arm's; ``in_windows`` takes a value in any turn.
+from the value is the held arm's; ``in_windows`` takes a value in any turn; ``window_reference`` is one value of
+the window, the same for every value in it.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import pytest
 from rewrites import rewrite
 
 from sweepik import load_robot, solving
-from sweepik.engine.lock_windows import GRID_STEP, in_windows
+from sweepik.engine.lock_windows import GRID_STEP, in_windows, window_reference
 from sweepik.model.origin_axis import hold_joints
 from sweepik.model.structure import near_structure, structure_of
 
@@ -88,6 +89,30 @@ def test_in_windows_takes_any_turn() -> None:
     for v in (0.01, 1.0, -2.0, 3.1, 2 * math.pi + 0.01):
         assert not in_windows(v, fast.windows)
     assert not in_windows(0.0, np.zeros((0, 2)))
+
+
+def test_a_window_has_one_reference_value() -> None:
+    """Every value of a window (any turn; the window round +-pi is one) names the same reference value, which lies
+    in that window off its middle; values outside every window name none."""
+    fast = solving._held_pose(load_robot("franka_panda"), 5)
+    assert fast is not None
+    w = fast.windows
+    assert w[0, 0] == -math.inf and w[-1, 1] == math.inf  # (a window round +-pi)
+    rng = np.random.default_rng(3)
+    refs = set()
+    for lo, hi in w:
+        a, b = (w[-1, 0], w[0, 1] + 2 * math.pi) if lo == -math.inf or hi == math.inf else (lo, hi)
+        values = np.r_[a + 1e-3 * (b - a), b - 1e-3 * (b - a), rng.uniform(a, b, 6)]
+        found = {window_reference(float(v) + t, w) for v in values for t in (0.0, 2 * math.pi, -4 * math.pi)}
+        assert len(found) == 1
+        ref = found.pop()
+        assert ref is not None and in_windows(ref, w)
+        assert abs(math.remainder(ref - 0.5 * (a + b), 2 * math.pi)) > 0.1 * (b - a)
+        refs.add(ref)
+    assert len(refs) == w.shape[0] - 1  # (the window round +-pi counted once)
+    for v in (0.01, 1.0, 3.0, -3.0 + 2 * math.pi):
+        assert not in_windows(v, w) and window_reference(v, w) is None
+    assert window_reference(0.0, np.zeros((0, 2))) is None
 
 
 @pytest.mark.parametrize("k", [1, 3, 5])

@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 from sweepik.engine.chunk import one_block, resumed
 from sweepik.engine.companion import joined
 from sweepik.engine.held_pose import SPECIAL, HeldPose, at_turn, references
-from sweepik.engine.lock_windows import in_windows, special_windows
+from sweepik.engine.lock_windows import in_windows, special_windows, window_reference
 from sweepik.engine.one_pose import DUE, OK
 from sweepik.engine.single_pose import SinglePose, settles
 from sweepik.model.origin_axis import HeldJoints, hold_joints
@@ -114,12 +114,17 @@ class HeldJoined:
         if any(in_windows(v, windows) for v in values):
             return None
         out = cls(pair, made[0], made[1], windows)
-        vouch_held_plan(robot, (k,), pair[0], out.special, companion=pair[1])
+        vouch_held_plan(robot, (k,), pair[0], out.window_reference, companion=pair[1])
         return out
 
     def special(self, value: float) -> bool:
         """Whether ``value`` is in ``windows`` (the held arm there may be another arm)."""
         return in_windows(value, self.windows)
+
+    def window_reference(self, value: float) -> float | None:
+        """The reference value of the window of ``windows`` that holds ``value``, None outside them
+        (``lock_windows.window_reference``)."""
+        return window_reference(value, self.windows)
 
     def joined(self, pose: Array, value: float, limits: bool) -> Block | int:
         """The block of ``pose`` (checked, C-contiguous, writable) at ``value``: both calls' answers joined; else the

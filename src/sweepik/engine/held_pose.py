@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 
 from sweepik._jit import inlined, writable
 from sweepik.engine import search
-from sweepik.engine.lock_windows import in_windows, special_windows
+from sweepik.engine.lock_windows import in_windows, special_windows, window_reference
 from sweepik.engine.one_pose import OK, SETTLE_CLOSED_SIG, SETTLE_ONE_SIG, every_branch_settled
 from sweepik.engine.settings import MAX_ISOLATED_SOLUTIONS
 from sweepik.engine.single_pose import SinglePose, answer, not_rigid, pose_row, rigid_pose, swept_settled
@@ -327,12 +327,17 @@ class HeldPose:
             return None
         made.windows = windows
         plan = found[0][1].plan  # (the general way builds it at a new value as it is: ``vouch_held_plan``)
-        vouch_held_plan(robot, (k,), (plan.family, plan.reversed, plan.free, plan.case), made.special)
+        vouch_held_plan(robot, (k,), (plan.family, plan.reversed, plan.free, plan.case), made.window_reference)
         return made
 
     def special(self, value: float) -> bool:
         """Whether ``value`` is in ``windows`` (the held arm there may be another arm)."""
         return in_windows(value, self.windows)
+
+    def window_reference(self, value: float) -> float | None:
+        """The reference value of the window of ``windows`` that holds ``value``, None outside them
+        (``lock_windows.window_reference``)."""
+        return window_reference(value, self.windows)
 
     def plan_at(self, value: float) -> Plan:
         """The held arm's plan at ``value`` (not in ``windows``): the references' with the wrist centre and meeting

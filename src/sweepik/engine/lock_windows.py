@@ -40,7 +40,7 @@ from sweepik.model.structure import (
     structure_of,
 )
 
-__all__ = ["special_windows", "in_windows", "GRID_STEP"]
+__all__ = ["special_windows", "in_windows", "window_reference", "GRID_STEP", "REFERENCE_AT"]
 
 Array = NDArray[np.float64]
 
@@ -52,6 +52,9 @@ GRID_STEP = NEAR_TOL / 4.0
 SAME_DISTANCE_REL = 1e-3
 #: A value marked for its plan alone (step 3) is taken within this of it.
 EXACT_WINDOW = 1e-6
+#: A window's reference value (``window_reference``) lies this fraction of its width from its start: off the special
+#: value at its middle, where the held arm may be another arm.
+REFERENCE_AT = 0.3
 
 
 def _relations(structure: Structure) -> tuple[Any, ...]:
@@ -153,3 +156,21 @@ def in_windows(value: float, windows: Array) -> bool:
     v = math.remainder(value, 2.0 * math.pi)
     i = int(np.searchsorted(windows[:, 0], v, side="right")) - 1
     return bool(i >= 0 and v <= windows[i, 1])
+
+
+def window_reference(value: float, windows: Array) -> float | None:
+    """The reference value of the window of ``windows`` that holds ``value`` (radians, any turn), None where none
+    does: a fixed value in it (``REFERENCE_AT`` of its width from its start, in ``[-pi, pi]``), the same for every
+    value in the window, at which what the window's values share can be chosen once (``reductions``'
+    ``automatic_for_held``: the companion of the plan vouched for). A window that goes round (ends at -inf and inf)
+    is one window."""
+    if not in_windows(value, windows):
+        return None
+    v = math.remainder(value, 2.0 * math.pi)
+    i = int(np.searchsorted(windows[:, 0], v, side="right")) - 1
+    lo, hi = float(windows[i, 0]), float(windows[i, 1])
+    if lo == -math.inf:  # (its start is the last window's, a turn before)
+        lo = float(windows[-1, 0]) - 2.0 * math.pi if windows[-1, 1] == math.inf else -math.pi
+    if hi == math.inf:
+        hi = float(windows[0, 1]) + 2.0 * math.pi if windows[0, 0] == -math.inf else math.pi
+    return math.remainder(lo + REFERENCE_AT * (hi - lo), 2.0 * math.pi)

@@ -5,7 +5,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from functools import lru_cache
 
-from sweepik.errors import NoReductionError, SweepikError, UnknownOptionError
+from sweepik.errors import LockedJointError, NoReductionError, SweepikError, UnknownOptionError
+from sweepik.model.origin_axis import hold_joints
 from sweepik.model.robot import Robot
 from sweepik.reductions import decompose, general
 from sweepik.reductions.base import Reduction
@@ -123,29 +124,36 @@ def plan_signature(plan: Plan) -> PlanSignature:
 
 
 #: Plans that hold at every value of a held joint but a few (``engine.held_pose``), by (full arm, held joints): the
-#: plan's signature, its companion's (or None) and the test of the values where they may not (``vouch_held_plan``).
-_VOUCHED: dict[tuple[Robot, tuple[int, ...]], tuple[PlanSignature, PlanSignature | None, Callable[[float], bool]]] = {}
+#: plan's signature, its companion's (or None) and the windows of values where they may not (``vouch_held_plan``).
+_VOUCHED: dict[
+    tuple[Robot, tuple[int, ...]], tuple[PlanSignature, PlanSignature | None, Callable[[float], float | None]]
+] = {}
+#: What the plan choice of a held arm found at a window's reference value (``_window_second``), by (full arm, held
+#: joints, reference value): its plan's signature and its companion's (None: none; the plan None: no plan).
+_WINDOW_CHOICES: dict[tuple[Robot, tuple[int, ...], float], tuple[PlanSignature | None, PlanSignature | None]] = {}
 
 
 def vouch_held_plan(
     full: Robot,
     held: tuple[int, ...],
     sig: PlanSignature,
-    special: Callable[[float], bool],
+    window: Callable[[float], float | None],
     companion: PlanSignature | None = None,
 ) -> None:
     """``full`` with the joints ``held`` locked is the plan ``sig`` (a ``wrist`` or ``pair`` plan's family, chain,
-    theta* and case) at every value where ``special(value)`` is False, and that plan is the first without a blind
-    spot there (``engine.held_pose`` checked it): ``automatic_for_held`` then builds that plan at a new value
-    (``position_plan``) instead of finding it again (``first_plan``, the near-structure and continuum checks: 1-4 ms),
-    with the same outcome. With ``companion``: a held arm with a near-structure solved by ``sig`` and that companion
-    at every such value (``engine.held_joined`` checked both at five values and where axes turn perpendicular), taken
-    as they are instead of checked again (every plan at a value seen first, or the short check of the plan chosen
-    before: 5-10 ms a value on the Kinova Gen3)."""
+    theta* and case) at every value outside a few windows (``window(value)``: the reference value of the window
+    holding ``value``, ``engine.lock_windows.window_reference``; None outside them), and that plan is the first
+    without a blind spot there (``engine.held_pose`` checked it): ``automatic_for_held`` then builds that plan at a
+    new value (``position_plan``) instead of finding it again (``first_plan``, the near-structure and continuum
+    checks: 1-4 ms), with the same outcome; inside a window, the second opinion it joins is chosen once, at the
+    window's reference value (``_window_second``). With ``companion``: a held arm with a near-structure solved by
+    ``sig`` and that companion at every such value (``engine.held_joined`` checked both at five values and where axes
+    turn perpendicular), taken as they are instead of checked again (every plan at a value seen first, or the short
+    check of the plan chosen before: 5-10 ms a value on the Kinova Gen3)."""
     if sig[0] in ("wrist", "pair") and (companion is None or companion[0] in ("wrist", "pair")):
         if len(_VOUCHED) > 256:  # (bounded, as the caches around it)
             _VOUCHED.clear()
-        _VOUCHED[(full, held)] = (sig, companion, special)
+        _VOUCHED[(full, held)] = (sig, companion, window)
 
 
 def _vouched(
@@ -154,7 +162,7 @@ def _vouched(
     """The plan ``vouch_held_plan`` vouched for at these ``values`` (one held joint), and its companion (None: none
     vouched for); None where none was, the value is one of its special ones, or a plan does not apply."""
     entry = _VOUCHED.get((full, held))
-    if entry is None or values is None or len(values) != 1 or entry[2](values[0]):
+    if entry is None or values is None or len(values) != 1 or entry[2](values[0]) is not None:
         return None
     plan = position_plan(arm, *entry[0])
     if plan is None or entry[1] is None:
@@ -216,7 +224,8 @@ def automatic_for_held(
             if comp is None and plan_signature(GENERAL) in sigs and general_refusal(arm) is None:
                 comp = GENERAL  # (its setup takes the ranking found at the other values: ``general._setup``)
             if comp is None:  # (none remembered: this value's own choice, or its companion, as a second opinion)
-                comp = _own_second(arm, plan)
+                ref = None if entry is None or values is None or len(values) != 1 else entry[2](values[0])
+                comp = _own_second(arm, plan) if ref is None else _window_second(full, held, arm, plan, ref)
         else:
             comp = decompose.companion_plan(arm)
     red = paired_reduction(arm, plan, comp)
@@ -236,6 +245,40 @@ def _own_second(arm: Robot, plan: Plan) -> Plan | None:
     except NoReductionError:
         return None
     return own if own != plan else decompose.companion_plan(arm)
+
+
+def _window_second(full: Robot, held: tuple[int, ...], arm: Robot, plan: Plan, ref: float) -> Plan | None:
+    """``_own_second`` at a value in a window of a vouched plan, chosen once for the window: at its reference value
+    ``ref`` (``vouch_held_plan``), every plan checked there, and the plan that choice takes (or its companion, where
+    that is ``plan``) built at this value. Each value in a window chose its own (8 plans checked, 0.2-0.6 s a value on
+    the Panda held at joint 6); the choice at a fixed value keeps the answer independent of the values solved
+    before. This value's own choice where the one at ``ref`` does not apply here (or ``ref`` is outside the
+    limits)."""
+    key = (full, held, ref)
+    found = _WINDOW_CHOICES.get(key)
+    if found is None:
+        try:
+            at_ref = hold_joints(full, {held[0]: ref}).arm
+        except LockedJointError:
+            return _own_second(arm, plan)
+        try:
+            own, _ = decompose.choice(at_ref, None)
+        except NoReductionError:
+            found = (None, None)
+        else:
+            comp = decompose.companion_plan(at_ref)
+            found = (plan_signature(own), None if comp is None else plan_signature(comp))
+        if len(_WINDOW_CHOICES) > 256:  # (bounded, as the caches around it)
+            _WINDOW_CHOICES.clear()
+        _WINDOW_CHOICES[key] = found
+    own_sig, comp_sig = found
+    second = own_sig if own_sig != plan_signature(plan) else comp_sig
+    if second is None:
+        return None
+    if second == plan_signature(GENERAL):
+        return GENERAL if general_refusal(arm) is None else None
+    built = position_plan(arm, *second) if second[0] in ("wrist", "pair") else None
+    return built if built is not None else _own_second(arm, plan)
 
 
 def first_held_reduction(arm: Robot) -> Reduction | None:
