@@ -7,12 +7,14 @@ independent reduction (the hand-written carm-theta2, which sweeps theta2) and by
 from __future__ import annotations
 
 import copy
+import time
 import tomllib
 from importlib import resources
 
 import numpy as np
 import pytest
 from oracles import numpy_engine
+from singular import recovered
 
 from sweepik import SweepikError, load_robot, solve, solve_many
 from sweepik.engine.chunk import chain_poses as _chain_poses
@@ -363,3 +365,34 @@ def test_compiled_trace_follows_the_reference() -> None:
             assert np.all(err <= tol)
     finally:
         cont._BUFFER = buffer
+
+
+@pytest.mark.parametrize(
+    ("name", "k", "q", "limits"),
+    [
+        ("kuka_iiwa14", 0, (0.2, 0.3, 0.4, 0.0, -0.5, 0.0, 1.0), True),
+        ("kuka_iiwa14", 0, (0.2, 0.3, 0.4, 0.0, -0.5, 0.0, 1.0), False),
+        ("franka_panda", 5, (0.0, 0.0, 0.0, 0.0, 0.0, 0.5, 0.0), True),
+    ],
+)
+def test_a_self_motion_of_two_dimensions_is_answered(
+    name: str, k: int, q: tuple[float, ...], limits: bool
+) -> None:  # fmt: skip
+    """Three axes on one line, a self-motion of two dimensions (any share of their angles' sum): a Kuka iiwa held at
+    A1 with A4 and A6 at 0 (axes 3, 5 and 7), a Panda held at joint 6 with joints 2 and 4 at 0 (axes 1, 3 and 5; joint
+    4 outside its limits). Each of the sweep's candidates lay on a curve of it of its own: each was traced and the
+    seeds left filtered against every family traced before (the Panda's: more than 25 minutes). Now seconds
+    (``settings.MAX_TRACES``; the bound here only catches a hang): every solution and family member reaches the pose,
+    and the configuration is recovered where it is inside the limits."""
+    robot = load_robot(name)
+    qq = np.array(q)
+    T = robot.fk(qq)
+    start = time.perf_counter()
+    sol = solve(robot, T, locked={k: q[k]}, limits=limits)
+    assert time.perf_counter() - start < 120.0
+    tol = 1e-9 * robot.length_scale
+    assert len(sol) == 0 or pose_error_geodesic(robot.fk(sol.q), T, 1.0).max() <= tol
+    for f in sol.families:
+        assert pose_error_geodesic(robot.fk(f.at(np.linspace(*f.interval, 5))), T, 1.0).max() <= tol
+    if robot.within_limits(qq) or not limits:
+        assert recovered(robot, sol, qq)

@@ -30,6 +30,7 @@ from sweepik.engine.polish import polished, pose_and_jacobian
 from sweepik.engine.search import PARALLEL_MIN
 from sweepik.engine.settings import (
     BACKTRACK,
+    MAX_TRACES,
     PINV_RCOND,
     PROBE_ERROR,
     PROBE_STEP,
@@ -431,7 +432,8 @@ def continuum_families(
     poses ``world``), each along its ``joint (K,)``: ``(families per pose, pose index, q)`` as ``families_of`` gives
     them (pieces that shrink to a point, at the limits, as isolated members). A configuration on a family already
     traced from another of its pose is not traced again; one that cannot be followed (an isolated solution) gives
-    nothing."""
+    nothing. At most ``MAX_TRACES`` families are traced a pose and joint (more: a self-motion of two or more
+    dimensions, of which the families are curves)."""
     out: dict[int, list[Family]] = {}
     iso_p: list[IntArray] = [np.zeros(0, dtype=np.intp)]
     iso_q: list[Array] = [np.zeros((0, robot.n_joints))]
@@ -441,7 +443,8 @@ def continuum_families(
         ks = np.nonzero(joint == j)[0]
         for i in np.unique(pose[ks]).tolist():
             left = q[ks[pose[ks] == i]]
-            while left.shape[0]:
+            traces = 0
+            while left.shape[0] and traces < MAX_TRACES:
                 # onto the solution set first, a few at a time (a candidate where the closed form leaves j free is
                 # rough; a pose on a continuum can have thousands, most of them on the first family traced)
                 head = left[:SEED_BATCH]
@@ -455,13 +458,13 @@ def continuum_families(
                 stretch = _trace_one(robot, world[i], seed, j, tol)
                 if stretch is None:
                     continue
+                traces += 1
                 th, Q, closed = stretch
-                spans += _pieces(i, traced.add(th, Q), th, closed, traced.periodic)
-                if left.shape[0]:  # the other seeds on it are not traced again
+                new = _pieces(i, traced.add(th, Q), th, closed, traced.periodic)
+                spans += new
+                if left.shape[0]:  # the other seeds on it are not traced again (those left are off the others)
                     mine = tuple(
-                        Family(j, (lo, hi), traced, chain[i], b, members=certified_members)
-                        for p, b, lo, hi in spans
-                        if p == i
+                        Family(j, (lo, hi), traced, chain[i], b, members=certified_members) for _, b, lo, hi in new
                     )
                     left = left[off_families(robot, [(left, mine)])[0]]
         if not spans:

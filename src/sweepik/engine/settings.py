@@ -331,6 +331,12 @@ TRACE_SINGULAR = 1e-5
 TRACE_SHARE = 1e-3
 #: Seeds corrected at once (``continuum_families``).
 SEED_BATCH = 8
+#: Families traced from one pose along one joint at most (``continuum_families``). A pose has a few; where each seed
+#: traces a family of its own, the pose lies on a self-motion of two or more dimensions (three revolute axes on one
+#: line: a Kuka iiwa with its elbow and wrist straight, a Panda with its elbow straight), and its candidates, thousands
+#: of them, are each on a curve of it of their own: traced, each filtered against every other, they took minutes.
+#: The families returned there are curves on it (the first traced), not all of it.
+MAX_TRACES = 32
 #: A traced stretch shorter than this fraction of a step is no family (the candidate is isolated).
 TRACE_MIN = 0.5
 #: A trace's first step is this fraction of a step; until the trace has gone ``TRACE_MIN`` of a step from its seed,
