@@ -151,11 +151,16 @@ def _perpendicular(H: Array, hk: Array, k: int, n: int) -> list[float]:
 
 def in_windows(value: float, windows: Array) -> bool:
     """Whether ``value`` (radians, any turn) lies in one of ``windows`` (``special_windows``)."""
+    return _window_of(value, windows) is not None
+
+
+def _window_of(value: float, windows: Array) -> int | None:
+    """The row of ``windows`` that holds ``value`` (radians, any turn), None where none does."""
     if windows.shape[0] == 0:
-        return False
+        return None
     v = math.remainder(value, 2.0 * math.pi)
     i = int(np.searchsorted(windows[:, 0], v, side="right")) - 1
-    return bool(i >= 0 and v <= windows[i, 1])
+    return i if i >= 0 and v <= windows[i, 1] else None
 
 
 def window_reference(value: float, windows: Array) -> float | None:
@@ -164,10 +169,9 @@ def window_reference(value: float, windows: Array) -> float | None:
     value in the window, at which what the window's values share can be chosen once (``reductions``'
     ``automatic_for_held``: the companion of the plan vouched for). A window that goes round (ends at -inf and inf)
     is one window."""
-    if not in_windows(value, windows):
+    i = _window_of(value, windows)
+    if i is None:
         return None
-    v = math.remainder(value, 2.0 * math.pi)
-    i = int(np.searchsorted(windows[:, 0], v, side="right")) - 1
     lo, hi = float(windows[i, 0]), float(windows[i, 1])
     if lo == -math.inf:  # (its start is the last window's, a turn before)
         lo = float(windows[-1, 0]) - 2.0 * math.pi if windows[-1, 1] == math.inf else -math.pi
