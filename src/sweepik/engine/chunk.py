@@ -48,7 +48,7 @@ from sweepik.engine.settle import (
     snap_reach,
     snap_to_limits,
 )
-from sweepik.errors import ShapeError
+from sweepik.errors import SearchOverflowError, ShapeError
 from sweepik.model.robot import Robot
 from sweepik.model.units import mm_per_unit, orientation_weight
 from sweepik.reductions import Reduction, get_reduction
@@ -429,15 +429,35 @@ def _fallback_solutions(
     if strategy != "precise" or not use_fallback or red.fallback is None:
         return fallback
     for by, deg in red.degenerate_fallbacks(chain):
-        idx = np.nonzero(deg)[0]
         alt_red = get_reduction(robot, by)
-        alt = solve_chunk(robot, alt_red, poses[idx], strategy, limits, n_samples, False)
-        if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
-            fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx)})
-            trace_cut_continua(robot, alt_red, chain, poses, idx, alt, limits, fams, fallback)
-        else:  # the reduction's blind spot: the fallback's families
-            fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)})
+        for idx, alt in _answered(robot, alt_red, poses, np.nonzero(deg)[0], strategy, limits, n_samples):
+            if red.closed_form:  # at or near its singular set a closed form loses digits: the sweep answers
+                fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx)})
+                trace_cut_continua(robot, alt_red, chain, poses, idx, alt, limits, fams, fallback)
+            else:  # the reduction's blind spot: the fallback's families
+                fallback.update({int(i): alt.solutions(k) for k, i in enumerate(idx) if alt.families.get(k)})
     return fallback
+
+
+def _answered(
+    robot: Robot, red: Reduction, poses: Array, idx: IntArray, strategy: str, limits: bool, n_samples: int
+) -> Iterator[tuple[IntArray, Block]]:
+    """``(idx, block)``: the poses ``idx`` solved by the fallback ``red``, in one chunk, or one by one where its search
+    overflows (``SearchOverflowError``), without those that overflow alone: such a pose's candidates cross the
+    fallback's residual more than ``settings.REDO_MAX_FOUND`` times (a self-motion of two dimensions, whose slices
+    make it zero along stretches), and the answer of the reduction that handed it over stands there."""
+    try:
+        block = solve_chunk(robot, red, poses[idx], strategy, limits, n_samples, False)
+    except SearchOverflowError:
+        if idx.size == 1:
+            return
+    else:
+        yield idx, block
+        return
+    for i in idx.tolist():
+        one = np.array([i], dtype=np.intp)
+        with contextlib.suppress(SearchOverflowError):
+            yield one, solve_chunk(robot, red, poses[one], strategy, limits, n_samples, False)
 
 
 def _block(

@@ -58,6 +58,7 @@ from sweepik.engine.settings import (
     PARALLEL_MIN,
     REDO_GROW,
     REDO_MAX_CAND,
+    REDO_MAX_FOUND,
     STACK,
     SUB_SAMPLES,
     U_EDGE,
@@ -1500,7 +1501,8 @@ def _redone(
     """The poses that overflowed the search's buffers (their candidates, family spans or pending intervals) searched
     again by the staged search on the same samples, leaving out the stretches ``masked`` (``Spans`` of these poses:
     continua traced already), with buffers ``REDO_GROW`` times larger, then (for the poses that still overflow) large
-    enough for twice the counts they reached, up to ``REDO_MAX_CAND`` candidates a pose. Pose by pose in order."""
+    enough for twice the counts they reached, up to ``REDO_MAX_CAND`` candidates a pose; a pose whose candidates (not
+    its families) overflow buffers of ``REDO_MAX_FOUND`` raises ``SearchOverflowError``. Pose by pose in order."""
     N = poses.shape[0]
     theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
     n_masks = np.zeros(N, dtype=np.int64)
@@ -1524,6 +1526,11 @@ def _redone(
         out = _Out.empty(todo.size, K, F)
         rows = (params[todo], theta[todo], n_theta[todo], lo[todo], hi[todo])
         _run_search(reduction, plan, *rows, multiplicity, out, masks[todo], n_masks[todo])
+        if K >= REDO_MAX_FOUND and np.any(out.cnt > K):
+            raise SearchOverflowError(
+                f"the search of {reduction.name!r} found more than {K} isolated candidates on a pose: its residual "
+                "crosses zero that often along theta* (a pose on a self-motion of two or more dimensions?)"
+            )
         over = (out.cnt > K) | (out.fcnt > F)
         c, sp = _gathered(out, over)
         mine = candidates.Candidates(todo[c.pose], c.branch, c.theta, c.mult)
