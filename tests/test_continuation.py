@@ -399,3 +399,27 @@ def test_a_self_motion_of_two_dimensions_is_answered(
         assert pose_error_geodesic(robot.fk(f.at(np.linspace(*f.interval, 5))), T, 1.0).max() <= tol
     if robot.within_limits(qq) or not limits:
         assert recovered(robot, sol, qq)
+
+
+def test_a_fallback_batch_that_overflows_goes_pose_by_pose(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``chunk._answered``: where the fallback's search overflows on a batch, its poses are solved one by one, and
+    only the pose that overflows alone is left to the reduction that handed it over."""
+    from sweepik.engine import chunk
+    from sweepik.errors import SearchOverflowError
+
+    poses = np.stack([np.eye(4) * (1.0 + i) for i in range(4)])
+    bad = 2.0  # (the pose whose search overflows)
+
+    def solved(robot, red, chunk_poses, *args):  # type: ignore[no-untyped-def]
+        if np.any(chunk_poses[:, 0, 0] == bad + 1.0):
+            raise SearchOverflowError("the search of 'x' found more than 1 isolated candidates")
+        return [float(p[0, 0]) for p in chunk_poses]
+
+    monkeypatch.setattr(chunk, "solve_chunk", solved)
+    idx = np.array([0, 2, 3], dtype=np.intp)
+    got = [(i.tolist(), b) for i, b in chunk._answered(None, None, poses, idx, "precise", True, 64)]
+    assert got == [([0], [1.0]), ([3], [4.0])]
+    assert [(i.tolist(), b) for i, b in chunk._answered(None, None, poses, idx[:1], "precise", True, 64)] == [
+        ([0], [1.0])
+    ]
+    assert list(chunk._answered(None, None, poses, np.array([2]), "precise", True, 64)) == []
