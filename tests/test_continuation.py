@@ -407,11 +407,10 @@ def test_a_fallback_batch_that_overflows_goes_pose_by_pose(monkeypatch: pytest.M
     from sweepik.engine import chunk
     from sweepik.errors import SearchOverflowError
 
-    poses = np.stack([np.eye(4) * (1.0 + i) for i in range(4)])
-    bad = 2.0  # (the pose whose search overflows)
+    poses = np.stack([np.eye(4) * (1.0 + i) for i in range(4)])  # (pose i marked i + 1)
 
     def solved(robot, red, chunk_poses, *args):  # type: ignore[no-untyped-def]
-        if np.any(chunk_poses[:, 0, 0] == bad + 1.0):
+        if np.any(chunk_poses[:, 0, 0] == 3.0):  # (pose 2's search overflows)
             raise SearchOverflowError("the search of 'x' found more than 1 isolated candidates")
         return [float(p[0, 0]) for p in chunk_poses]
 
