@@ -422,3 +422,13 @@ def test_a_fallback_batch_that_overflows_goes_pose_by_pose(monkeypatch: pytest.M
         ([0], [1.0])
     ]
     assert list(chunk._answered(None, None, poses, np.array([2]), "precise", True, 64)) == []
+
+
+def test_a_reductions_own_search_is_not_capped() -> None:
+    """The cap on a search's isolated candidates is the fallback's alone (``search.candidates_capped``): the Kinova
+    Gen3 held at joint 2 at its zero pose, whose own sweep's candidates pass it, is still answered (a first version
+    of the cap raised ``SearchOverflowError`` there)."""
+    robot = load_robot("kinova_gen3")
+    q = np.zeros(7)
+    sol = solve(robot, robot.fk(q), locked={1: 0.0})
+    assert recovered(robot, sol, q)

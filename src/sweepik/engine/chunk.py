@@ -37,6 +37,7 @@ from sweepik.engine.settings import (
     PAPER_ACCEPT_MM,
     POLISH_BELOW_REL,
     POLISH_SINGULAR_REL,
+    REDO_MAX_FOUND,
     SEED_TOL_REL,
 )
 from sweepik.engine.settle import (
@@ -445,9 +446,11 @@ def _answered(
     """``(idx, block)``: the poses ``idx`` solved by the fallback ``red``, in one chunk, or one by one where its search
     overflows (``SearchOverflowError``), without those that overflow alone: such a pose's candidates cross the
     fallback's residual more than ``settings.REDO_MAX_FOUND`` times (a self-motion of two dimensions, whose slices
-    make it zero along stretches), and the answer of the reduction that handed it over stands there."""
+    make it zero along stretches; ``search.candidates_capped``: a reduction's own search is not capped so), and the
+    answer of the reduction that handed it over stands there."""
     try:
-        block = solve_chunk(robot, red, poses[idx], strategy, limits, n_samples, False)
+        with search.candidates_capped(REDO_MAX_FOUND):
+            block = solve_chunk(robot, red, poses[idx], strategy, limits, n_samples, False)
     except SearchOverflowError:
         if idx.size == 1:
             return
@@ -456,8 +459,12 @@ def _answered(
         return
     for i in idx.tolist():
         one = np.array([i], dtype=np.intp)
-        with contextlib.suppress(SearchOverflowError):
-            yield one, solve_chunk(robot, red, poses[one], strategy, limits, n_samples, False)
+        try:
+            with search.candidates_capped(REDO_MAX_FOUND):  # (closed before the yield: the caller's steps uncapped)
+                block = solve_chunk(robot, red, poses[one], strategy, limits, n_samples, False)
+        except SearchOverflowError:
+            continue
+        yield one, block
 
 
 def _block(

@@ -18,7 +18,9 @@ from __future__ import annotations
 
 import math
 import weakref
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -58,7 +60,6 @@ from sweepik.engine.settings import (
     PARALLEL_MIN,
     REDO_GROW,
     REDO_MAX_CAND,
-    REDO_MAX_FOUND,
     STACK,
     SUB_SAMPLES,
     U_EDGE,
@@ -1495,6 +1496,22 @@ def _called_back(
     return candidates.twin_copies(reduction, cand, spans)
 
 
+#: Buffers of isolated candidates a pose may overflow before its search raises (``candidates_capped``); None: up to
+#: ``REDO_MAX_CAND``.
+_FOUND_CAP: ContextVar[int | None] = ContextVar("found_cap", default=None)
+
+
+@contextmanager
+def candidates_capped(cap: int) -> Iterator[None]:
+    """Within the block, a pose whose isolated candidates overflow buffers of ``cap`` raises ``SearchOverflowError``
+    at once (``_redone``) instead of searching again with larger ones (a fallback's search: ``chunk._answered``)."""
+    token = _FOUND_CAP.set(cap)
+    try:
+        yield
+    finally:
+        _FOUND_CAP.reset(token)
+
+
 def _redone(
     reduction, plan, poses, params, lo, hi, n_samples, multiplicity, masked
 ) -> tuple[candidates.Candidates, candidates.Spans]:
@@ -1502,7 +1519,8 @@ def _redone(
     again by the staged search on the same samples, leaving out the stretches ``masked`` (``Spans`` of these poses:
     continua traced already), with buffers ``REDO_GROW`` times larger, then (for the poses that still overflow) large
     enough for twice the counts they reached, up to ``REDO_MAX_CAND`` candidates a pose; a pose whose candidates (not
-    its families) overflow buffers of ``REDO_MAX_FOUND`` raises ``SearchOverflowError``. Pose by pose in order."""
+    its families) overflow buffers of the cap ``candidates_capped`` sets (a fallback's search) raises
+    ``SearchOverflowError``. Pose by pose in order."""
     N = poses.shape[0]
     theta, n_theta = sample_grid(reduction, poses, lo, hi, n_samples, params)
     n_masks = np.zeros(N, dtype=np.int64)
@@ -1526,7 +1544,8 @@ def _redone(
         out = _Out.empty(todo.size, K, F)
         rows = (params[todo], theta[todo], n_theta[todo], lo[todo], hi[todo])
         _run_search(reduction, plan, *rows, multiplicity, out, masks[todo], n_masks[todo])
-        if K >= REDO_MAX_FOUND and np.any(out.cnt > K):
+        cap = _FOUND_CAP.get()
+        if cap is not None and K >= cap and np.any(out.cnt > K):
             raise SearchOverflowError(
                 f"the search of {reduction.name!r} found more than {K} isolated candidates on a pose: its residual "
                 "crosses zero that often along theta* (a pose on a self-motion of two or more dimensions?)"

@@ -217,10 +217,12 @@ STACK = 512
 #: slide_parallel arm's, gives ~10,000 flat stretches).
 REDO_GROW = 8
 REDO_MAX_CAND = 1 << 22
-#: ... but a pose whose isolated candidates (not its family spans) overflow buffers of this many raises at once: on a
+#: ... but in a fallback's search (``search.candidates_capped``: ``chunk._answered``) a pose whose isolated candidates
+#: (not its family spans) overflow buffers of this many raises at once, and the fallback leaves it: on a
 #: self-motion of two dimensions (a Panda held at joint 6, axes 1, 3 and 5 on one line) a sweep's residual is zero
 #: along stretches of every slice, and its crossings grew eight times each round (168,000 ... 4 million; minutes).
-#: The families of a slide_parallel arm's pose above need buffers of 290,000 for 9,055 family spans, no candidate.
+#: The families of a slide_parallel arm's pose above need buffers of 290,000 for 9,055 family spans, no candidate; a
+#: Kinova Gen3 held at joint 2 at its zero pose, its own sweep's candidates past this cap, is answered in ~3 s.
 REDO_MAX_FOUND = 1 << 17
 #: Batches at least this large are searched with parallel threads.
 PARALLEL_MIN = 64
