@@ -448,23 +448,25 @@ def _answered(
     fallback's residual more than ``settings.REDO_MAX_FOUND`` times (a self-motion of two dimensions, whose slices
     make it zero along stretches; ``search.candidates_capped``: a reduction's own search is not capped so), and the
     answer of the reduction that handed it over stands there."""
-    try:
-        with search.candidates_capped(REDO_MAX_FOUND):
-            block = solve_chunk(robot, red, poses[idx], strategy, limits, n_samples, False)
-    except SearchOverflowError:
-        if idx.size == 1:
-            return
-    else:
+    block = _capped(robot, red, poses[idx], strategy, limits, n_samples)
+    if block is not None:
         yield idx, block
         return
-    for i in idx.tolist():
+    for i in idx.tolist() if idx.size > 1 else ():
         one = np.array([i], dtype=np.intp)
-        try:
-            with search.candidates_capped(REDO_MAX_FOUND):  # (closed before the yield: the caller's steps uncapped)
-                block = solve_chunk(robot, red, poses[one], strategy, limits, n_samples, False)
-        except SearchOverflowError:
-            continue
-        yield one, block
+        block = _capped(robot, red, poses[one], strategy, limits, n_samples)
+        if block is not None:
+            yield one, block
+
+
+def _capped(robot: Robot, red: Reduction, poses: Array, strategy: str, limits: bool, n_samples: int) -> Block | None:
+    """The fallback ``red``'s block of ``poses``, its search capped at ``REDO_MAX_FOUND`` candidates (the cap lifted
+    before the caller goes on); None where it overflows."""
+    try:
+        with search.candidates_capped(REDO_MAX_FOUND):
+            return solve_chunk(robot, red, poses, strategy, limits, n_samples, False)
+    except SearchOverflowError:
+        return None
 
 
 def _block(
